@@ -1,0 +1,54 @@
+# axon: the two set-up commands are `make run` and `make test` (see README.md).
+# Each installs missing Debian packages, configures with CMake presets and builds with Ninja.
+.PHONY: all deps release debug run test bench asan test-asan tsan test-tsan fuzz fuzz-smoke clean
+
+JOBS ?= $(shell nproc)
+CMAKE_EXTRA ?=
+
+all: release
+
+deps:
+	@bash scripts/install-deps.sh
+
+release: deps
+	@cmake --preset release $(CMAKE_EXTRA) >/dev/null
+	@cmake --build --preset release -j $(JOBS)
+
+debug: deps
+	@cmake --preset debug $(CMAKE_EXTRA) >/dev/null
+	@cmake --build --preset debug -j $(JOBS)
+
+run: release
+	./build/release/axon demo
+
+test: release
+	ctest --preset release -j $(JOBS)
+
+bench: release
+	@bash bench/run-all.sh build/release
+
+asan: deps
+	@cmake --preset asan $(CMAKE_EXTRA) >/dev/null
+	@cmake --build --preset asan -j $(JOBS)
+
+test-asan: asan
+	ctest --preset asan -j $(JOBS) -LE slow
+
+tsan: deps
+	@cmake --preset tsan $(CMAKE_EXTRA) >/dev/null
+	@cmake --build --preset tsan -j $(JOBS)
+
+test-tsan: tsan
+	ctest --preset tsan -j $(JOBS) -LE slow
+
+fuzz: deps
+	@cmake --preset fuzz $(CMAKE_EXTRA) >/dev/null
+	@cmake --build --preset fuzz -j $(JOBS)
+
+# A short run of every fuzz target (CI); FUZZ_SECONDS per target.
+FUZZ_SECONDS ?= 10
+fuzz-smoke: fuzz
+	@bash fuzz/smoke.sh build/fuzz $(FUZZ_SECONDS)
+
+clean:
+	rm -rf build

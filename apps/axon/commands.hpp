@@ -1,0 +1,19 @@
+// Subcommand groups of the axon CLI; one file each.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace axon::app {
+
+// Options every subcommand sees.
+struct GlobalOptions {
+  int verbosity = 0;  // -v / -vv raise, -q lowers
+};
+
+void add_can_commands(CLI::App& app, GlobalOptions& global);
+void add_demo_command(CLI::App& app, GlobalOptions& global);
+
+// Exit code chosen by the subcommand that ran.
+int& exit_code();
+
+}  // namespace axon::app

@@ -1,0 +1,76 @@
+#include "core/config.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+
+using axon::CoreErrc;
+using axon::core::ConfigNode;
+
+TEST(Config, ReadsTypedValues) {
+  auto root = ConfigNode::load_string("name: vcan0\nbitrate: 500000\nid: 0x1F\nscale: 2.5\nenabled: yes\n", "t.yaml");
+  ASSERT_TRUE(root);
+  EXPECT_EQ(root.value().get<std::string>("name").value(), "vcan0");
+  EXPECT_EQ(root.value().get<std::uint32_t>("bitrate").value(), 500000u);
+  EXPECT_EQ(root.value().get<int>("id").value(), 0x1F);
+  EXPECT_DOUBLE_EQ(root.value().get<double>("scale").value(), 2.5);
+  EXPECT_TRUE(root.value().get<bool>("enabled").value());
+  EXPECT_EQ(root.value().get_or<int>("absent", 7).value(), 7);
+}
+
+TEST(Config, ErrorNamesFileLineColumnAndKey) {
+  auto root = ConfigNode::load_string("buses:\n  - name: a\n    bitrate: fast\n", "buses.yaml").value();
+  auto buses = root.child("buses").value().items().value();
+  auto r = buses.at(0).get<std::uint32_t>("bitrate");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error(), CoreErrc::config_bad_value);
+  EXPECT_EQ(r.error().detail, "buses.yaml:3:14: key 'buses[0].bitrate': expected an integer (decimal or 0x hex), got 'fast'");
+}
+
+TEST(Config, MissingKeyIsNamed) {
+  auto root = ConfigNode::load_string("a: 1\n", "m.yaml").value();
+  auto r = root.get<int>("b");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error(), CoreErrc::config_missing_key);
+  EXPECT_NE(r.error().detail.find("key 'b'"), std::string::npos);
+}
+
+TEST(Config, RangeChecked) {
+  auto root = ConfigNode::load_string("priority: 120\n", "r.yaml").value();
+  auto r = root.get_in<int>("priority", 1, 99);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().detail.find("1..99"), std::string::npos);
+  EXPECT_NE(r.error().detail.find("'120'"), std::string::npos);
+  auto narrow = ConfigNode::load_string("v: 300\n").value().get<std::uint8_t>("v");
+  EXPECT_FALSE(narrow);
+  auto negative = ConfigNode::load_string("v: -1\n").value().get<unsigned>("v");
+  EXPECT_FALSE(negative);
+}
+
+TEST(Config, UnknownKeyRejectedWithPosition) {
+  auto root = ConfigNode::load_string("name: x\nbitrte: 1\n", "u.yaml").value();
+  auto r = root.reject_unknown({"name", "bitrate"});
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error(), CoreErrc::config_unknown_key);
+  EXPECT_NE(r.error().detail.find("u.yaml:2:1: key 'bitrte'"), std::string::npos);
+}
+
+TEST(Config, SyntaxErrorHasPosition) {
+  auto r = ConfigNode::load_string("a: [1, 2\n", "s.yaml");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error(), CoreErrc::config_syntax);
+  EXPECT_EQ(r.error().detail.rfind("s.yaml:", 0), 0u);
+}
+
+TEST(Config, LoadsFileAndReportsMissingFile) {
+  const std::string path = ::testing::TempDir() + "axon_config_test.yaml";
+  {
+    std::ofstream(path) << "x: 3\n";
+  }
+  EXPECT_EQ(ConfigNode::load_file(path).value().get<int>("x").value(), 3);
+  std::remove(path.c_str());
+  auto r = ConfigNode::load_file(path);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error(), CoreErrc::io);
+}
