@@ -32,14 +32,14 @@ asan: deps
 	@cmake --build --preset asan -j $(JOBS)
 
 test-asan: asan
-	ctest --preset asan -j $(JOBS) -LE slow
+	ctest --preset asan -j $(JOBS) -L unit
 
 tsan: deps
 	@cmake --preset tsan $(CMAKE_EXTRA) >/dev/null
 	@cmake --build --preset tsan -j $(JOBS)
 
 test-tsan: tsan
-	ctest --preset tsan -j $(JOBS) -LE slow
+	ctest --preset tsan -j $(JOBS) -L unit
 
 fuzz: deps
 	@cmake --preset fuzz $(CMAKE_EXTRA) >/dev/null
