@@ -1,0 +1,37 @@
+# Helpers for the multi-process integration tests (sourced, not run).
+set -euo pipefail
+AXON=${1:?usage: $0 PATH_TO_AXON}
+TMP=$(mktemp -d)
+PIDS=()
+cleanup() {
+  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
+  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
+  rm -rf "$TMP"
+}
+trap cleanup EXIT
+fail() { echo "FAIL: $*" >&2; for f in "$TMP"/*.out "$TMP"/*.err; do [ -f "$f" ] && { echo "--- $f" >&2; cat "$f" >&2; }; done; exit 1; }
+
+# wait_for_line FILE REGEX [SECONDS]: prints the first matching line once it appears.
+wait_for_line() {
+  local file=$1 re=$2 limit=${3:-20} i=0
+  while [ $i -lt $((limit * 20)) ]; do
+    if [ -f "$file" ] && grep -Eq "$re" "$file"; then grep -Em1 "$re" "$file"; return 0; fi
+    sleep 0.05; i=$((i + 1))
+  done
+  fail "timed out waiting for /$re/ in $file"
+}
+
+# start_bridge ARGS...: starts `axon can bridge ARGS` in the background; sets SCD_PORT / CANNET_PORT
+# from its "listening" lines.
+start_bridge() {
+  "$AXON" can bridge "$@" >"$TMP/bridge.out" 2>"$TMP/bridge.err" &
+  PIDS+=($!)
+  BRIDGE_PID=$!
+  SCD_PORT=""; CANNET_PORT=""
+  for arg in "$@"; do
+    case "$arg" in
+      cannet://*) CANNET_PORT=$(wait_for_line "$TMP/bridge.out" '^listening cannet ' | sed 's/.*://') ;;
+      *:*) SCD_PORT=$(wait_for_line "$TMP/bridge.out" '^listening socketcand ' | sed 's/.*://') ;;
+    esac
+  done
+}
