@@ -35,6 +35,16 @@ Result<Filter::Format> parse_format(const ConfigNode& node) {
   return c.error(CoreErrc::config_bad_value, fmt::format("unknown format '{}'; expected any, standard or extended", text));
 }
 
+// An optional count or seed (0 or more). Read as a signed number so that a negative value gets a
+// clear message.
+Result<std::uint64_t> non_negative(const ConfigNode& node, std::string_view key, std::uint64_t fallback) {
+  if (!node.has(key)) return fallback;
+  AXON_TRY(c, node.child(key));
+  AXON_TRY(v, c.as<std::int64_t>());
+  if (v < 0) return c.error(CoreErrc::config_bad_value, fmt::format("expected 0 or more, got {}", v));
+  return static_cast<std::uint64_t>(v);
+}
+
 // A key that only makes sense with one action.
 Result<void> only_with(const ConfigNode& node, std::string_view key, FaultRule::Action have, FaultRule::Action need,
                        std::string_view need_name) {
@@ -62,10 +72,14 @@ Result<FaultRule> parse_rule(const ConfigNode& node) {
   AXON_TRY(format, parse_format(node));
   r.match.format = format;
 
-  AXON_TRY(skip, node.get_or<std::uint64_t>("skip", 0));
+  AXON_TRY(skip, non_negative(node, "skip", 0));
   r.skip = skip;
   if (node.has("count")) {
-    AXON_TRY(count, node.get_in<std::uint64_t>("count", 1, std::numeric_limits<std::uint64_t>::max()));
+    AXON_TRY(count, non_negative(node, "count", 0));
+    if (count == 0) {
+      AXON_TRY(c, node.child("count"));
+      return c.error(CoreErrc::config_bad_value, "expected 1 or more (a rule with count 0 never fires)");
+    }
     r.count = count;
   }
   if (node.has("probability")) {
@@ -95,7 +109,7 @@ Result<FaultPlan> FaultPlan::from_config(const ConfigNode& node) {
   if (!node.is_map()) return node.error(CoreErrc::config_bad_value, "expected a fault plan (a map with 'seed' and 'rules')");
   AXON_TRY(node.reject_unknown({"seed", "rules"}));
   FaultPlan plan;
-  AXON_TRY(seed, node.get_or<std::uint64_t>("seed", 1));
+  AXON_TRY(seed, non_negative(node, "seed", 1));
   plan.seed = seed;
   if (!node.has("rules")) return plan;
   AXON_TRY(rules, node.child("rules"));
