@@ -116,7 +116,7 @@ struct VirtualBus::Impl {
 
   void run() {
     if (pacing()) {
-      start_next();
+      start_next(false);
       return;
     }
     while (begin()) {
@@ -211,33 +211,40 @@ struct VirtualBus::Impl {
       if (n->id() != sender) n->hand_in(f);
   }
 
-  // Paced mode: arbitrate, then hold the medium for the winner's bit time.
-  void start_next() {
+  // Paced mode: arbitrate, then hold the medium for the winner's bit time. `back_to_back`: the
+  // previous frame has just ended, so this one starts where that one ended (not when the timer
+  // handler happened to run), and wake-up latency does not pile up over a burst.
+  void start_next(bool back_to_back) {
     if (!begin()) {
       active = false;
       return;
     }
-    hold_wire();
+    hold_wire(back_to_back);
   }
 
-  void hold_wire() {
+  // How far the medium may lag behind the wire schedule and still catch up by sending the next
+  // frames sooner; a longer stall (a descheduled process) restarts the schedule instead of
+  // flushing a burst no real bus could carry.
+  static constexpr core::Duration kMaxCatchUp = std::chrono::milliseconds(2);
+
+  void hold_wire(bool back_to_back) {
     const auto now = core::SteadyClock::instance().now();
-    if (now >= wire_free) {  // the medium was idle: a new burst starts now
+    if (!back_to_back || now - wire_free > kMaxCatchUp) {
       burst_start = now;
       burst_bits = 0;
     }
     burst_bits += on_wire.bits;
-    // Measured from the start of the burst so that rounding and wake-up latency never add up.
+    // Measured from the start of the burst so that rounding never adds up either.
     wire_free = burst_start + bits_to_time(burst_bits, wire.bitrate);
     wire_timer.expires_at(wire_free);
     wire_timer.async_wait([s = self()](const boost::system::error_code& ec) {
       if (ec == asio::error::operation_aborted) return;
       auto& m = *s->impl_;
       if (m.finish_copy()) {
-        m.hold_wire();
+        m.hold_wire(true);
         return;
       }
-      m.start_next();
+      m.start_next(true);
     });
   }
 
