@@ -53,7 +53,7 @@ Bus::~Bus() = default;
 
 void Bus::set_filters(std::vector<Filter> filters) { filters_ = std::move(filters); }
 
-void Bus::deliver(Frame frame) {
+void Bus::deliver(Frame frame, std::uint32_t wire_bits) {
   if (state_ == BusState::closed) return;
   if (!filters_.empty() && std::none_of(filters_.begin(), filters_.end(), [&](const Filter& f) { return f.matches(frame); })) {
     ++stats_.rx_filtered;
@@ -64,14 +64,14 @@ void Bus::deliver(Frame frame) {
     return;
   }
   ++stats_.frames_in;
-  stats_.bits_in += frame_bits(frame).total;
+  stats_.bits_in += wire_bits;
   rx_.push_back(frame);
   wake_receivers();
 }
 
-void Bus::count_sent(const Frame& frame) noexcept {
+void Bus::count_sent(const Frame&, std::uint32_t wire_bits) noexcept {
   ++stats_.frames_out;
-  stats_.bits_out += frame_bits(frame).total;
+  stats_.bits_out += wire_bits;
 }
 
 void Bus::set_state(BusState s) noexcept {

@@ -107,9 +107,13 @@ class Bus {
 
  protected:
   // For transports: a frame came in from the wire (filters, statistics, queue; drops counted).
-  void deliver(Frame frame);
+  void deliver(Frame frame) { deliver(frame, frame_bits(frame).total); }
+  // The same, for transports that already know the frame's wire bits (one computation per frame
+  // however many receivers).
+  void deliver(Frame frame, std::uint32_t wire_bits);
   // For transports: a frame went out.
-  void count_sent(const Frame& frame) noexcept;
+  void count_sent(const Frame& frame) noexcept { count_sent(frame, frame_bits(frame).total); }
+  void count_sent(const Frame& frame, std::uint32_t wire_bits) noexcept;
   void set_state(BusState s) noexcept;
   BusStats& mutable_stats() noexcept { return stats_; }
 

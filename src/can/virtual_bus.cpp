@@ -42,8 +42,8 @@ class VirtualNode final : public Bus {
   // Medium side.
   [[nodiscard]] std::uint64_t id() const noexcept { return id_; }
   std::deque<Queued>& queue() noexcept { return tx_; }
-  void take(const Frame& f) noexcept { count_sent(f); }
-  void hand_in(const Frame& f) { deliver(f); }
+  void take(const Frame& f, std::uint32_t bits) noexcept { count_sent(f, bits); }
+  void hand_in(const Frame& f, std::uint32_t bits) { deliver(f, bits); }
 
  private:
   static asio::any_io_executor impl_executor(const VirtualBus::Impl& impl);
@@ -154,7 +154,8 @@ struct VirtualBus::Impl {
     if (!winner) return false;
     const Frame frame = winner->queue().front().frame;
     winner->queue().pop_front();
-    winner->take(frame);
+    const std::uint32_t bits = frame_bits(frame).total;
+    winner->take(frame, bits);
 
     on_wire = OnWire{};
     on_wire.sender = winner->id();
@@ -176,7 +177,7 @@ struct VirtualBus::Impl {
       on_wire.frame = d.frame;
     }
     // The wire carries what the sender sent; corruption is the receivers' view of it.
-    on_wire.bits = accounting() ? frame_bits(frame).total : 0;
+    on_wire.bits = accounting() ? bits : 0;
     account();
     return true;
   }
@@ -207,8 +208,9 @@ struct VirtualBus::Impl {
   }
 
   void deliver_all(const Frame& f, std::uint64_t sender) {
+    const std::uint32_t bits = frame_bits(f).total;
     for (auto* n : nodes)
-      if (n->id() != sender) n->hand_in(f);
+      if (n->id() != sender) n->hand_in(f, bits);
   }
 
   // Paced mode: arbitrate, then hold the medium for the winner's bit time. `back_to_back`: the

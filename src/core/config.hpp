@@ -8,10 +8,12 @@
 
 #include "core/error.hpp"
 
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cstdint>
 #include <initializer_list>
+#include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -77,7 +79,7 @@ class ConfigNode {
   [[nodiscard]] Result<double> as_double() const;
   template <class T>
   static std::string range_text(T lo, T hi, const std::string& got) {
-    return "expected a value within " + std::to_string(lo) + ".." + std::to_string(hi) + ", got '" + got + "'";
+    return fmt::format("expected a value within {}..{}, got '{}'", lo, hi, got);
   }
 
   YAML::Node node_;
@@ -99,8 +101,7 @@ Result<T> ConfigNode::as() const {
     AXON_TRY(v, as_int64());
     if (v < static_cast<std::int64_t>(std::numeric_limits<T>::min()) ||
         (v > 0 && static_cast<std::uint64_t>(v) > static_cast<std::uint64_t>(std::numeric_limits<T>::max())))
-      return error(CoreErrc::config_bad_value, range_text<long long>(static_cast<long long>(std::numeric_limits<T>::min()),
-                                                              static_cast<long long>(std::numeric_limits<T>::max()), scalar()));
+      return error(CoreErrc::config_bad_value, range_text(std::numeric_limits<T>::min(), std::numeric_limits<T>::max(), scalar()));
     return static_cast<T>(v);
   } else if constexpr (std::is_floating_point_v<T>) {
     AXON_TRY(v, as_double());

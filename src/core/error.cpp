@@ -5,7 +5,10 @@ namespace axon {
 std::string Error::message() const {
   std::string m = code ? code.message() : std::string("no error");
   if (detail.empty()) return m;
-  return detail + ": " + m;
+  std::string out;
+  out.reserve(detail.size() + 2 + m.size());
+  out.append(detail).append(": ").append(m);
+  return out;
 }
 
 namespace {

@@ -46,6 +46,10 @@ TEST(Config, RangeChecked) {
   EXPECT_FALSE(narrow);
   auto negative = ConfigNode::load_string("v: -1\n").value().get<unsigned>("v");
   EXPECT_FALSE(negative);
+  EXPECT_NE(negative.error().detail.find("0..4294967295"), std::string::npos) << negative.error().detail;
+  auto wide = ConfigNode::load_string("v: -1\n").value().get<std::uint64_t>("v");
+  ASSERT_FALSE(wide);
+  EXPECT_NE(wide.error().detail.find("0..18446744073709551615"), std::string::npos) << wide.error().detail;
 }
 
 TEST(Config, UnknownKeyRejectedWithPosition) {
