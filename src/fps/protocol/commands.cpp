@@ -63,9 +63,14 @@ std::string command_name(std::uint8_t number) {
   return fmt::format("UNKNOWN_COMMAND_{}", number);
 }
 
-Result<void> check_request(const CommandInfo& c, bool broadcast, std::size_t size) {
+Result<void> check_request(const CommandInfo& c, bool broadcast, std::size_t size, std::optional<Mode> mode) {
   if (!c.host_sends) {
     return Error(ProtocolErrc::not_sendable, fmt::format("{} ({})", c.name, c.number()));
+  }
+  if (mode && !c.valid_in(*mode)) {
+    return Error(ProtocolErrc::wrong_mode,
+                 fmt::format("{} ({}) is not taken by the {}", c.name, c.number(),
+                             *mode == Mode::bootloader ? "bootloader" : "main application"));
   }
   if (broadcast && !c.broadcast) {
     return Error(ProtocolErrc::broadcast_not_allowed, fmt::format("{} ({})", c.name, c.number()));

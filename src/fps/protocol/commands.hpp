@@ -331,10 +331,12 @@ const CommandInfo* find_command(std::string_view name) noexcept;
 // Printable name of any number ("UNKNOWN_COMMAND_250" when unknown).
 std::string command_name(std::uint8_t number);
 
-// Host side: may this request go out? Checks that the host sends this command, that a broadcast
-// (positioner 0) is allowed, and the payload size. Errors: not_sendable, broadcast_not_allowed,
+// Host side: may this request go out? Checks that the host sends this command, that the addressed
+// firmware takes it (when the caller knows which one runs), that a broadcast (positioner 0) is
+// allowed, and the payload size. Errors: not_sendable, wrong_mode, broadcast_not_allowed,
 // wrong_length.
-Result<void> check_request(const CommandInfo& c, bool broadcast, std::size_t size);
+Result<void> check_request(const CommandInfo& c, bool broadcast, std::size_t size,
+                           std::optional<Mode> mode = std::nullopt);
 
 // Host side: does an accepted reply have the size its command declares (in the given firmware)?
 // A reply with a non-zero response code may be empty or have the accepted size; anything else is

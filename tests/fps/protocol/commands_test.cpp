@@ -112,6 +112,11 @@ TEST(FpsCommands, HostChecks) {
   EXPECT_TRUE(check_request(go, false, 8));
   EXPECT_EQ(check_request(go, false, 0).error(), ProtocolErrc::wrong_length);
   EXPECT_EQ(check_request(go, true, 8).error(), ProtocolErrc::broadcast_not_allowed);
+  EXPECT_EQ(check_request(go, false, 8, Mode::bootloader).error(), ProtocolErrc::wrong_mode);
+  EXPECT_TRUE(check_request(go, false, 8, Mode::application));
+  EXPECT_EQ(check_request(command_info(CommandId::firmware_data), false, 8, Mode::application).error(),
+            ProtocolErrc::wrong_mode);
+  EXPECT_TRUE(check_request(command_info(CommandId::get_status), true, 0, Mode::bootloader));
   EXPECT_TRUE(check_reply(go, Mode::application, ResponseCode::accepted, 8));
   EXPECT_EQ(check_reply(go, Mode::application, ResponseCode::accepted, 0).error(), ProtocolErrc::wrong_length);
   EXPECT_TRUE(check_reply(go, Mode::application, ResponseCode::value_out_of_range, 0));
