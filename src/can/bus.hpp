@@ -94,7 +94,8 @@ class Bus {
   [[nodiscard]] virtual std::size_t tx_pending() const noexcept { return 0; }
 
   // Receive filters: a frame passes if any filter matches; no filters pass everything.
-  void set_filters(std::vector<Filter> filters);
+  // Transports that can also filter below user space (SocketCAN) override this and call it.
+  virtual void set_filters(std::vector<Filter> filters);
   [[nodiscard]] const std::vector<Filter>& filters() const noexcept { return filters_; }
 
   [[nodiscard]] const BusStats& stats() const noexcept { return stats_; }
