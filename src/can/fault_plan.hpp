@@ -44,6 +44,7 @@ class FaultInjector {
   struct Decision {
     bool drop = false;
     bool duplicate = false;
+    bool corrupted = false;
     core::Duration delay{0};
     Frame frame;  // possibly corrupted
   };
