@@ -116,23 +116,22 @@ void append_timestamp(std::string& out, core::WallTime t) {
 
 namespace {
 
-Result<Message> parse_fields(std::string_view text, const Fields& f) {
+// Errors carry only the reason; parse() adds the message itself.
+Result<Message> parse_fields(const Fields& f) {
   const std::string_view kw = f.v[0];
-  auto bad = [&](std::string_view why) {
-    return Error(CanErrc::parse_error, fmt::format("socketcand '{}': {}", excerpt(text), why));
-  };
+  auto bad = [&](std::string_view why) { return Error(CanErrc::parse_error, std::string(why)); };
   auto no_args = [&](Message m) -> Result<Message> {
     if (f.args() != 0) return bad(fmt::format("'{}' takes no arguments", kw));
     return m;
   };
   auto id_field = [&](std::string_view s) -> Result<Id> {
     auto id = parse_id(s);
-    if (!id) return bad(id.error().detail);
+    if (!id) return id.error();
     return id.value();
   };
   auto time_field = [&](std::string_view s) -> Result<core::WallTime> {
     auto t = parse_timestamp(s);
-    if (!t) return bad(t.error().detail);
+    if (!t) return t.error();
     return t.value();
   };
   // A length/DLC field: one or two hex digits, value 0..8 (decimal and hex agree there).
@@ -254,15 +253,16 @@ Result<Message> parse_fields(std::string_view text, const Fields& f) {
   }
 
   if (kw == "fdframe" || kw == "fdsend") return bad("CAN FD frames are not supported");
+  if (kw == "add" || kw == "update" || kw == "delete" || kw == "filter" || kw == "muxfilter" || kw == "subscribe" ||
+      kw == "unsubscribe" || kw == "isotpconf" || kw == "sendpdu")
+    return bad(fmt::format("'{}' (broadcast manager / ISO-TP) is not supported", kw));
   return bad(fmt::format("unknown command '{}'", excerpt(kw, 20)));
 }
 
 }  // namespace
 
-Result<Message> parse(std::string_view text) {
-  auto bad = [&](std::string_view why) {
-    return Error(CanErrc::parse_error, fmt::format("socketcand '{}': {}", excerpt(text), why));
-  };
+Result<Message> parse_terse(std::string_view text) {
+  auto bad = [&](std::string_view why) { return Error(CanErrc::parse_error, std::string(why)); };
   if (text.size() < 2 || text.front() != '<' || text.back() != '>') return bad("not enclosed in '<' '>'");
   if (text.size() > kMaxMessageLength) return bad(fmt::format("longer than {} characters", kMaxMessageLength));
   const std::string_view inner = text.substr(1, text.size() - 2);
@@ -282,7 +282,13 @@ Result<Message> parse(std::string_view text) {
     f.v[f.n++] = inner.substr(start, i - start);
   }
   if (f.n == 0) return bad("empty message");
-  return parse_fields(text, f);
+  return parse_fields(f);
+}
+
+Result<Message> parse(std::string_view text) {
+  auto r = parse_terse(text);
+  if (!r) return Error(CanErrc::parse_error, fmt::format("socketcand message '{}': {}", excerpt(text), r.error().detail));
+  return r;
 }
 
 // ------------------------------------------------------------------------------------------ format
@@ -405,7 +411,7 @@ void Tokenizer::compact() {
 
 Error Tokenizer::framing_error(std::string_view what, std::string_view sample) {
   ++stats_.errors;
-  return Error(CanErrc::parse_error, fmt::format("socketcand stream: {}: '{}'", what, excerpt(sample)));
+  return Error(CanErrc::parse_error, fmt::format("socketcand stream: {}: {}", what, excerpt(sample)));
 }
 
 Error Tokenizer::garbage_error(std::string_view what) {
@@ -429,7 +435,7 @@ std::optional<Result<std::string>> Tokenizer::next() {
           if (garbage_ >= max_length_) return garbage_error("garbage between messages");
         }
         if (pos_ == buf_.size()) return std::nullopt;
-        if (garbage_ > 0) return garbage_error(fmt::format("{} garbage byte(s) before '<'", garbage_));
+        if (garbage_ > 0) return garbage_error(fmt::format("{} garbage byte(s) between messages", garbage_));
         state_ = State::inside;
         scan_ = pos_ + 1;
         break;
@@ -450,7 +456,7 @@ std::optional<Result<std::string>> Tokenizer::next() {
             const std::size_t from = pos_;
             pos_ = scan_;
             scan_ = pos_ + 1;
-            return framing_error("message not terminated by '>' before the next '<'",
+            return framing_error("message cut short by the start of another",
                                  std::string_view(buf_).substr(from, pos_ - from));
           }
           ++scan_;
@@ -460,7 +466,7 @@ std::optional<Result<std::string>> Tokenizer::next() {
           const std::size_t from = pos_;
           pos_ = scan_;
           state_ = State::skipping;
-          return framing_error(fmt::format("no '>' within {} bytes", max_length_),
+          return framing_error(fmt::format("message longer than {} bytes", max_length_),
                                std::string_view(buf_).substr(from, pos_ - from));
         }
         return std::nullopt;

@@ -97,6 +97,9 @@ using Message =
 // Parses one complete message, '<' and '>' included (what Tokenizer::next() yields).
 // Errors: CanErrc::parse_error with the message text and what is wrong with it.
 Result<Message> parse(std::string_view text);
+// The same, but the error detail is only the reason ("length 2 but 1 data bytes"), without the
+// message quoted: what a server puts in its `< error ... >` answer.
+Result<Message> parse_terse(std::string_view text);
 
 // The exact text of a message. Empty frame data is written as two spaces ("< frame 123 1.000000  >"),
 // as the daemon does and as python-can's parser needs.
