@@ -54,7 +54,8 @@ asio::awaitable<Result<sc::Message>> read_message(tcp::socket& socket, sc::Token
 }
 
 // Sends a command during the handshake and reads the answer; `< ok >` is success.
-asio::awaitable<Result<void>> command(tcp::socket& socket, sc::Tokenizer& tokenizer, const sc::Message& cmd) {
+// (Called with named messages: GCC 12 destroys aggregate temporaries in co_await expressions twice.)
+asio::awaitable<Result<void>> command(tcp::socket& socket, sc::Tokenizer& tokenizer, sc::Message cmd) {
   const std::string text = sc::format(cmd);
   boost::system::error_code ec;
   co_await asio::async_write(socket, asio::buffer(text), asio::redirect_error(asio::use_awaitable, ec));
@@ -109,9 +110,12 @@ asio::awaitable<Result<std::unique_ptr<SocketcandBus>>> SocketcandBus::connect(a
   if (!hi) co_return fail(hi.error());
   if (!std::holds_alternative<sc::Hi>(hi.value()))
     co_return fail(Error(CanErrc::protocol_error, fmt::format("expected < hi >, got {}", sc::format(hi.value()))));
-  if (auto r = co_await command(conn->socket, conn->tokenizer, sc::Open{channel}); !r) co_return fail(r.error());
-  if (auto r = co_await command(conn->socket, conn->tokenizer, sc::Mode{sc::Mode::Kind::raw}); !r)
-    co_return fail(r.error());
+  const sc::Message open_cmd = sc::Open{channel};
+  auto opened = co_await command(conn->socket, conn->tokenizer, open_cmd);
+  if (!opened) co_return fail(opened.error());
+  const sc::Message raw_cmd = sc::Mode{sc::Mode::Kind::raw};
+  auto raw = co_await command(conn->socket, conn->tokenizer, raw_cmd);
+  if (!raw) co_return fail(raw.error());
   deadline.cancel();
   if (*timed_out) co_return fail(Error(CanErrc::timeout, ""));
 
