@@ -75,7 +75,7 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
   std::string channel;
   std::shared_ptr<Bus> bus;  // the forwarding coroutine holds its own reference
   State state = State::no_bus;
-  bool newline = false;      // end every message with '\n' (set once raw mode is confirmed)
+  bool separate = false;     // put '\n' before every message (set once raw mode is confirmed)
   bool hang_up = false;      // close once the queued answers are written
   bool ended = false;
   std::uint64_t errors = 0;
@@ -121,8 +121,8 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
 
   void reply(const sc::Message& m) {
     scratch.clear();
+    if (separate) scratch += '\n';
     sc::append(scratch, m);
-    if (newline) scratch += '\n';
     writer.write(scratch, 1, shared_from_this());
   }
 
@@ -246,7 +246,7 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
     reply(sc::Ok{});
     if (target == State::raw) {
       bus->set_filters({});
-      if (server->options.newline_after_message) newline = true;
+      if (server->options.separate_messages) separate = true;
       asio::co_spawn(socket.get_executor(), forward(shared_from_this(), bus), asio::detached);
     } else if (target == State::control && stats_interval_ms > 0) {
       start_statistics();
@@ -286,8 +286,8 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
       for (std::optional<Frame> next = f.value(); next; next = endpoint->try_receive()) {
         Frame frame = *next;
         if (frame.timestamp() == core::WallTime::zero()) frame.set_timestamp(wall_now());
+        if (self->separate) text += '\n';
         sc::append(text, sc::FrameMessage{frame});
-        if (self->newline) text += '\n';
         ++n;
         self->counters.rx_bytes += frame.payload().size();
         if (text.size() >= 16 * 1024) break;

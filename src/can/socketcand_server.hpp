@@ -14,7 +14,7 @@
 // the provider does not have: the server answers `< error ... >` and hangs up.
 //
 // Wire format, chosen for python-can 4.1 (see docs/can-socketcand.md): handshake answers are sent
-// alone and unterminated; once raw mode is confirmed, every message is followed by '\n' and frames
+// alone and unterminated; once raw mode is confirmed, every message is preceded by '\n' and frames
 // start only `raw_start_delay` after the `< ok >`.
 //
 // Threading: the server, its sessions and the provider's buses share one executor.
@@ -36,10 +36,12 @@ struct SocketcandServerOptions {
   // which read the handshake answer with one recv() (python-can) get it alone. Frames that arrive
   // meanwhile wait in the endpoint's queue; none is lost.
   core::Duration raw_start_delay = std::chrono::milliseconds(50);
-  // Once in raw mode, end every message with '\n'. The daemon writes messages back to back;
-  // python-can 4.1 drops one character after each batch it reads, which is then a separator
-  // instead of the '<' of the next message. Other clients skip what is between messages.
-  bool newline_after_message = true;
+  // Once in raw mode, put '\n' before every message. The daemon writes messages back to back;
+  // python-can 4.1 drops one character after the last complete message of each read, which then
+  // is this separator instead of the '<' of a message cut by the read (that frame would be lost).
+  // Before rather than after: a read that ends with a message then leaves nothing behind for
+  // python-can to warn about. Other clients skip whatever is between messages.
+  bool separate_messages = true;
   std::size_t max_clients = 64;
   // Bytes queued for one client's socket before the server stops taking frames from its endpoint
   // (a slow reader then loses frames in the endpoint's receive queue, counted in its rx_dropped).

@@ -118,10 +118,8 @@ TEST_F(SocketcandServerTest, ForwardsBusFramesInTheDaemonsFormat) {
     }
     EXPECT_EQ(frame_of(m2), F("00000456#AABBCCDDEEFF0011"));
     EXPECT_EQ(frame_of(m4), F("1ABCDEF0#R3"));
-    // In raw mode every message ends with a newline (see SocketcandServerOptions).
-    const std::string& raw = peer.raw();
-    const std::string tail = raw.substr(raw.find(m1));
-    EXPECT_EQ(tail, m1 + "\n" + m2 + "\n" + m3 + "\n" + m4 + "\n");
+    // In raw mode a newline goes before every message (see SocketcandServerOptions).
+    EXPECT_EQ(peer.raw(), "< hi >< ok >< ok >\n" + m1 + "\n" + m2 + "\n" + m3 + "\n" + m4);
   });
   EXPECT_EQ(server_->stats().frames_out, 4u);
 }
@@ -137,9 +135,9 @@ TEST_F(SocketcandServerTest, KeepsTheFramesOwnTimestamp) {
   });
 }
 
-TEST_F(SocketcandServerTest, WithoutNewlinesTheOutputIsByteForByteTheDaemons) {
+TEST_F(SocketcandServerTest, WithoutSeparatorsTheOutputIsByteForByteTheDaemons) {
   SocketcandServerOptions o;
-  o.newline_after_message = false;
+  o.separate_messages = false;
   o.raw_start_delay = core::Duration::zero();
   start_server(o);
   auto node = vcan0_->attach("node");
