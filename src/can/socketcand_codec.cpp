@@ -97,11 +97,14 @@ Result<core::WallTime> parse_timestamp(std::string_view text) {
   const std::string_view sec_text = text.substr(0, dot);
   const std::string_view frac = dot == std::string_view::npos ? std::string_view{} : text.substr(dot + 1);
   if (!all_decimal(sec_text)) return bad("seconds are not decimal digits");
-  if (sec_text.size() > 12) return bad("seconds out of range");
+  // Nanoseconds since 1970 in 64 bits reach the year 2262; accept up to 2255.
+  constexpr std::int64_t kMaxSeconds = 9'000'000'000;
+  if (sec_text.size() > 10) return bad("seconds out of range");
   if (dot != std::string_view::npos && (frac.empty() || frac.size() > 9 || !all_decimal(frac)))
     return bad("fraction must be 1 to 9 decimal digits");
   std::int64_t sec = 0;
   parse_unsigned(sec_text, sec, 10);
+  if (sec > kMaxSeconds) return bad("seconds out of range");
   std::int64_t usec = 0;
   for (std::size_t i = 0; i < 6; ++i) usec = usec * 10 + (i < frac.size() ? frac[i] - '0' : 0);
   return core::WallTime(sec * 1'000'000'000LL + usec * 1'000LL);

@@ -75,9 +75,10 @@ TEST(SocketcandTimestamp, ParsesSecondsAndFraction) {
   EXPECT_EQ(parse_timestamp("1700000000.000001").value(), core::WallTime(1'700'000'000'000'001'000));
   EXPECT_EQ(parse_timestamp("5").value(), core::WallTime(5'000'000'000));
   EXPECT_EQ(parse_timestamp("5.5").value(), core::WallTime(5'500'000'000));
+  EXPECT_EQ(parse_timestamp("9000000000.999999").value(), core::WallTime(9'000'000'000'999'999'000));
   // Beyond microseconds the digits are dropped, so formatting and parsing again is stable.
   EXPECT_EQ(parse_timestamp("1.123456789").value(), core::WallTime(1'123'456'000));
-  for (const char* bad : {"", ".5", "1.", "1.2.3", "a.000001", "1.00000x", "-1.000000", "1.1234567890", "1234567890123.0"})
+  for (const char* bad : {"", ".5", "1.", "1.2.3", "a.000001", "1.00000x", "-1.000000", "1.1234567890", "1234567890123.0", "9000000001.0", "99999999999"})
     EXPECT_FALSE(parse_timestamp(bad)) << bad;
 }
 
