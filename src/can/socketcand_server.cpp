@@ -321,26 +321,43 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
   }
 };
 
-SocketcandServer::SocketcandServer(asio::any_io_executor ex, BusProvider& provider, net::Endpoint listen,
+SocketcandServer::SocketcandServer(Unbound, asio::any_io_executor ex, BusProvider& provider,
                                    SocketcandServerOptions options)
-    : impl_(std::make_shared<Impl>(std::move(ex), provider, options)) {
+    : impl_(std::make_shared<Impl>(std::move(ex), provider, options)) {}
+
+SocketcandServer::SocketcandServer(asio::any_io_executor ex, BusProvider& provider, net::Endpoint listen_on,
+                                   SocketcandServerOptions options)
+    : SocketcandServer(Unbound{}, std::move(ex), provider, options) {
+  if (auto r = listen(listen_on); !r) throw Exception(r.error());
+}
+
+Result<std::unique_ptr<SocketcandServer>> SocketcandServer::create(asio::any_io_executor ex, BusProvider& provider,
+                                                                   net::Endpoint listen_on,
+                                                                   SocketcandServerOptions options) {
+  std::unique_ptr<SocketcandServer> server(new SocketcandServer(Unbound{}, std::move(ex), provider, options));
+  AXON_TRY(server->listen(listen_on));
+  return server;
+}
+
+Result<void> SocketcandServer::listen(const net::Endpoint& where) {
   auto fail = [&](const std::string& what, const boost::system::error_code& ec) {
-    throw Exception(Error(CanErrc::io, fmt::format("socketcand server on {}: {}: {}", listen.to_string(), what, ec.message())));
+    return Error(CanErrc::io, fmt::format("socketcand server on {}: {}: {}", where.to_string(), what, ec.message()));
   };
   boost::system::error_code ec;
   tcp::resolver resolver(impl_->ex);
-  const auto results = resolver.resolve(listen.host, std::to_string(listen.port), tcp::resolver::passive, ec);
-  if (ec || results.empty()) fail("resolving the address", ec);
+  const auto results = resolver.resolve(where.host, std::to_string(where.port), tcp::resolver::passive, ec);
+  if (ec || results.empty()) return fail("resolving the address", ec);
   const tcp::endpoint ep = results.begin()->endpoint();
   auto& acc = impl_->acceptor;
   acc.open(ep.protocol(), ec);
-  if (ec) fail("opening the socket", ec);
+  if (ec) return fail("opening the socket", ec);
   acc.set_option(asio::socket_base::reuse_address(true), ec);
   acc.bind(ep, ec);
-  if (ec) fail("binding", ec);
+  if (ec) return fail("binding", ec);
   acc.listen(asio::socket_base::max_listen_connections, ec);
-  if (ec) fail("listening", ec);
+  if (ec) return fail("listening", ec);
   const auto local = acc.local_endpoint(ec);
+  if (ec) return fail("reading the bound address", ec);
   impl_->bound = net::Endpoint{local.address().to_string(), local.port()};
 
   asio::co_spawn(
@@ -370,6 +387,7 @@ SocketcandServer::SocketcandServer(asio::any_io_executor ex, BusProvider& provid
         }
       }(impl_),
       asio::detached);
+  return ok();
 }
 
 SocketcandServer::~SocketcandServer() { stop(); }

@@ -61,7 +61,10 @@ struct SocketcandServerStats {
 class SocketcandServer {
  public:
   // Listens on `listen` (port 0: an ephemeral port, see local_endpoint()) and starts accepting.
-  // Throws axon::Exception (CanErrc::io) if the address cannot be resolved or bound.
+  // CanErrc::io if the address cannot be resolved or bound.
+  static Result<std::unique_ptr<SocketcandServer>> create(asio::any_io_executor ex, BusProvider& provider,
+                                                          net::Endpoint listen, SocketcandServerOptions options = {});
+  // The same; throws axon::Exception with that error instead.
   SocketcandServer(asio::any_io_executor ex, BusProvider& provider, net::Endpoint listen,
                    SocketcandServerOptions options = {});
   ~SocketcandServer();
@@ -77,6 +80,10 @@ class SocketcandServer {
   struct Impl;
 
  private:
+  struct Unbound {};
+  SocketcandServer(Unbound, asio::any_io_executor ex, BusProvider& provider, SocketcandServerOptions options);
+  Result<void> listen(const net::Endpoint& where);
+
   std::shared_ptr<Impl> impl_;
 };
 

@@ -74,9 +74,18 @@ TEST_F(SocketcandServerTest, ListensOnAnEphemeralPort) {
   EXPECT_NE(server_->local_endpoint().port, 0);
 }
 
-TEST_F(SocketcandServerTest, ThrowsWhenTheAddressCannotBeBound) {
+TEST_F(SocketcandServerTest, AddressThatCannotBeBoundIsAnError) {
+  auto taken = SocketcandServer::create(io_.get_executor(), registry_, server_->local_endpoint());
+  ASSERT_FALSE(taken);
+  EXPECT_EQ(taken.error(), CanErrc::io);
+  EXPECT_NE(taken.error().detail.find("binding"), std::string::npos) << taken.error().detail;
+  auto unknown = SocketcandServer::create(io_.get_executor(), registry_, net::Endpoint{"no-such-host.invalid", 0});
+  ASSERT_FALSE(unknown);
+  EXPECT_EQ(unknown.error(), CanErrc::io);
   EXPECT_THROW(SocketcandServer(io_.get_executor(), registry_, server_->local_endpoint()), Exception);
-  EXPECT_THROW(SocketcandServer(io_.get_executor(), registry_, net::Endpoint{"no-such-host.invalid", 0}), Exception);
+  auto fine = SocketcandServer::create(io_.get_executor(), registry_, net::Endpoint{"127.0.0.1", 0});
+  ASSERT_TRUE(fine);
+  EXPECT_NE(fine.value()->local_endpoint().port, server_->local_endpoint().port);
 }
 
 TEST_F(SocketcandServerTest, HandshakeAnswersComeAloneAndUnterminated) {
