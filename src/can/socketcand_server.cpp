@@ -62,7 +62,11 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
   enum class State : std::uint8_t { no_bus, bcm, raw, control };
 
   SocketcandSession(std::shared_ptr<Impl> srv, tcp::socket s)
-      : server(std::move(srv)), socket(std::move(s)), writer(socket), stats_timer(socket.get_executor()) {
+      : server(std::move(srv)),
+        socket(std::move(s)),
+        writer(socket),
+        raw_pause(socket.get_executor()),
+        stats_timer(socket.get_executor()) {
     boost::system::error_code ec;
     peer = describe(socket.remote_endpoint(ec));
   }
@@ -80,6 +84,7 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
   bool ended = false;
   std::uint64_t errors = 0;
   std::string scratch;
+  asio::steady_timer raw_pause;  // raw_start_delay before forwarding; cancelled when the session ends
   // `< statistics >`: interval, the loop's generation, and this connection's counters.
   asio::steady_timer stats_timer;
   std::uint32_t stats_interval_ms = 0;
@@ -108,6 +113,7 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
     state = State::no_bus;
     ++stats_generation;
     stats_timer.cancel();
+    raw_pause.cancel();
     if (bus) bus->close();
     bus.reset();
     writer.stop();
@@ -229,6 +235,7 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
     if (target == state) return reply(sc::Ok{});
     if (state == State::raw) {
       // Leaving raw mode closes the endpoint (its forwarder ends) and opens a quiet one.
+      raw_pause.cancel();
       bus->close();
       auto b = open_endpoint();
       if (!b) {
@@ -270,9 +277,9 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
   static asio::awaitable<void> forward(std::shared_ptr<SocketcandSession> self, std::shared_ptr<Bus> endpoint) {
     const auto delay = self->server->options.raw_start_delay;
     if (delay > core::Duration::zero()) {
-      asio::steady_timer pause(self->socket.get_executor(), delay);
+      self->raw_pause.expires_after(delay);
       boost::system::error_code ec;
-      co_await pause.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+      co_await self->raw_pause.async_wait(asio::redirect_error(asio::use_awaitable, ec));
     }
     std::string text;
     for (;;) {

@@ -102,6 +102,27 @@ TEST_F(SocketcandServerTest, HandshakeAnswersComeAloneAndUnterminated) {
   EXPECT_EQ(server_->stats().errors, 0u);
 }
 
+TEST_F(SocketcandServerTest, RawModeOkIsNotFollowedAtOnceByFramesOnABusyBus) {
+  SocketcandServerOptions o;
+  o.raw_start_delay = std::chrono::seconds(30);  // longer than the test: the first read must be the ok alone
+  start_server(o);
+  auto node = vcan0_->attach("node");
+  run([&]() -> asio::awaitable<void> {
+    auto peer = co_await TextPeer::connect(io_.get_executor(), port());
+    EXPECT_EQ(co_await peer.read_some(), "< hi >");
+    co_await peer.write("< open vcan0 >");
+    EXPECT_EQ(co_await peer.read_some(), "< ok >");
+    co_await peer.write("< rawmode >");
+    // Keep the bus busy around the mode switch.
+    for (int i = 0; i < 50; ++i) EXPECT_TRUE(co_await node->send(F("123#01")));
+    EXPECT_EQ(co_await peer.read_some(), "< ok >");
+    for (int i = 0; i < 50; ++i) EXPECT_TRUE(co_await node->send(F("123#02")));
+    // Commands are still answered while frames wait.
+    co_await peer.write("< echo >");
+    EXPECT_EQ(co_await peer.next(), "< echo >");
+  });
+}
+
 TEST_F(SocketcandServerTest, ForwardsBusFramesInTheDaemonsFormat) {
   auto node = vcan0_->attach("node");
   run([&]() -> asio::awaitable<void> {
