@@ -26,8 +26,9 @@ std::vector<Frame> mix() {
           F("02F#3C3C3C3C3C3C3C3C")};
 }
 
-void send_all(asio::io_context& io, Bus& bus, const std::vector<Frame>& frames) {
-  asio::co_spawn(io, [&]() -> asio::awaitable<void> {
+// The coroutine runs later (in io.run()), so it keeps its own copy of the frames.
+void send_all(asio::io_context& io, Bus& bus, std::vector<Frame> frames) {
+  asio::co_spawn(io, [&bus, frames = std::move(frames)]() -> asio::awaitable<void> {
     for (const auto& f : frames) EXPECT_TRUE((co_await bus.send(f)).has_value());
   }, asio::detached);
 }
