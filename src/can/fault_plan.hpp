@@ -33,8 +33,13 @@ struct FaultPlan {
   std::vector<FaultRule> rules;
   std::uint64_t seed = 1;
 
-  // YAML: { seed: 1, rules: [ { action: drop, id: 0x123, mask: 0x7FF, skip: 2, count: 1,
-  //         probability: 1.0, delay_ms: 5, xor: 0xFF } ] }
+  // YAML: { seed: 1, rules: [ { action: drop, id: 0x123, mask: 0x7FF, format: standard, skip: 2,
+  //         count: 1, probability: 1.0 } ] }
+  // action (required): drop | delay | duplicate | corrupt. id alone matches exactly that id
+  // (mask 0x1FFFFFFF); neither id nor mask matches every frame; format: any | standard | extended.
+  // delay_ms (> 0, fractions allowed) is required with delay and refused elsewhere; xor (1..0xFF,
+  // default 0xFF) only with corrupt. Unknown keys and out-of-range values are errors that name
+  // file:line:column and the key path (e.g. rules[2].probability).
   static Result<FaultPlan> from_config(const core::ConfigNode& node);
 };
 
@@ -44,12 +49,14 @@ class FaultInjector {
   struct Decision {
     bool drop = false;
     bool duplicate = false;
+    bool corrupted = false;
     core::Duration delay{0};
     Frame frame;  // possibly corrupted
   };
   FaultInjector() = default;
   explicit FaultInjector(FaultPlan plan);
-  // What happens to this frame; the first matching rule that fires decides.
+  // What happens to this frame; the first matching rule that fires decides, and the rules after
+  // it do not see the frame. A corrupt rule ignores frames without payload (remote or empty).
   Decision apply(const Frame& frame);
   [[nodiscard]] bool empty() const noexcept { return plan_.rules.empty(); }
 

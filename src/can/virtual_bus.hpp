@@ -24,6 +24,7 @@ struct WireModel {
   bool enabled = false;                      // account exact bit times (busy time, load)
   std::uint32_t bitrate = kDefaultBitrate;   // bits per second
   bool pace_realtime = false;                // deliver each frame only after its bit time has elapsed
+                                             // (implies the accounting of `enabled`)
 };
 
 struct VirtualBusStats {
@@ -40,10 +41,13 @@ struct VirtualBusStats {
 
 class VirtualBus : public std::enable_shared_from_this<VirtualBus> {
  public:
+  // Throws axon::Exception (CanErrc::bad_spec) for bitrate 0.
   static std::shared_ptr<VirtualBus> create(asio::any_io_executor ex, std::string name, WireModel wire = {});
   ~VirtualBus();
 
-  // A new node on this medium. The node keeps the medium alive.
+  // A new node on this medium. The node keeps the medium alive; closing or destroying it detaches
+  // it and discards the frames it still had queued. options.bitrate is set to the medium's.
+  // An empty name becomes "BUS#N".
   std::unique_ptr<Bus> attach(std::string node_name = {}, BusOptions options = {});
 
   void set_fault_plan(FaultPlan plan);
@@ -51,7 +55,9 @@ class VirtualBus : public std::enable_shared_from_this<VirtualBus> {
   [[nodiscard]] const WireModel& wire() const noexcept;
   [[nodiscard]] const VirtualBusStats& stats() const noexcept;
   [[nodiscard]] std::size_t node_count() const noexcept;
-  // busy / elapsed since creation (0..1); needs the wire model.
+  // busy / elapsed since creation; needs the wire model. A frame counts in full from the moment
+  // it goes on the wire. With pacing this stays at or near 1 at most; without pacing the virtual
+  // medium can carry more than a real bus would, and the figure then exceeds 1.
   [[nodiscard]] double load(core::TimePoint now) const noexcept;
 
   struct Impl;
@@ -65,7 +71,7 @@ class VirtualBus : public std::enable_shared_from_this<VirtualBus> {
 class VirtualBusRegistry final : public BusProvider {
  public:
   explicit VirtualBusRegistry(asio::any_io_executor ex) : executor_(std::move(ex)) {}
-  // Adds a medium (error if the name is taken).
+  // Adds a medium (CanErrc::bad_spec if the name is empty or taken, or the bitrate is 0).
   Result<std::shared_ptr<VirtualBus>> add(std::string name, WireModel wire = {});
   [[nodiscard]] std::shared_ptr<VirtualBus> find(std::string_view name) const;
   Result<std::unique_ptr<Bus>> open(std::string_view channel, BusOptions options = {}) override;
