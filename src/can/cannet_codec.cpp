@@ -404,4 +404,37 @@ std::string format_line(const Line& line) {
       line);
 }
 
+std::optional<LineSplitter::Piece> LineSplitter::next() {
+  for (;;) {
+    const auto nl = buf_.find('\n', head_);
+    if (skipping_) {
+      if (nl == std::string::npos) {
+        buf_.clear();
+        head_ = 0;
+        return std::nullopt;
+      }
+      head_ = nl + 1;
+      skipping_ = false;
+      continue;
+    }
+    if (nl == std::string::npos) {
+      if (head_ > 0) {  // keep the partial line at the front
+        buf_.erase(0, head_);
+        head_ = 0;
+      }
+      if (buf_.size() > max_) {
+        buf_.clear();
+        skipping_ = true;
+        return Piece{{}, true};
+      }
+      return std::nullopt;
+    }
+    const std::size_t len = nl - head_;
+    const std::size_t start = head_;
+    head_ = nl + 1;
+    if (len > max_) return Piece{{}, true};
+    return Piece{buf_.substr(start, len), false};
+  }
+}
+
 }  // namespace axon::can::cannet

@@ -23,6 +23,7 @@
 #include "can/frame.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -165,5 +166,27 @@ bool is_standard_bitrate(std::uint32_t bitrate) noexcept;
 
 // Checks 1..4; CanErrc::parse_error otherwise.
 Result<void> check_channel(int channel);
+
+// Cuts a byte stream into lines at '\n'. A line longer than max_length is not kept: it comes out
+// once as an overlong piece (its text empty) and the rest of it up to the next '\n' is skipped.
+class LineSplitter {
+ public:
+  struct Piece {
+    std::string text;  // without the '\n' (a '\r' before it is left for parse_line)
+    bool overlong = false;
+  };
+  explicit LineSplitter(std::size_t max_length = kMaxLineLength + 1) : max_(max_length) {}
+  void append(std::string_view bytes) { buf_.append(bytes); }
+  // The next complete line, or nothing until more bytes arrive.
+  std::optional<Piece> next();
+  // Bytes held that do not yet form a line.
+  [[nodiscard]] std::size_t buffered() const noexcept { return buf_.size() - head_; }
+
+ private:
+  std::string buf_;
+  std::size_t head_ = 0;  // start of the unread part of buf_
+  bool skipping_ = false;  // inside an overlong line
+  std::size_t max_;
+};
 
 }  // namespace axon::can::cannet
