@@ -320,7 +320,10 @@ asio::awaitable<void> CanNetGatewayEmulator::Impl::run_pump(std::shared_ptr<Impl
     auto frame = co_await c.endpoint->receive();
     if (!frame) co_return;  // endpoint closed: the emulator stops
     const auto& conn = s.client;
-    if (!conn || !c.running || c.bus_off) continue;  // nobody to tell, or the channel is not on the bus
+    if (!conn || !c.running || c.bus_off) {  // nobody to tell, or the channel is not on the bus
+      ++s.stats.bus_frames_discarded;
+      continue;
+    }
     if (!filter_passes(c.filters, frame.value())) {
       ++s.stats.filtered;
       continue;

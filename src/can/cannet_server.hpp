@@ -55,6 +55,7 @@ struct CanNetEmulatorStats {
   std::uint64_t error_replies = 0;      // of which with R ERR
   std::uint64_t frames_to_bus = 0;      // client frames handed to a channel's bus
   std::uint64_t frames_to_client = 0;   // bus frames sent to the client
+  std::uint64_t bus_frames_discarded = 0;  // bus frames while no client, or the channel stopped or bus-off
   std::uint64_t tx_overflow_drops = 0;  // client frames dropped: transmit FIFO full
   std::uint64_t not_running_drops = 0;  // client frames discarded: channel stopped or bus-off
   std::uint64_t output_drops = 0;       // bus frames dropped: the client did not read fast enough
