@@ -251,3 +251,48 @@ TEST(CanNetCodec, FormatFrameMatchesFormatLine) {
 
 }  // namespace
 }  // namespace axon::can::cannet
+
+namespace axon::can::cannet {
+namespace {
+
+std::vector<LineSplitter::Piece> feed(LineSplitter& s, std::string_view bytes) {
+  s.append(bytes);
+  std::vector<LineSplitter::Piece> out;
+  while (auto p = s.next()) out.push_back(std::move(*p));
+  return out;
+}
+
+TEST(CanNetLineSplitter, CutsAtNewlinesAcrossChunks) {
+  LineSplitter s;
+  auto a = feed(s, "R ok\nM 1 CSD 1");
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(a[0].text, "R ok");
+  EXPECT_EQ(s.buffered(), 9u);  // the partial line waits
+  auto b = feed(s, "23 01\r\n\nE 1 BUSOFF\n");
+  ASSERT_EQ(b.size(), 3u);
+  EXPECT_EQ(b[0].text, "M 1 CSD 123 01\r");  // '\r' is left for parse_line
+  EXPECT_EQ(b[1].text, "");
+  EXPECT_EQ(b[2].text, "E 1 BUSOFF");
+  EXPECT_FALSE(b[2].overlong);
+  EXPECT_EQ(s.buffered(), 0u);
+}
+
+TEST(CanNetLineSplitter, ReportsAnOverlongLineOnceAndResumesAfterIt) {
+  LineSplitter s(8);
+  auto a = feed(s, "0123456789");  // already too long, no newline yet
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_TRUE(a[0].overlong);
+  auto b = feed(s, "more of it\nR ok\n");
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_EQ(b[0].text, "R ok");
+  auto c = feed(s, "123456789\nR ok\n");  // too long but complete in one chunk
+  ASSERT_EQ(c.size(), 2u);
+  EXPECT_TRUE(c[0].overlong);
+  EXPECT_EQ(c[1].text, "R ok");
+  auto d = feed(s, "12345678\n");  // exactly the limit is fine
+  ASSERT_EQ(d.size(), 1u);
+  EXPECT_EQ(d[0].text, "12345678");
+}
+
+}  // namespace
+}  // namespace axon::can::cannet
