@@ -127,6 +127,7 @@ class CanNetBus final : public Bus {
 
   asio::awaitable<Result<void>> send(const Frame& f) override {
     const Frame frame = f;
+    if (!impl_->connected) co_return impl_->down_error;  // io when lost, closed when closed by the host
     if (!is_open()) co_return Error(CanErrc::closed, name());
     if (state() == BusState::bus_off)
       co_return Error(CanErrc::bus_off, fmt::format("{}: the channel is bus-off; restart it first", name()));

@@ -68,6 +68,8 @@ class CanNetGateway : public std::enable_shared_from_this<CanNetGateway> {
   // Connects to the gateway at `endpoint` (port 19228 for a real one) and sets up `channels`
   // (each 1..4, no repeats). Errors: bad_spec (channels), connect_failed, device_error (a set-up
   // command refused), timeout (no reply), protocol_error (a reply that is not "R ok"), io.
+  // gcc 12 note: pass a named net::Endpoint; a braced temporary written inside the co_await
+  // expression (connect(ex, net::Endpoint{"h", 1}, ...)) reaches the coroutine corrupted.
   static asio::awaitable<Result<std::shared_ptr<CanNetGateway>>> connect(asio::any_io_executor executor,
                                                                          net::Endpoint endpoint,
                                                                          std::vector<int> channels,

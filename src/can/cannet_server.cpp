@@ -380,6 +380,9 @@ Line CanNetGatewayEmulator::Impl::answer(const Line& command) {
     c.running = false;
     c.bus_off = c.error_warning = c.overrun = false;
     c.bitrate = init->bitrate;
+    if (c.endpoint->options().bitrate != init->bitrate)
+      spdlog::warn("CAN@net emulator: channel {} set to {} kbit/s, but its bus '{}' runs at {} kbit/s", ch,
+                   format_kbit(init->bitrate), c.name, format_kbit(c.endpoint->options().bitrate));
     return ReplyOk{};
   }
   if (std::holds_alternative<CanFilterClear>(command)) {

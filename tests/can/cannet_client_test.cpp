@@ -260,7 +260,7 @@ TEST(CanNetClient, ANewClientReplacesTheOldOneWhoseBusesClose) {
     auto r = co_await old_bus.value()->receive(5s);
     EXPECT_EQ(r.error(), CanErrc::closed);
     EXPECT_FALSE(old_gw.value()->is_connected());
-    EXPECT_EQ((co_await old_bus.value()->send(F("111#02"))).error(), CanErrc::closed);
+    EXPECT_EQ((co_await old_bus.value()->send(F("111#02"))).error(), CanErrc::io);
     EXPECT_EQ((co_await old_gw.value()->status(1)).error(), CanErrc::io);
     // The new one works.
     CO_ASSERT_TRUE((co_await b.can0->send(F("222#02"))).has_value());
@@ -288,6 +288,24 @@ TEST(CanNetClient, ConnectionLossClosesBusesAfterQueuedFrames) {
     auto next = co_await bus.value()->receive(5s);
     EXPECT_EQ(next.error(), CanErrc::closed);
     EXPECT_FALSE(gw.value()->is_connected());
+    EXPECT_EQ((co_await bus.value()->send(F("123#02"))).error(), CanErrc::io);
+  });
+}
+
+TEST(CanNetClient, ClosingTheGatewayClosesItsBuses) {
+  Bench b;
+  run(b.io, [&]() -> asio::awaitable<void> {
+    auto gw = co_await b.connect(1, 2);
+    CO_ASSERT_TRUE(gw);
+    auto bus = gw.value()->bus(2);
+    CO_ASSERT_TRUE(bus);
+    gw.value()->close();
+    EXPECT_FALSE(gw.value()->is_connected());
+    EXPECT_FALSE(bus.value()->is_open());
+    EXPECT_EQ((co_await bus.value()->send(F("123#01"))).error(), CanErrc::closed);
+    EXPECT_EQ((co_await bus.value()->receive(5s)).error(), CanErrc::closed);
+    EXPECT_EQ((co_await gw.value()->status(1)).error(), CanErrc::closed);
+    EXPECT_EQ(gw.value()->bus(1).error(), CanErrc::closed);
   });
 }
 
