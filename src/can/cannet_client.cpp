@@ -44,8 +44,7 @@ class CanNetBus;
 struct CanNetGateway::Impl : std::enable_shared_from_this<CanNetGateway::Impl> {
   struct Channel {
     CanNetBus* bus = nullptr;  // the open bus, if any
-    BusState state = BusState::active;
-    bool set_up = false;
+    BusState state = BusState::active;  // as the gateway last reported it
   };
   struct PendingReply {
     explicit PendingReply(const asio::any_io_executor& ex) : waiter(ex) {}
@@ -411,9 +410,7 @@ asio::awaitable<Result<void>> CanNetGateway::Impl::set_up(int channel) {
     co_return Error(CanErrc::protocol_error, fmt::format("{}: '{}' answered '{}' (expected 'R ok')", where,
                                                          format_line(steps[i]), format_line(r.value())));
   }
-  auto& c = chan[static_cast<std::size_t>(channel)];
-  c.set_up = true;
-  c.state = BusState::active;
+  chan[static_cast<std::size_t>(channel)].state = BusState::active;
   co_return ok();
 }
 

@@ -72,12 +72,10 @@ struct CanNetGatewayEmulator::Impl : std::enable_shared_from_this<CanNetGatewayE
     bool bus_off = false;
     bool error_warning = false;
     bool overrun = false;           // frames for the client were lost
-    std::uint32_t bitrate = 0;
     std::vector<CanFilterAdd> filters;
 
     void reset() {
       initialized = running = bus_off = error_warning = overrun = false;
-      bitrate = 0;
       filters.clear();
     }
   };
@@ -379,7 +377,6 @@ Line CanNetGatewayEmulator::Impl::answer(const Line& command) {
     c.initialized = true;
     c.running = false;
     c.bus_off = c.error_warning = c.overrun = false;
-    c.bitrate = init->bitrate;
     if (c.endpoint->options().bitrate != init->bitrate)
       spdlog::warn("CAN@net emulator: channel {} set to {} kbit/s, but its bus '{}' runs at {} kbit/s", ch,
                    format_kbit(init->bitrate), c.name, format_kbit(c.endpoint->options().bitrate));
