@@ -15,6 +15,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/read_until.hpp>
+#include <boost/asio/redirect_error.hpp>
 #include <boost/asio/use_awaitable.hpp>
 #include <boost/asio/write.hpp>
 #include <fmt/format.h>
@@ -115,11 +116,20 @@ int main(int argc, char** argv) {
         asio::co_spawn(ex, echo_node(*node), asio::detached);
         const net::Endpoint lo{"127.0.0.1", 0};
         auto server = can::SocketcandServer::create(ex, reg, lo).value();
-        auto gw = can::CanNetGatewayEmulator::create(ex, reg, lo, {"vcan0"}).value();
+        can::CanNetEmulatorOptions eo;
+        eo.port = 0;
+        auto gw = std::make_unique<can::CanNetGatewayEmulator>(ex, reg, std::vector<std::string>{"vcan0"}, eo);
+        gw->start().value();
 
-        auto sb = (co_await can::SocketcandBus::connect(ex, server->local_endpoint(), "vcan0", {}, 2s)).value();
+        // Arguments of co_awaited calls are named: gcc 12 mishandles temporaries built inside co_await.
+        const net::Endpoint scd_ep = server->local_endpoint(), gw_ep = gw->local_endpoint();
+        const std::string channel = "vcan0";
+        const can::BusOptions bo;
+        auto sb = (co_await can::SocketcandBus::connect(ex, scd_ep, channel, bo, 2s)).value();
         scd = co_await can_round_trips(*sb, n);
-        auto gateway = (co_await can::CanNetGateway::connect(ex, gw->local_endpoint(), {1}, {})).value();
+        const can::CanNetOptions co;
+        std::vector<int> chans{1};
+        auto gateway = (co_await can::CanNetGateway::connect(ex, gw_ep, std::move(chans), co)).value();
         auto cb = gateway->bus(1).value();
         cn = co_await can_round_trips(*cb, n);
 

@@ -46,6 +46,8 @@ inline int run_command(const std::function<asio::awaitable<int>(asio::io_context
 }
 
 // Unwraps a Result inside a command: its error becomes an axon::Exception for main to print.
+// With a coroutine, first name the result (`auto r = co_await f(); need(std::move(r));`): gcc 12
+// mishandles non-trivial temporaries that live across a co_await inside one expression.
 template <class T>
 T need(Result<T>&& r) {
   if (!r) throw Exception(r.error());

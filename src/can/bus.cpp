@@ -95,6 +95,20 @@ std::optional<Frame> Bus::try_receive() {
   return f;
 }
 
+asio::awaitable<Result<void>> Bus::flush(core::Duration timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  asio::steady_timer timer(executor_);
+  while (tx_pending() > 0) {
+    if (state_ == BusState::closed) co_return Error(CanErrc::closed, fmt::format("bus {}: closed while flushing", name_));
+    if (std::chrono::steady_clock::now() >= deadline)
+      co_return Error(CanErrc::timeout, fmt::format("bus {}: {} frames still waiting to leave", name_, tx_pending()));
+    timer.expires_after(std::chrono::microseconds(200));
+    boost::system::error_code ec;
+    co_await timer.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+  }
+  co_return ok();
+}
+
 asio::awaitable<Result<Frame>> Bus::receive() { return receive_until(std::nullopt); }
 
 asio::awaitable<Result<Frame>> Bus::receive(core::Duration timeout) {

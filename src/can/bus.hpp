@@ -92,6 +92,9 @@ class Bus {
   [[nodiscard]] std::size_t pending() const noexcept { return rx_.size(); }
   // Frames sent but not yet on the wire (transports that queue; 0 for the others).
   [[nodiscard]] virtual std::size_t tx_pending() const noexcept { return 0; }
+  // Waits until every frame sent so far has left (tx_pending() == 0): call before close() when
+  // the last frames matter. Errors: timeout (with the count still waiting), closed.
+  asio::awaitable<Result<void>> flush(core::Duration timeout);
 
   // Receive filters: a frame passes if any filter matches; no filters pass everything.
   // Transports that can also filter below user space (SocketCAN) override this and call it.

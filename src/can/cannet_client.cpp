@@ -97,6 +97,11 @@ struct CanNetGateway::Impl : std::enable_shared_from_this<CanNetGateway::Impl> {
     if (writer_idle) writer_idle->wake();
   }
   asio::awaitable<Result<void>> write_bounded(std::string line);
+  // Lines queued or being written (0 once the writer is idle with nothing queued).
+  [[nodiscard]] std::size_t output_pending() const noexcept {
+    const auto lines = static_cast<std::size_t>(std::count(out.begin(), out.end(), '\n'));
+    return connected && writer_idle == nullptr ? lines + 1 : lines;
+  }
 
   // ---- input ----
 
@@ -140,6 +145,9 @@ class CanNetBus final : public Bus {
     unregister();
     Bus::close();
   }
+
+  // Lines of this gateway connection not yet handed to the socket (shared by its channels).
+  [[nodiscard]] std::size_t tx_pending() const noexcept override { return impl_->output_pending(); }
 
   // Gateway side.
   void on_frame(Frame f) { deliver(std::move(f)); }
