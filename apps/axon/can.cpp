@@ -151,12 +151,19 @@ struct BridgeOptions {
   bool pace = false;
   std::uint32_t bitrate = can::kDefaultBitrate;
   double duration_s = 0;
+  std::string fault_plan;
 };
 
 int run_bridge(const BridgeOptions& o) {
   return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
     const asio::any_io_executor ex = io.get_executor();
     can::WireModel wire{o.wire_model || o.pace, o.bitrate, o.pace};
+    std::optional<can::FaultPlan> faults;
+    if (!o.fault_plan.empty()) {
+      const auto node = need(core::ConfigNode::load_file(o.fault_plan));
+      faults = need(can::FaultPlan::from_config(node));
+      spdlog::info("bridge: fault plan {} ({} rules) on every virtual bus", o.fault_plan, faults->rules.size());
+    }
     can::VirtualBusRegistry registry(ex);
     std::vector<std::unique_ptr<Bus>> upstreams, pumps;
     std::vector<std::unique_ptr<can::RelayStats>> relay_stats;
@@ -182,6 +189,9 @@ int run_bridge(const BridgeOptions& o) {
       upstreams.push_back(std::move(upstream));
       pumps.push_back(std::move(pump));
     }
+
+    if (faults)
+      for (const auto& c : registry.channels()) registry.find(c)->set_fault_plan(*faults);
 
     std::vector<std::unique_ptr<can::SocketcandServer>> scd;
     std::vector<std::unique_ptr<can::CanNetGatewayEmulator>> gateways;
@@ -333,6 +343,7 @@ void add_can_commands(CLI::App& app, GlobalOptions&) {
   b->add_flag("--pace", bridge.pace, "deliver frames at the real bus speed (implies --wire-model)");
   b->add_option("--bitrate", bridge.bitrate, "bit rate of the virtual buses")->check(CLI::Range(10'000u, 1'000'000u));
   b->add_option("--duration", bridge.duration_s, "stop after this many seconds (default: until Ctrl-C)");
+  b->add_option("--fault-plan", bridge.fault_plan, "YAML fault plan applied to every virtual bus (docs/can-virtual.md)");
   b->callback([] { exit_code() = run_bridge(bridge); });
 
   static ReplayOptions replay;

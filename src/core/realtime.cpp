@@ -21,7 +21,8 @@ bool RealtimeReport::all_granted() const noexcept {
 std::string RealtimeReport::summary() const {
   std::string out;
   for (const auto& s : steps) {
-    out += fmt::format("{}: {}{}\n", s.name, s.granted ? "granted" : "refused", s.granted ? "" : " (" + s.reason + ")");
+    if (s.granted) out += fmt::format("{}: granted\n", s.name);
+    else out += fmt::format("{}: refused ({})\n", s.name, s.reason);
   }
   return out;
 }
@@ -63,7 +64,8 @@ RealtimeReport apply_realtime(const RealtimeRequest& req) {
     const long ncpu = sysconf(_SC_NPROCESSORS_CONF);
     bool bad = false;
     for (int c : req.cpus) {
-      list += (list.empty() ? "" : ",") + std::to_string(c);
+      if (!list.empty()) list += ',';
+      list += std::to_string(c);
       if (c < 0 || c >= ncpu || c >= CPU_SETSIZE) bad = true; else CPU_SET(c, &set);
     }
     RealtimeStep step{"affinity " + list, false, {}};
