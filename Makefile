@@ -3,6 +3,9 @@
 .PHONY: all deps release debug run test bench asan test-asan tsan test-tsan fuzz fuzz-smoke clean
 
 JOBS ?= $(shell nproc)
+# ccache (when installed) shares compiled objects between clones of the project on one machine.
+export CCACHE_BASEDIR := $(CURDIR)
+export CCACHE_NOHASHDIR := 1
 CMAKE_EXTRA ?=
 
 all: release
