@@ -7,6 +7,7 @@
 #include "fps/protocol/message.hpp"
 
 #include <boost/asio/co_spawn.hpp>
+#include <boost/asio/detached.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -111,6 +112,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
   struct PoolEntry {
     UidPool pool;
     std::deque<UidWaiter*> waiters;
+    std::size_t grants = 0;  // uids handed to waiters that have not resumed yet (keeps FIFO order)
   };
   struct SlotWaiter {
     explicit SlotWaiter(const asio::any_io_executor& e) : wake(e) {}
@@ -247,6 +249,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
       UidWaiter* w = e.waiters.front();
       e.waiters.pop_front();
       w->granted = *u;
+      ++e.grants;
       w->wake.notify();
     }
   }
@@ -259,7 +262,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
 
   asio::awaitable<Result<std::uint8_t>> acquire_uid(std::uint16_t pos, std::uint8_t cmd) {
     PoolEntry& e = pools[pool_key(pos, cmd)];  // references into unordered_map stay valid
-    if (e.waiters.empty()) {
+    if (e.waiters.empty() && e.grants == 0) {
       if (auto u = e.pool.acquire(now())) co_return *u;
     }
     ++counters.uid_waits;
@@ -271,7 +274,10 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
       ~Unlist() { q.erase(std::remove(q.begin(), q.end(), w), q.end()); }
     } unlist{e.waiters, &w};
     for (;;) {
-      if (w.granted) co_return *w.granted;
+      if (w.granted) {
+        --e.grants;
+        co_return *w.granted;
+      }
       if (auto r = check_running(); !r) co_return r.error();
       // A quarantine may have run out meanwhile.
       if (e.waiters.front() == &w) {
@@ -530,6 +536,61 @@ asio::awaitable<Result<Reply>> CommandClient::request(std::uint16_t positioner, 
                                                       protocol::Payload payload, RequestOptions options) {
   auto self = impl_;
   co_return co_await self->request(positioner, command, payload, options);
+}
+
+namespace {
+
+struct PipeState {
+  explicit PipeState(const asio::any_io_executor& ex, std::size_t n) : wake(ex), done(n, 0) {}
+  Wakeup wake;
+  std::size_t outstanding = 0;
+  std::vector<std::uint8_t> done;  // 0 waiting, 1 accepted, 2 failed
+  std::map<std::size_t, Error> failures;
+};
+
+asio::awaitable<void> pipe_one(CommandClient* client, PipeState* st, std::uint16_t pos, protocol::Request req,
+                               std::size_t i, RequestOptions options) {
+  auto r = co_await client->request(pos, req.command, req.payload, options);
+  if (r) {
+    st->done[i] = 1;
+  } else {
+    st->done[i] = 2;
+    st->failures.emplace(i, r.error());
+  }
+  --st->outstanding;
+  st->wake.notify();
+}
+
+}  // namespace
+
+asio::awaitable<PipelineResult> CommandClient::pipeline(std::uint16_t positioner,
+                                                        std::span<const protocol::Request> requests,
+                                                        std::size_t window, std::function<void(std::size_t)> progress,
+                                                        RequestOptions options) {
+  auto self = impl_;
+  window = std::max<std::size_t>(window, 1);
+  PipeState st(self->ex, requests.size());
+  PipelineResult out;
+  std::size_t next = 0;
+  for (;;) {
+    while (st.failures.empty() && next < requests.size() && st.outstanding < window) {
+      ++st.outstanding;
+      asio::co_spawn(self->ex, pipe_one(this, &st, positioner, requests[next], next, options), asio::detached);
+      ++next;
+      ++out.issued;
+    }
+    const std::size_t before = out.accepted;
+    while (out.accepted < requests.size() && st.done[out.accepted] == 1) ++out.accepted;
+    if (progress && out.accepted != before) progress(out.accepted);
+    if (st.outstanding == 0 && (next == requests.size() || !st.failures.empty())) break;
+    st.wake.reset();
+    co_await st.wake.wait_until(core::TimePoint::max());
+  }
+  if (!st.failures.empty()) {
+    out.failed_index = st.failures.begin()->first;
+    out.error = st.failures.begin()->second;
+  }
+  co_return out;
 }
 
 asio::awaitable<Result<BroadcastResult>> CommandClient::broadcast(CommandId command, protocol::Payload payload,

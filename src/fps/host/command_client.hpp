@@ -27,6 +27,7 @@
 #include "core/error.hpp"
 #include "fps/host/error.hpp"
 #include "fps/protocol/commands.hpp"
+#include "fps/protocol/message.hpp"
 #include "fps/protocol/payload.hpp"
 #include "fps/protocol/payloads.hpp"
 #include "fps/protocol/response.hpp"
@@ -40,6 +41,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -127,6 +129,16 @@ struct BroadcastResult {
   [[nodiscard]] std::vector<std::uint16_t> positioners() const;
 };
 
+// The outcome of a pipelined run of requests to one positioner (CommandClient::pipeline).
+struct PipelineResult {
+  std::size_t issued = 0;                   // requests sent
+  std::size_t accepted = 0;                 // requests accepted in order before the first failure
+  std::optional<std::size_t> failed_index;  // the first request (in order) that failed
+  std::optional<Error> error;               // and why
+
+  [[nodiscard]] bool ok() const noexcept { return !failed_index.has_value(); }
+};
+
 struct ClientCounters {
   std::uint64_t sent = 0;               // request frames handed to the bus (retries and broadcasts included)
   std::uint64_t send_errors = 0;        // frames the bus refused
@@ -187,6 +199,14 @@ class CommandClient {
     if (!v) return bad_reply(reply, v.error());
     return std::move(v).value();
   }
+
+  // Sends `requests` to one positioner in order, at most `window` of them waiting for replies at
+  // a time, and checks every reply. After the first failure no further request goes out (those
+  // already in flight are awaited). `progress` is called with the number of requests accepted in
+  // order each time that number grows. The requests must stay alive until this completes.
+  asio::awaitable<PipelineResult> pipeline(std::uint16_t positioner, std::span<const protocol::Request> requests,
+                                           std::size_t window, std::function<void(std::size_t)> progress = {},
+                                           RequestOptions options = {});
 
   // Sends a broadcast (positioner 0, uid 0) and collects the replies until `expected` positioners
   // answered or the window closed. Replies with a non-zero code are collected too (check each).
