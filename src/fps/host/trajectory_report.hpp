@@ -50,7 +50,9 @@ struct TrajectoryOptions {
   // clear_collision_flags a STOP_TRAJECTORY broadcast follows, as the host in service does.
   bool clear_collision_flags = false;
   core::Duration settle = 100ms;        // after the abort/stop, before the next command
-  core::Duration start_window = 1s;     // collecting start acknowledgements
+  // Collecting start acknowledgements. The robots that did start keep moving while the host waits
+  // for one that does not answer, so keep this short (acknowledgements take milliseconds).
+  core::Duration start_window = 250ms;
   core::Duration end_margin = 10s;      // beyond the trajectory's duration
   // Starts with the sync line instead of a START_TRAJECTORY broadcast: called once every bus
   // listens for the acknowledgements (uid 0). Must drive the line high long enough (about 0.5 s).

@@ -42,8 +42,9 @@ class SimRig {
   explicit SimRig(std::size_t buses = 1, sim::SimulatorOptions so = fast_sim(), ArrayOptions ao = fast_array())
       : simulator(runner.io.get_executor(), std::move(so)), array_options_(std::move(ao)) {
     for (std::size_t i = 0; i < buses; ++i) {
-      media.push_back(can::VirtualBus::create(runner.io.get_executor(), "fps" + std::to_string(i)));
-      host_buses.push_back(media.back()->attach("host"));
+      const std::string name = "fps" + std::to_string(i);
+      media.push_back(can::VirtualBus::create(runner.io.get_executor(), name));
+      host_buses.push_back(media.back()->attach(name));  // the host's endpoint carries the bus's name
     }
   }
 
