@@ -245,6 +245,26 @@ void Array::on_unsolicited(std::size_t bus, const Unsolicited& u) {
   ++counters_.collision_locks;
   lock_for(fmt::format("collision ({}) reported by positioner {} on bus {}", arm_of(u.code), u.positioner,
                        bus_name(bus)));
+  stop_in_background();
+}
+
+void Array::collision_seen(std::uint16_t positioner, const protocol::PositionerStatus& status) {
+  if (lock_.locked) return;
+  Collision c;
+  c.positioner = positioner;
+  if (auto b = bus_of(positioner)) c.bus = b.value();
+  c.code = status.has(protocol::StatusBit::collision_alpha) ? ResponseCode::alpha_collision
+                                                             : ResponseCode::beta_collision;
+  c.caused_lock = true;
+  lock_.collisions.push_back(c);
+  ++counters_.collision_locks;
+  lock_for(fmt::format("collision flag ({}) in the status of positioner {} on bus {} (its collision report was "
+                       "not received)",
+                       arm_of(c.code), positioner, bus_name(c.bus)));
+  stop_in_background();
+}
+
+void Array::stop_in_background() {
   ++background_;
   asio::co_spawn(executor_, stop_everyone(), [this](std::exception_ptr) {
     --background_;

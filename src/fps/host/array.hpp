@@ -115,6 +115,9 @@ class Array final : public MotionGate {
 
   // --- safety --------------------------------------------------------------------------------
   [[nodiscard]] Result<void> may_move(std::uint16_t positioner) const override;
+  // A collision flag found while polling a robot during a step: locks and stops like a collision
+  // frame (which may have been lost).
+  void collision_seen(std::uint16_t positioner, const protocol::PositionerStatus& status) override;
   [[nodiscard]] bool locked() const noexcept { return lock_.locked; }
   [[nodiscard]] const LockState& lock_state() const noexcept { return lock_; }
   // Locks the array and stops every robot (TRAJECTORY_ABORT broadcast on every bus at once), as
@@ -174,6 +177,7 @@ class Array final : public MotionGate {
 
   void on_unsolicited(std::size_t bus, const Unsolicited& u);
   void lock_for(std::string reason);
+  void stop_in_background();
   asio::awaitable<void> stop_everyone();
   asio::awaitable<std::vector<BusBroadcast>> broadcast_on(std::vector<std::size_t> buses, protocol::CommandId c,
                                                           BroadcastOptions options = {});

@@ -115,9 +115,24 @@ asio::awaitable<void> Array::upgrade_one(std::uint16_t id, const std::vector<pro
   auto sent = co_await p->client().pipeline(id, chunks, options.window, progress);
   report.chunks_acked = sent.accepted;
   if (!sent.ok()) {
+    // A request or only its reply may have been lost, and the frames already in flight went on:
+    // ask the robot what it has before saying anything about its state.
+    const std::string why = fmt::format("transfer stopped at chunk {} of {}: {}", *sent.failed_index, chunks.size(),
+                                        sent.error ? sent.error->message() : std::string("?"));
+    auto st = co_await p->read_bootloader_status();
+    if (st) {
+      report.final_status = st.value();
+      if (st.value().upgrade_succeeded()) {
+        report.outcome = UpgradeOutcome::ok;
+        report.reason = fmt::format("replies were lost ({}), but the robot received and verified the whole image", why);
+        co_return;
+      }
+      if (st.value().upgrade_failed()) {
+        co_return failed(fmt::format("{}; the robot's CRC-32 check failed, it keeps its previous firmware", why));
+      }
+    }
     report.half_written = true;
-    co_return failed(fmt::format("transfer stopped at chunk {} of {}: {}", *sent.failed_index, chunks.size(),
-                                 sent.error ? sent.error->message() : std::string("?")));
+    co_return failed(why);
   }
 
   // The bootloader checks the CRC once the last byte is in.

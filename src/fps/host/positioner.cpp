@@ -78,7 +78,7 @@ std::string UploadResult::describe() const {
   return fmt::format("{} failed: {}", to_string(stage), why);
 }
 
-Positioner::Positioner(CommandClient& client, std::uint16_t id, PositionerOptions options, const MotionGate* gate)
+Positioner::Positioner(CommandClient& client, std::uint16_t id, PositionerOptions options, MotionGate* gate)
     : client_(&client), id_(id), options_(std::move(options)), gate_(gate) {}
 
 Result<void> Positioner::check_gate() const { return gate_ ? gate_->may_move(id_) : ok(); }
@@ -357,6 +357,7 @@ asio::awaitable<Result<PositionerStatus>> Positioner::wait_for(std::function<boo
     auto st = co_await read_status();
     if (!st) co_return st.error();
     if (st.value().collided()) {
+      if (gate_) gate_->collision_seen(id_, st.value());
       co_return Error(HostErrc::collision,
                       fmt::format("positioner {} during {}: {}", id_, what, st.value().to_string()));
     }

@@ -53,11 +53,14 @@ struct PositionerOptions {
   std::size_t trajectory_window = 8;          // trajectory points in flight to one robot
 };
 
-// Decides whether a robot may move now (the Array's collision lock implements it).
+// Decides whether a robot may move now (the Array's collision lock implements it), and hears
+// about collision flags a positioner finds while polling a robot (the backup for a lost collision
+// frame).
 class MotionGate {
  public:
   virtual ~MotionGate() = default;
   [[nodiscard]] virtual Result<void> may_move(std::uint16_t positioner) const = 0;
+  virtual void collision_seen(std::uint16_t /*positioner*/, const protocol::PositionerStatus& /*status*/) {}
 };
 
 struct MoveResult {
@@ -98,8 +101,7 @@ enum class CoggingTable : std::uint8_t { positive, negative, angles };
 
 class Positioner {
  public:
-  Positioner(CommandClient& client, std::uint16_t id, PositionerOptions options = {},
-             const MotionGate* gate = nullptr);
+  Positioner(CommandClient& client, std::uint16_t id, PositionerOptions options = {}, MotionGate* gate = nullptr);
 
   [[nodiscard]] std::uint16_t id() const noexcept { return id_; }
   [[nodiscard]] CommandClient& client() const noexcept { return *client_; }
@@ -180,8 +182,8 @@ class Positioner {
   // trajectory_window in flight, TRAJECTORY_DATA_END). Does not start it.
   asio::awaitable<UploadResult> upload_trajectory(const protocol::Trajectory& trajectory);
 
-  // Waits until `done(status)` holds, polling; fails on a collision flag (unless allow_collision),
-  // a closed gate (`motion`), or after `timeout`. `what` names the step in errors.
+  // Waits until `done(status)` holds, polling; fails on a collision flag (and tells the gate), on
+  // a closed gate (when `motion`), or after `timeout`. `what` names the step in errors.
   asio::awaitable<Result<protocol::PositionerStatus>> wait_for(
       std::function<bool(const protocol::PositionerStatus&)> done, core::Duration timeout, std::string what,
       bool motion = true);
@@ -197,7 +199,7 @@ class Positioner {
   CommandClient* client_;
   std::uint16_t id_;
   PositionerOptions options_;
-  const MotionGate* gate_;
+  MotionGate* gate_;
   std::optional<protocol::FirmwareVersion> firmware_;
   std::optional<protocol::PositionerStatus> status_;
   std::optional<protocol::BootloaderStatus> boot_status_;
