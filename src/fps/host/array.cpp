@@ -373,18 +373,32 @@ asio::awaitable<Result<void>> Array::stop_all(bool clear_collision_flags) {
 
 // --- motion --------------------------------------------------------------------------------------
 
-asio::awaitable<Result<std::map<std::uint16_t, Result<MoveResult>>>> Array::goto_absolute(
-    std::map<std::uint16_t, ArmAngles> targets) {
-  std::vector<std::pair<std::uint16_t, ArmAngles>> list(targets.begin(), targets.end());
+asio::awaitable<Result<Array::MoveResults>> Array::goto_absolute(std::map<std::uint16_t, ArmAngles> targets) {
+  return move_many(std::move(targets), false);
+}
+
+asio::awaitable<Result<Array::MoveResults>> Array::goto_relative(std::map<std::uint16_t, ArmAngles> deltas) {
+  return move_many(std::move(deltas), true);
+}
+
+asio::awaitable<Result<Array::MoveResults>> Array::move_many(std::map<std::uint16_t, ArmAngles> values,
+                                                             bool relative) {
+  std::vector<std::pair<std::uint16_t, ArmAngles>> list(values.begin(), values.end());
   for (const auto& [id, t] : list) {
     if (!find(id)) co_return Error(HostErrc::unknown_positioner, fmt::format("positioner {}", id));
     if (auto g = may_move(id); !g) co_return g.error();
   }
   std::vector<Result<MoveResult>> results(list.size(), Result<MoveResult>(Error(HostErrc::cancelled)));
   co_await for_each_concurrently(list.size(), [&](std::size_t i) -> asio::awaitable<void> {
-    results[i] = co_await find(list[i].first)->goto_absolute(list[i].second);
+    Positioner* p = find(list[i].first);
+    // (no co_await inside ?: : gcc 12 miscompiles it)
+    if (relative) {
+      results[i] = co_await p->goto_relative(list[i].second);
+    } else {
+      results[i] = co_await p->goto_absolute(list[i].second);
+    }
   });
-  std::map<std::uint16_t, Result<MoveResult>> out;
+  MoveResults out;
   for (std::size_t i = 0; i < list.size(); ++i) out.emplace(list[i].first, std::move(results[i]));
   co_return out;
 }

@@ -128,9 +128,11 @@ class Array final : public MotionGate {
   asio::awaitable<Result<UnlockReport>> unlock();
 
   // --- motion --------------------------------------------------------------------------------
-  // Moves every listed robot at once and waits for all; one result per robot.
-  asio::awaitable<Result<std::map<std::uint16_t, Result<MoveResult>>>> goto_absolute(
-      std::map<std::uint16_t, ArmAngles> targets);
+  // Moves every listed robot at once and waits for all; one result per robot (each checked
+  // against its target within the position tolerance). Errors: locked, unknown_positioner.
+  using MoveResults = std::map<std::uint16_t, Result<MoveResult>>;
+  asio::awaitable<Result<MoveResults>> goto_absolute(std::map<std::uint16_t, ArmAngles> targets);
+  asio::awaitable<Result<MoveResults>> goto_relative(std::map<std::uint16_t, ArmAngles> deltas);
   // The trajectory sequence (see docs/fps-host.md): abort (and optionally stop) each robot,
   // settle, check status, upload every trajectory checking every reply, refuse to start unless
   // every robot loaded its trajectory, start by broadcast on every bus (or the sync line),
@@ -175,6 +177,7 @@ class Array final : public MotionGate {
     Result<BroadcastResult> result = Error(HostErrc::cancelled);
   };
 
+  asio::awaitable<Result<MoveResults>> move_many(std::map<std::uint16_t, ArmAngles> values, bool relative);
   void on_unsolicited(std::size_t bus, const Unsolicited& u);
   void lock_for(std::string reason);
   void stop_in_background();

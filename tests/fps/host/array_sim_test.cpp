@@ -388,3 +388,32 @@ TEST(ArraySim, HallSwitchesAreBroadcastOnEveryBusAndChecked) {
     EXPECT_TRUE(stop.has_value());
   });
 }
+
+TEST(ArraySim, GoToMovesRobotsOnSeveralBusesAtOnce) {
+  SimRig rig(2);
+  rig.add(3, 0);
+  rig.add(5, 1);
+  rig.start();
+  std::map<std::uint16_t, ArmAngles> targets, deltas;
+  targets.emplace(3, ArmAngles{30, 150});
+  targets.emplace(5, ArmAngles{40, 160});
+  deltas.emplace(3, ArmAngles{-10, 5});
+  rig.run([&]() -> asio::awaitable<void> {
+    co_await rig.discover();
+    auto a = co_await rig.array->goto_absolute(targets);
+    EXPECT_TRUE(a.has_value());
+    if (a) {
+      for (const auto& [id, r] : a.value()) EXPECT_TRUE(r.has_value()) << id << ": " << (r ? "" : r.error().message());
+    }
+    auto r = co_await rig.array->goto_relative(deltas);
+    EXPECT_TRUE(r.has_value());
+    if (r && r.value().at(3)) { EXPECT_NEAR(r.value().at(3).value().reached.alpha, 20.0, 0.1); }
+    std::map<std::uint16_t, ArmAngles> unknown;
+    unknown.emplace(77, ArmAngles{});
+    auto u = co_await rig.array->goto_absolute(unknown);
+    EXPECT_FALSE(u.has_value());
+    if (!u) { EXPECT_EQ(u.error(), HostErrc::unknown_positioner); }
+  });
+  EXPECT_NEAR(rig.model(5).reported_deg(sim::Arm::alpha), 40.0, 0.1);
+  EXPECT_NEAR(rig.model(3).reported_deg(sim::Arm::beta), 155.0, 0.1);
+}
