@@ -108,7 +108,8 @@ class Array final : public MotionGate {
 
   // GET_ID broadcast on every bus (collecting for discover_window, or until `expected` robots
   // answered on that bus when given), then firmware version and status of every robot found.
-  // Robots no longer answering are forgotten; new ones are added.
+  // New robots are added; known robots that did not answer are kept and listed as problems. Do not
+  // run it while other operations use the robots (a robot found on another bus gets a new handle).
   asio::awaitable<Result<DiscoveryReport>> discover(std::map<std::size_t, std::size_t> expected = {});
   // Firmware (if not known), status and (application robots) position of every known robot.
   asio::awaitable<StatusTable> status_table(bool positions = true);

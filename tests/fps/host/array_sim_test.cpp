@@ -417,3 +417,38 @@ TEST(ArraySim, GoToMovesRobotsOnSeveralBusesAtOnce) {
   EXPECT_NEAR(rig.model(5).reported_deg(sim::Arm::alpha), 40.0, 0.1);
   EXPECT_NEAR(rig.model(3).reported_deg(sim::Arm::beta), 155.0, 0.1);
 }
+
+// A sextant's worth: four buses of 21 robots each, discovered and moved by one trajectory run.
+TEST(ArraySim, FourBusesOfTwentyOneRobots) {
+  SimRig rig(4);
+  std::vector<std::uint16_t> ids;
+  for (std::uint16_t bus = 0; bus < 4; ++bus) {
+    for (std::uint16_t k = 0; k < 21; ++k) {
+      const auto id = static_cast<std::uint16_t>(100 * (bus + 1) + k);
+      rig.add(id, bus);
+      ids.push_back(id);
+    }
+  }
+  rig.start();
+  std::optional<TrajectoryReport> report;
+  rig.run([&]() -> asio::awaitable<void> {
+    std::map<std::size_t, std::size_t> expected{{0, 21}, {1, 21}, {2, 21}, {3, 21}};
+    auto found = co_await rig.array->discover(expected);
+    EXPECT_TRUE(found.has_value());
+    if (found) {
+      EXPECT_EQ(found.value().table.count_ready(), 84u) << found.value().table.to_text();
+    }
+    std::map<std::uint16_t, protocol::Trajectory> t;
+    for (auto id : ids) t.emplace(id, trajectory({{10, 1.0}, {25, 2.0}}, {{170, 1.5}}));
+    auto r = co_await rig.array->run_trajectories(std::move(t));
+    EXPECT_TRUE(r.has_value());
+    if (r) report = r.value();
+  });
+  ASSERT_TRUE(report.has_value());
+  EXPECT_TRUE(report->completed) << report->summary();
+  EXPECT_EQ(report->in_state(RobotState::completed).size(), 84u);
+  EXPECT_EQ(rig.array->ids_on(3).size(), 21u);
+  EXPECT_EQ(rig.array->client_totals().timeouts, 0u);
+  EXPECT_EQ(rig.simulator.receive_overflows(), 0u);
+  for (auto id : ids) EXPECT_NEAR(rig.model(id).reported_deg(sim::Arm::alpha), 25.0, 0.1) << id;
+}
