@@ -113,3 +113,29 @@ TEST(FpsSimCollision, NothingWhenNotInTheApplication) {
   h.model.power_off(h.now);
   EXPECT_TRUE(h.model.inject_collision(Arm::alpha, h.now).empty());
 }
+
+TEST(FpsSimCollision, FrictionAboveTheMarginGivesFalseCollisionsUntilTheMarginIsRaised) {
+  Harness h;  // beta margin 20 by default
+  h.model.set_friction_fault(Arm::beta, 25);
+  ASSERT_EQ(h.code(CommandId::go_to_relative_position, positions(0, -10)), ResponseCode::accepted);
+  h.wait(300ms);
+  ASSERT_EQ(h.unsolicited.size(), 1u);
+  EXPECT_EQ(h.unsolicited[0].id.response, ResponseCode::beta_collision);
+  // Raise the margin, clear the flags, move again: no more false alarms.
+  ASSERT_EQ(h.code(CommandId::set_collision_margin, two_i32(-5, 30)), ResponseCode::accepted);
+  ASSERT_EQ(h.code(CommandId::stop_trajectory), ResponseCode::accepted);
+  ASSERT_EQ(h.code(CommandId::go_to_relative_position, positions(0, -10)), ResponseCode::accepted);
+  h.wait_idle();
+  EXPECT_EQ(h.unsolicited.size(), 1u);
+  EXPECT_FALSE(h.status().collided());
+}
+
+TEST(FpsSimCollision, FrictionIsHarmlessWithDetectionOff) {
+  Harness h;
+  h.model.set_friction_fault(Arm::alpha, 30);
+  ASSERT_EQ(h.code(CommandId::alpha_closed_loop_without_collision_detection), ResponseCode::accepted);
+  ASSERT_EQ(h.code(CommandId::go_to_relative_position, positions(10, 0)), ResponseCode::accepted);
+  h.wait_idle();
+  EXPECT_TRUE(h.unsolicited.empty());
+  EXPECT_NEAR(h.position().first, 10, 1e-6);
+}

@@ -336,6 +336,30 @@ TEST(FpsSimulator, ReplyFaultPlanDropsAndDuplicates) {
   EXPECT_EQ(rig.sim.stats().faults_duplicated, 1u);
 }
 
+TEST(FpsSimulator, ReplyFaultPlanDelaysAReply) {
+  SimulatorOptions o;
+  can::FaultRule delay;
+  delay.action = can::FaultRule::Action::delay;
+  delay.match = can::Filter{0x00040400, 0x1FFFFC00, can::Filter::Format::extended};  // robot 1, GET_ID
+  delay.count = 1;
+  delay.delay = 50ms;
+  o.reply_faults.rules = {delay};
+  Rig rig(o);
+  rig.add(1);
+  rig.sim.start();
+  std::vector<protocol::Message> got;
+  run(rig.io, [&]() -> asio::awaitable<void> {
+    (void)co_await rig.host->send(request(1, CommandId::get_id, 1));
+    (void)co_await rig.host->send(request(1, CommandId::get_status, 2));
+    got = co_await collect(*rig.host, 2, 2s);
+    rig.sim.stop();
+  });
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0].id.uid, 2);  // the status overtook the delayed id
+  EXPECT_EQ(got[1].id.uid, 1);
+  EXPECT_EQ(rig.sim.stats().faults_delayed, 1u);
+}
+
 TEST(FpsSimulator, PowerCycleIntoTheBootloaderKeepsTheRealTimeWindow) {
   SimulatorOptions o;
   o.time_scale = 50;
