@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -88,16 +89,30 @@ Result<void> PositionerConfig::validate() const {
   return ok();
 }
 
-Result<PositionerConfig> PositionerConfig::from_config(const core::ConfigNode& node, const PositionerConfig& base) {
-  AXON_TRY(node.reject_unknown(
-      {"id", "firmware", "bootloader", "get_holding_current_on_112", "gear_ratio", "hard_stop_lower_deg",
-       "hard_stop_upper_deg", "default_speed_rpm", "min_speed_rpm", "max_speed_rpm", "max_current_percent",
-       "default_drive_current_percent", "precise_approach_deg", "datum_backoff_deg", "motor_calibration_turns",
-       "datum_spread_motor_deg", "motors_calibrated", "datums_calibrated", "cogging_calibrated",
-       "datums_initialized", "start_position_deg", "sync_line_low_at_power_on", "receive_buffer", "boot_time_s",
-       "bootloader_timeout_s", "watchdog_timeout_s", "hall_wake_up_s", "led_blink_s", "motor_calibration_time_s",
-       "cogging_calibration_time_s", "max_firmware_size", "cogging_vector_length", "raw_temperature", "x_mm",
-       "y_mm", "orientation_deg", "alpha_arm_mm", "beta_arm_mm", "collision_buffer_mm", "seed"}));
+namespace {
+constexpr std::string_view kKeys[] = {
+    "id", "firmware", "bootloader", "get_holding_current_on_112", "gear_ratio", "hard_stop_lower_deg",
+    "hard_stop_upper_deg", "default_speed_rpm", "min_speed_rpm", "max_speed_rpm", "max_current_percent",
+    "default_drive_current_percent", "precise_approach_deg", "datum_backoff_deg", "motor_calibration_turns",
+    "datum_spread_motor_deg", "motors_calibrated", "datums_calibrated", "cogging_calibrated", "datums_initialized",
+    "start_position_deg", "sync_line_low_at_power_on", "receive_buffer", "boot_time_s", "bootloader_timeout_s",
+    "watchdog_timeout_s", "hall_wake_up_s", "led_blink_s", "motor_calibration_time_s", "cogging_calibration_time_s",
+    "max_firmware_size", "cogging_vector_length", "raw_temperature", "x_mm", "y_mm", "orientation_deg",
+    "alpha_arm_mm", "beta_arm_mm", "collision_buffer_mm", "seed"};
+}  // namespace
+
+Result<PositionerConfig> PositionerConfig::from_config(const core::ConfigNode& node, const PositionerConfig& base,
+                                                       std::span<const std::string_view> also_allowed) {
+  if (!node.is_map()) return node.error(CoreErrc::config_bad_value, "expected a map of positioner settings");
+  for (const auto& k : node.keys()) {
+    const auto known = [&](std::span<const std::string_view> list) {
+      return std::find(list.begin(), list.end(), k) != list.end();
+    };
+    if (!known(kKeys) && !known(also_allowed)) {
+      AXON_TRY(c, node.child(k));
+      return c.error(CoreErrc::config_unknown_key, "unknown positioner setting (see docs/fps-simulator.md)");
+    }
+  }
   PositionerConfig c = base;
   auto num = [&](std::string_view key, auto& field) -> Result<void> {
     if (!node.has(key)) return ok();

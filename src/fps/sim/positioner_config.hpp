@@ -15,6 +15,8 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <span>
+#include <string_view>
 
 namespace axon::fps::sim {
 
@@ -90,7 +92,9 @@ struct PositionerConfig {
   // watchdog_timeout_s, hall_wake_up_s, led_blink_s, motor_calibration_time_s,
   // cogging_calibration_time_s, max_firmware_size, cogging_vector_length, raw_temperature, x_mm,
   // y_mm, orientation_deg, alpha_arm_mm, beta_arm_mm, collision_buffer_mm, seed.
-  static Result<PositionerConfig> from_config(const core::ConfigNode& node, const PositionerConfig& base);
+  // `also_allowed` names keys the caller reads itself (e.g. "bus" in a simulator's robot list).
+  static Result<PositionerConfig> from_config(const core::ConfigNode& node, const PositionerConfig& base,
+                                              std::span<const std::string_view> also_allowed = {});
   static Result<PositionerConfig> from_config(const core::ConfigNode& node);
 };
 

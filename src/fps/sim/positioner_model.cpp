@@ -303,6 +303,11 @@ void PositionerModel::start_commanded(Arm a, ArmPath cmd) {
   if (s.detection) {
     // The arm stops at the first contact; the path need not be clamped.
     s.collision_at = raw.first_outside(lower_stop(a), upper_stop(a));
+    // Too much friction for the margin: the controller sees a stall right after the start.
+    if (friction_[a] && *friction_[a] > s.margin && raw.end() > raw.start()) {
+      const SimTime stall = raw.start() + std::min<SimDuration>(std::chrono::milliseconds(200), raw.end() - raw.start());
+      if (!s.collision_at || stall < *s.collision_at) s.collision_at = stall;
+    }
     s.phys = std::move(raw);
   } else {
     s.phys = raw.clamped(lower_stop(a), upper_stop(a), !s.closed_loop);

@@ -129,6 +129,11 @@ class PositionerModel {
   // Fault injection: a collision of `arm` now, whatever the geometry and detection settings (the
   // robot stops, sets the flag and reports with command 18, uid 0). Nothing outside the application.
   Outbox inject_collision(Arm arm, SimTime now);
+  // Fault injection: extra friction on an arm (interface document 9.4.2). While `level` exceeds the
+  // arm's collision margin (SET_COLLISION_MARGIN, -30..30) and detection is on, every move of that
+  // arm ends in a false collision shortly after it starts; raising the margin above the level cures
+  // it. nullopt removes the fault.
+  void set_friction_fault(Arm arm, std::optional<std::int32_t> level) noexcept { friction_[arm] = level; }
 
   // Observers.
   [[nodiscard]] std::uint16_t id() const noexcept { return config_.id; }
@@ -254,6 +259,7 @@ class PositionerModel {
   bool position_restored_ = false;
   bool position_estimated_ = false;
   std::uint64_t noise_counter_ = 0;
+  PerArm<std::optional<std::int32_t>> friction_{};
   ModelCounters counters_;
 };
 

@@ -179,11 +179,10 @@ void Simulator::State::emit(Robot& r, const Outbox& out, bool from_sync) {
       continue;
     }
     if (d.corrupted) ++stats.faults_corrupted;
-    const int copies = d.duplicate ? 2 : 1;
     if (d.duplicate) ++stats.faults_duplicated;
-    for (int i = 0; i < copies; ++i) {
+    if (d.delay > core::Duration::zero()) ++stats.faults_delayed;
+    for (int i = 0; i < (d.duplicate ? 2 : 1); ++i) {
       if (d.delay > core::Duration::zero()) {
-        ++stats.faults_delayed;
         asio::co_spawn(executor, delayed(shared_from_this(), &r, d.frame, d.delay), asio::detached);
       } else {
         enqueue(r, d.frame);
@@ -387,6 +386,13 @@ Result<void> Simulator::force_collision(std::uint16_t id, Arm arm) {
     return make_error(CoreErrc::invalid_argument, fmt::format("simulator: no positioner {}", id));
   }
   state_->emit(*it->second, it->second->model.inject_collision(arm, now()));
+  return ok();
+}
+
+Result<void> Simulator::set_friction_fault(std::uint16_t id, Arm arm, std::optional<std::int32_t> level) {
+  PositionerModel* m = find(id);
+  if (m == nullptr) return make_error(CoreErrc::invalid_argument, fmt::format("simulator: no positioner {}", id));
+  m->set_friction_fault(arm, level);
   return ok();
 }
 

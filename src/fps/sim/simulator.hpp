@@ -111,6 +111,7 @@ class Simulator {
 
   // Faults.
   Result<void> force_collision(std::uint16_t id, Arm arm);
+  Result<void> set_friction_fault(std::uint16_t id, Arm arm, std::optional<std::int32_t> level);
   void add_obstacle(Obstacle obstacle);
   void clear_obstacles();
   void set_reply_faults(can::FaultPlan plan);
