@@ -21,8 +21,13 @@ void CollisionMonitor::set_obstacles(std::vector<Obstacle> obstacles) { obstacle
 std::vector<CollisionMonitor::Contact> CollisionMonitor::update(std::span<const Pose> poses) {
   std::vector<Contact> out;
   if (poses.size() != robots_.size()) return out;
+  const auto segments_at = [&](std::span<const Pose> p, std::vector<Segment>& into) {
+    into.resize(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) into[i] = beta_segment(robots_[i], p[i].alpha_deg, p[i].beta_deg);
+  };
   if (previous_.size() != poses.size()) {
     previous_.assign(poses.begin(), poses.end());
+    segments_at(previous_, previous_segments_);
     return out;
   }
   std::vector<bool> moved(poses.size());
@@ -32,7 +37,11 @@ std::vector<CollisionMonitor::Contact> CollisionMonitor::update(std::span<const 
     any = any || moved[i];
   }
   if (!any) return out;
-  const auto seg = [&](std::size_t i, const Pose& p) { return beta_segment(robots_[i], p.alpha_deg, p.beta_deg); };
+  // Each robot's segment once per update; unmoved robots keep the previous one.
+  segments_.resize(poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    segments_[i] = moved[i] ? beta_segment(robots_[i], poses[i].alpha_deg, poses[i].beta_deg) : previous_segments_[i];
+  }
   const auto report = [&](std::size_t i, std::optional<std::size_t> other, std::size_t obstacle, double d) {
     out.push_back(Contact{i, other, obstacle, d, poses[i].alpha_deg != previous_[i].alpha_deg,
                           poses[i].beta_deg != previous_[i].beta_deg});
@@ -43,9 +52,10 @@ std::vector<CollisionMonitor::Contact> CollisionMonitor::update(std::span<const 
   };
   for (const Pair& p : pairs_) {
     if (!moved[p.a] && !moved[p.b]) continue;
-    const double now = segment_distance(seg(p.a, poses[p.a]), seg(p.b, poses[p.b]));
+    if (surely_apart(segments_[p.a], segments_[p.b], p.limit)) continue;
+    const double now = segment_distance(segments_[p.a], segments_[p.b]);
     if (now >= p.limit) continue;
-    const double before = segment_distance(seg(p.a, previous_[p.a]), seg(p.b, previous_[p.b]));
+    const double before = segment_distance(previous_segments_[p.a], previous_segments_[p.b]);
     if (!hit(now, before, p.limit)) continue;
     if (moved[p.a]) report(p.a, p.b, 0, now);
     if (moved[p.b]) report(p.b, p.a, 0, now);
@@ -54,13 +64,15 @@ std::vector<CollisionMonitor::Contact> CollisionMonitor::update(std::span<const 
     if (!moved[i]) continue;
     for (std::size_t k = 0; k < obstacles_.size(); ++k) {
       const double limit = robots_[i].buffer_mm + obstacles_[k].radius_mm;
-      const double now = segment_distance(seg(i, poses[i]), obstacles_[k].shape);
+      if (surely_apart(segments_[i], obstacles_[k].shape, limit)) continue;
+      const double now = segment_distance(segments_[i], obstacles_[k].shape);
       if (now >= limit) continue;
-      const double before = segment_distance(seg(i, previous_[i]), obstacles_[k].shape);
+      const double before = segment_distance(previous_segments_[i], obstacles_[k].shape);
       if (hit(now, before, limit)) report(i, std::nullopt, k, now);
     }
   }
   previous_.assign(poses.begin(), poses.end());
+  previous_segments_.swap(segments_);
   return out;
 }
 

@@ -57,6 +57,8 @@ class CollisionMonitor {
   std::vector<Pair> pairs_;
   std::vector<Obstacle> obstacles_;
   std::vector<Pose> previous_;
+  std::vector<Segment> previous_segments_;  // beta segments at the previous poses
+  std::vector<Segment> segments_;           // scratch: at the current poses
 };
 
 }  // namespace axon::fps::sim

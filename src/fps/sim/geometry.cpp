@@ -16,7 +16,7 @@ double point_segment(Vec2 p, const Segment& s) noexcept {
   const double len2 = dot(d, d);
   const double f = len2 > 0 ? std::clamp(dot(sub(p, s.a), d) / len2, 0.0, 1.0) : 0.0;
   const Vec2 q{s.a.x + d.x * f, s.a.y + d.y * f};
-  return std::hypot(p.x - q.x, p.y - q.y);
+  return std::sqrt((p.x - q.x) * (p.x - q.x) + (p.y - q.y) * (p.y - q.y));
 }
 
 double cross(Vec2 a, Vec2 b) noexcept { return a.x * b.y - a.y * b.x; }
@@ -33,6 +33,15 @@ bool segments_cross(const Segment& s, const Segment& t) noexcept {
 }
 
 }  // namespace
+
+bool surely_apart(const Segment& s, const Segment& t, double limit) noexcept {
+  // Each segment lies within half its length of its midpoint.
+  const double hs = 0.5 * std::sqrt(dot(sub(s.b, s.a), sub(s.b, s.a)));
+  const double ht = 0.5 * std::sqrt(dot(sub(t.b, t.a), sub(t.b, t.a)));
+  const Vec2 d{(s.a.x + s.b.x - t.a.x - t.b.x) * 0.5, (s.a.y + s.b.y - t.a.y - t.b.y) * 0.5};
+  const double reach = hs + ht + limit;
+  return dot(d, d) >= reach * reach;
+}
 
 double segment_distance(const Segment& s, const Segment& t) noexcept {
   if (segments_cross(s, t)) return 0.0;

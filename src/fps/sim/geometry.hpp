@@ -25,6 +25,8 @@ struct Segment {
 
 // Shortest distance between two segments (either may be a single point).
 double segment_distance(const Segment& s, const Segment& t) noexcept;
+// A quick test: true when the segments are certainly at least `limit` apart (false: maybe closer).
+bool surely_apart(const Segment& s, const Segment& t, double limit) noexcept;
 
 struct RobotGeometry {
   Vec2 base;

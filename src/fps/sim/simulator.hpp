@@ -42,7 +42,7 @@ namespace asio = boost::asio;
 struct SimulatorOptions {
   double time_scale = 1.0;                                   // simulated seconds per real second (> 0)
   core::Duration tick = std::chrono::milliseconds(5);        // real time between advances
-  SimDuration collision_step = std::chrono::milliseconds(20);  // simulated time between collision checks
+  SimDuration collision_step = std::chrono::milliseconds(50);  // simulated time between collision checks
   core::Duration processing_delay = std::chrono::microseconds(100);  // real time per command
   core::Duration flash_delay = std::chrono::milliseconds(1);  // instead, for 53, 200 and 201
   bool scale_protocol_timeouts = false;                      // see above

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <vector>
 
 using namespace axon::fps::sim;
@@ -13,6 +15,20 @@ TEST(FpsSimGeometry, SegmentDistance) {
   EXPECT_DOUBLE_EQ(segment_distance({{0, 0}, {10, 0}}, {{5, -1}, {5, 1}}), 0);  // crossing
   EXPECT_DOUBLE_EQ(segment_distance({{0, 0}, {10, 0}}, {{13, 4}, {13, 4}}), 5);  // point
   EXPECT_DOUBLE_EQ(segment_distance({{0, 0}, {0, 0}}, {{3, 4}, {3, 4}}), 5);
+}
+
+TEST(FpsSimGeometry, SurelyApartNeverHidesAContact) {
+  const Segment s{{0, 0}, {10, 0}};
+  EXPECT_TRUE(surely_apart(s, {{30, 0}, {40, 0}}, 4));
+  EXPECT_FALSE(surely_apart(s, {{13, 0}, {23, 0}}, 4));  // 3 mm apart: must not be skipped
+  // Whenever the exact distance is below the limit, the quick test says "maybe".
+  for (int i = 0; i < 200; ++i) {
+    const double a = i * 0.1, x = 5 + (i % 17);
+    const Segment t{{x, 0.5 * (i % 9)}, {x + 10 * std::cos(a), 0.5 * (i % 9) + 10 * std::sin(a)}};
+    if (segment_distance(s, t) < 4) {
+      EXPECT_FALSE(surely_apart(s, t, 4)) << i;
+    }
+  }
 }
 
 TEST(FpsSimGeometry, BetaSegmentFollowsTheArms) {
