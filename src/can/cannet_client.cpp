@@ -1,6 +1,6 @@
 #include "can/cannet_client.hpp"
 
-#include "can/wakeup.hpp"
+#include "core/wakeup.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/connect.hpp>
@@ -48,7 +48,7 @@ struct CanNetGateway::Impl : std::enable_shared_from_this<CanNetGateway::Impl> {
   };
   struct PendingReply {
     explicit PendingReply(const asio::any_io_executor& ex) : waiter(ex) {}
-    Wakeup waiter;
+    core::Wakeup waiter;
     std::optional<Line> reply;
   };
 
@@ -73,11 +73,11 @@ struct CanNetGateway::Impl : std::enable_shared_from_this<CanNetGateway::Impl> {
   std::array<Channel, kMaxChannel + 1> chan{};  // indexed by channel number
 
   std::string out;                  // lines waiting for the writer
-  Wakeup* writer_idle = nullptr;    // the writer, when it has nothing to write
-  std::vector<Wakeup*> space_waiters;
+  core::Wakeup* writer_idle = nullptr;    // the writer, when it has nothing to write
+  std::vector<core::Wakeup*> space_waiters;
 
   bool command_busy = false;        // a command is in flight (or being sent)
-  std::deque<Wakeup*> command_queue;
+  std::deque<core::Wakeup*> command_queue;
   PendingReply* pending = nullptr;  // the command in flight
 
   // ---- connection ----
@@ -94,7 +94,7 @@ struct CanNetGateway::Impl : std::enable_shared_from_this<CanNetGateway::Impl> {
     out.append(line);
     out.push_back('\n');
     ++stats.lines_out;
-    if (writer_idle) writer_idle->wake();
+    if (writer_idle) writer_idle->notify();
   }
   asio::awaitable<Result<void>> write_bounded(std::string line);
   // Lines queued or being written (0 once the writer is idle with nothing queued).
@@ -235,9 +235,9 @@ asio::awaitable<void> CanNetGateway::Impl::run_writer(std::shared_ptr<Impl> self
   std::string chunk;
   while (s.connected) {
     if (s.out.empty()) {
-      Wakeup idle(s.executor);
+      core::Wakeup idle(s.executor);
       s.writer_idle = &idle;
-      OnExit clear{[&s] { s.writer_idle = nullptr; }};
+      core::OnExit clear{[&s] { s.writer_idle = nullptr; }};
       co_await idle.wait();
       continue;
     }
@@ -249,7 +249,7 @@ asio::awaitable<void> CanNetGateway::Impl::run_writer(std::shared_ptr<Impl> self
       s.connection_down(Error(CanErrc::io, fmt::format("{}: write failed: {}", s.where, ec.message())));
       co_return;
     }
-    for (auto* w : s.space_waiters) w->wake();
+    for (auto* w : s.space_waiters) w->notify();
   }
 }
 
@@ -264,10 +264,10 @@ void CanNetGateway::Impl::connection_down(Error why) {
   boost::system::error_code ignored;
   socket.shutdown(tcp::socket::shutdown_both, ignored);
   socket.close(ignored);
-  if (writer_idle) writer_idle->wake();
-  for (auto* w : space_waiters) w->wake();
-  for (auto* w : command_queue) w->timer.cancel();  // cancelled without being granted the turn
-  if (pending) pending->waiter.timer.cancel();
+  if (writer_idle) writer_idle->notify();
+  for (auto* w : space_waiters) w->notify();
+  for (auto* w : command_queue) w->abandon();  // woken without being granted the turn
+  if (pending) pending->waiter.abandon();
   for (auto& c : chan)
     if (c.bus) c.bus->on_connection_down();
 }
@@ -275,9 +275,9 @@ void CanNetGateway::Impl::connection_down(Error why) {
 asio::awaitable<Result<void>> CanNetGateway::Impl::write_bounded(std::string line) {
   auto self = shared_from_this();
   while (connected && out.size() >= kOutputHighWater) {
-    Wakeup room(executor);
+    core::Wakeup room(executor);
     space_waiters.push_back(&room);
-    OnExit remove{[this, &room] { space_waiters.erase(std::remove(space_waiters.begin(), space_waiters.end(), &room), space_waiters.end()); }};
+    core::OnExit remove{[this, &room] { space_waiters.erase(std::remove(space_waiters.begin(), space_waiters.end(), &room), space_waiters.end()); }};
     co_await room.wait();
   }
   if (!connected) co_return down_error;
@@ -326,7 +326,7 @@ void CanNetGateway::Impl::handle_reply(Line line) {
   ++stats.commands;
   if (std::holds_alternative<ReplyError>(line)) ++stats.device_errors;
   pending->reply = std::move(line);
-  pending->waiter.wake();
+  pending->waiter.notify();
 }
 
 void CanNetGateway::Impl::handle_event(const Event& e) {
@@ -367,29 +367,28 @@ asio::awaitable<Result<Line>> CanNetGateway::Impl::transact(const Line& command)
   const std::string text = format_line(command);
   AXON_CO_TRY(check_open());
   if (command_busy) {  // wait for our turn, in order
-    Wakeup turn(executor);
+    core::Wakeup turn(executor);
     command_queue.push_back(&turn);
-    OnExit remove{[this, &turn] { command_queue.erase(std::remove(command_queue.begin(), command_queue.end(), &turn), command_queue.end()); }};
-    co_await turn.wait();
-    if (!turn.woken) co_return down_error;  // shut down while waiting; the turn never came
+    core::OnExit remove{[this, &turn] { command_queue.erase(std::remove(command_queue.begin(), command_queue.end(), &turn), command_queue.end()); }};
+    const bool granted = co_await turn.wait();
+    if (!granted) co_return down_error;  // shut down while waiting; the turn never came
   }
   command_busy = true;  // ours now, until handed on below
   PendingReply reply(executor);
-  OnExit release{[this] {
+  core::OnExit release{[this] {
     pending = nullptr;
     if (command_queue.empty()) {
       command_busy = false;
     } else {
-      Wakeup* next = command_queue.front();
+      core::Wakeup* next = command_queue.front();
       command_queue.pop_front();
-      next->wake();
+      next->notify();
     }
   }};
   AXON_CO_TRY(check_open());
   pending = &reply;
   queue_line(text);
-  reply.waiter.timer.expires_after(options.reply_timeout);
-  co_await reply.waiter.wait();
+  (void)co_await reply.waiter.wait_until(std::chrono::steady_clock::now() + options.reply_timeout);
   if (reply.reply) co_return std::move(*reply.reply);
   if (!connected) co_return down_error;
   co_return Error(CanErrc::timeout, fmt::format("{}: no reply to '{}' within {} ms", where, text, millis(options.reply_timeout)));

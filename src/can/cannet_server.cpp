@@ -1,7 +1,8 @@
 #include "can/cannet_server.hpp"
 
-#include "can/wakeup.hpp"
+#include "core/wakeup.hpp"
 
+#include <boost/asio/redirect_error.hpp>
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -62,7 +63,7 @@ struct CanNetGatewayEmulator::Impl : std::enable_shared_from_this<CanNetGatewayE
     std::uint64_t id;
     bool open = true;
     std::string out;                // lines waiting for the writer
-    Wakeup* writer_idle = nullptr;  // the writer, when it has nothing to write
+    core::Wakeup* writer_idle = nullptr;  // the writer, when it has nothing to write
   };
   struct Channel {
     std::string name;               // provider channel; empty: not fitted
@@ -108,7 +109,7 @@ struct CanNetGatewayEmulator::Impl : std::enable_shared_from_this<CanNetGatewayE
     if (!conn.open) return;
     conn.out.append(line);
     conn.out.push_back('\n');
-    if (conn.writer_idle) conn.writer_idle->wake();
+    if (conn.writer_idle) conn.writer_idle->notify();
   }
   void send(Connection& conn, const Line& line) { send(conn, std::string_view(format_line(line))); }
   void send_to_client(const Line& line) {
@@ -212,7 +213,7 @@ void CanNetGatewayEmulator::Impl::drop(std::shared_ptr<Connection> conn, std::st
   boost::system::error_code ignored;
   conn->socket.shutdown(tcp::socket::shutdown_both, ignored);
   conn->socket.close(ignored);
-  if (conn->writer_idle) conn->writer_idle->wake();
+  if (conn->writer_idle) conn->writer_idle->notify();
   if (client == conn) client.reset();
 }
 
@@ -249,9 +250,9 @@ asio::awaitable<void> CanNetGatewayEmulator::Impl::run_writer(std::shared_ptr<Im
   std::string chunk;
   while (conn->open) {
     if (conn->out.empty()) {
-      Wakeup idle(s.executor);
+      core::Wakeup idle(s.executor);
       conn->writer_idle = &idle;
-      OnExit clear{[&conn] { conn->writer_idle = nullptr; }};
+      core::OnExit clear{[&conn] { conn->writer_idle = nullptr; }};
       co_await idle.wait();
       continue;
     }

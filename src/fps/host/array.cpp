@@ -285,7 +285,7 @@ asio::awaitable<void> Array::stop_everyone() {
     for (unsigned attempt = 0; attempt < std::max(1u, options_.emergency_send_attempts); ++attempt) {
       r = co_await buses_[i].client->broadcast_now(CommandId::trajectory_abort);
       if (r) co_return;
-      co_await sleep_for(10ms);
+      co_await core::sleep_for(10ms);
     }
     const auto msg = fmt::format("bus {}: TRAJECTORY_ABORT not sent: {}", bus_name(i), r.error().message());
     spdlog::error("fps array: {}", msg);
@@ -431,7 +431,7 @@ ClientCounters Array::client_totals() const {
 
 asio::awaitable<void> Array::close() {
   while (background_ > 0) {
-    Wakeup w(executor_);
+    core::Wakeup w(executor_);
     background_waiters_.push_back(&w);
     co_await w.wait_until(core::TimePoint::max());
     std::erase(background_waiters_, &w);

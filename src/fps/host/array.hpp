@@ -27,7 +27,7 @@
 #include "fps/host/positioner.hpp"
 #include "fps/host/status_table.hpp"
 #include "fps/host/trajectory_report.hpp"
-#include "fps/host/wakeup.hpp"
+#include "core/wakeup.hpp"
 #include "fps/protocol/trajectory.hpp"
 
 #include <boost/asio/awaitable.hpp>
@@ -198,7 +198,7 @@ class Array final : public MotionGate {
   LockState lock_;
   ArrayCounters counters_;
   std::size_t background_ = 0;  // emergency stops running in the background
-  std::vector<Wakeup*> background_waiters_;
+  std::vector<core::Wakeup*> background_waiters_;
 };
 
 }  // namespace axon::fps::host

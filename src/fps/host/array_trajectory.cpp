@@ -86,7 +86,7 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
       }
     }
   }
-  co_await sleep_for(o.settle);
+  co_await core::sleep_for(o.settle);
 
   // 2. Check each robot and note where it starts.
   co_await for_each_concurrently(n, [&](std::size_t i) -> asio::awaitable<void> {

@@ -1,7 +1,7 @@
 #include "fps/host/command_client.hpp"
 
 #include "fps/host/uid_pool.hpp"
-#include "fps/host/wakeup.hpp"
+#include "core/wakeup.hpp"
 #include "fps/protocol/error.hpp"
 #include "fps/protocol/identifier.hpp"
 #include "fps/protocol/message.hpp"
@@ -101,12 +101,12 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
 
   struct Pending {
     explicit Pending(const asio::any_io_executor& e) : wake(e) {}
-    Wakeup wake;
+    core::Wakeup wake;
     std::optional<Reply> reply;
   };
   struct UidWaiter {
     explicit UidWaiter(const asio::any_io_executor& e) : wake(e) {}
-    Wakeup wake;
+    core::Wakeup wake;
     std::optional<std::uint8_t> granted;
   };
   struct PoolEntry {
@@ -116,12 +116,12 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
   };
   struct SlotWaiter {
     explicit SlotWaiter(const asio::any_io_executor& e) : wake(e) {}
-    Wakeup wake;
+    core::Wakeup wake;
     bool granted = false;
   };
   struct Collector {
     Collector(const asio::any_io_executor& e, std::optional<std::size_t> exp) : wake(e), expected(exp) {}
-    Wakeup wake;
+    core::Wakeup wake;
     std::optional<std::size_t> expected;
     BroadcastResult result;
   };
@@ -131,10 +131,10 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
   std::size_t in_flight = 0;
   std::deque<SlotWaiter*> slot_waiters;
   std::unordered_map<std::uint8_t, Collector*> collectors;
-  std::unordered_map<std::uint8_t, std::deque<Wakeup*>> collector_waiters;
+  std::unordered_map<std::uint8_t, std::deque<core::Wakeup*>> collector_waiters;
   std::map<std::uint64_t, Handler> subscribers;
   std::uint64_t next_subscriber = 1;
-  std::vector<Wakeup*> stop_waiters;
+  std::vector<core::Wakeup*> stop_waiters;
 
   // --- reader ------------------------------------------------------------------------------
 
@@ -427,12 +427,12 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
     const std::uint8_t n = info.number();
     while (collectors.contains(n)) {
       if (auto r = check_running(); !r) co_return r.error();
-      Wakeup w(ex);
+      core::Wakeup w(ex);
       auto& q = collector_waiters[n];
       q.push_back(&w);
       struct Unlist {
-        std::deque<Wakeup*>& q;
-        Wakeup* w;
+        std::deque<core::Wakeup*>& q;
+        core::Wakeup* w;
         ~Unlist() { q.erase(std::remove(q.begin(), q.end(), w), q.end()); }
       } unlist{q, &w};
       co_await w.wait_until(core::TimePoint::max());
@@ -496,11 +496,11 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
     stopping = true;
     wake_everyone();
     if (reader_done) co_return;
-    Wakeup w(ex);
+    core::Wakeup w(ex);
     stop_waiters.push_back(&w);
     struct Unlist {
-      std::vector<Wakeup*>& q;
-      Wakeup* w;
+      std::vector<core::Wakeup*>& q;
+      core::Wakeup* w;
       ~Unlist() { q.erase(std::remove(q.begin(), q.end(), w), q.end()); }
     } unlist{stop_waiters, &w};
     co_await w.wait_until(core::TimePoint::max());
@@ -542,7 +542,7 @@ namespace {
 
 struct PipeState {
   explicit PipeState(const asio::any_io_executor& ex, std::size_t n) : wake(ex), done(n, 0) {}
-  Wakeup wake;
+  core::Wakeup wake;
   std::size_t outstanding = 0;
   std::vector<std::uint8_t> done;  // 0 waiting, 1 accepted, 2 failed
   std::map<std::size_t, Error> failures;

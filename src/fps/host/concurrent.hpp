@@ -2,7 +2,7 @@
 // talks to many robots (and many buses) at once from one thread.
 #pragma once
 
-#include "fps/host/wakeup.hpp"
+#include "core/wakeup.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
@@ -14,7 +14,7 @@ namespace axon::fps::host {
 
 namespace detail {
 template <class F>
-asio::awaitable<void> run_one(F* f, std::size_t i, std::size_t* left, Wakeup* done) {
+asio::awaitable<void> run_one(F* f, std::size_t i, std::size_t* left, core::Wakeup* done) {
   co_await (*f)(i);
   if (--*left == 0) done->notify();
 }
@@ -26,7 +26,7 @@ template <class F>
 asio::awaitable<void> for_each_concurrently(std::size_t n, F f) {
   if (n == 0) co_return;
   auto ex = co_await asio::this_coro::executor;
-  Wakeup done(ex);
+  core::Wakeup done(ex);
   std::size_t left = n;
   for (std::size_t i = 0; i < n; ++i) asio::co_spawn(ex, detail::run_one(&f, i, &left, &done), asio::detached);
   co_await done.wait_until(core::TimePoint::max());

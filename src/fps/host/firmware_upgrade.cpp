@@ -148,7 +148,7 @@ asio::awaitable<void> Array::upgrade_one(std::uint16_t id, const std::vector<pro
     if (std::chrono::steady_clock::now() >= deadline) {
       co_return failed(fmt::format("image sent, but the robot did not confirm it (status {})", st.value().to_string()));
     }
-    co_await sleep_for(options.verify_poll);
+    co_await core::sleep_for(options.verify_poll);
   }
   report.outcome = UpgradeOutcome::ok;
   report.reason.clear();

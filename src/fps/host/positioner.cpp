@@ -1,6 +1,6 @@
 #include "fps/host/positioner.hpp"
 
-#include "fps/host/wakeup.hpp"
+#include "core/wakeup.hpp"
 
 #include <fmt/format.h>
 
@@ -367,7 +367,7 @@ asio::awaitable<Result<PositionerStatus>> Positioner::wait_for(std::function<boo
       co_return Error(HostErrc::timeout, fmt::format("positioner {}: {} not finished after {:.1f} s (status {})", id_,
                                                      what, seconds(timeout), st.value().to_string()));
     }
-    co_await sleep_for(std::min<core::Duration>(options_.poll_interval, deadline - t));
+    co_await core::sleep_for(std::min<core::Duration>(options_.poll_interval, deadline - t));
   }
 }
 

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "can/virtual_bus.hpp"
-#include "fps/host/wakeup.hpp"
+#include "core/wakeup.hpp"
 #include "fps/protocol/message.hpp"
 
 #include <boost/asio/co_spawn.hpp>
@@ -85,7 +85,7 @@ class FakeDevice {
   }
 
   asio::awaitable<void> delayed(Outgoing out) {
-    co_await sleep_for(out.delay);
+    co_await core::sleep_for(out.delay);
     if (!stopping_) (void)co_await bus_->send(out.frame);
   }
 

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "can/virtual_bus.hpp"
-#include "fps/host/wakeup.hpp"
+#include "core/wakeup.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/io_context.hpp>
@@ -16,6 +16,8 @@
 
 namespace axon::fps::host::testing {
 
+namespace asio = boost::asio;
+
 using namespace std::chrono_literals;
 
 // Waits (polling the io_context) until `pred` holds; gives up after `limit` polls. Not a timing
@@ -23,7 +25,7 @@ using namespace std::chrono_literals;
 inline asio::awaitable<bool> eventually(std::function<bool()> pred, int limit = 5000) {
   for (int i = 0; i < limit; ++i) {
     if (pred()) co_return true;
-    co_await sleep_for(1ms);
+    co_await core::sleep_for(1ms);
   }
   co_return pred();
 }
