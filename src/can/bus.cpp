@@ -85,7 +85,7 @@ void Bus::set_state(BusState s) noexcept {
 void Bus::close() { set_state(BusState::closed); }
 
 void Bus::wake_receivers() noexcept {
-  for (auto* t : waiters_) t->cancel();
+  for (auto* t : *waiters_) t->cancel();
 }
 
 std::optional<Frame> Bus::try_receive() {
@@ -122,11 +122,11 @@ asio::awaitable<Result<Frame>> Bus::receive_until(std::optional<core::TimePoint>
     if (deadline && std::chrono::steady_clock::now() >= *deadline)
       co_return Error(CanErrc::timeout, fmt::format("bus {}", name_));
     asio::steady_timer timer(executor_, deadline ? *deadline : core::TimePoint::max());
-    waiters_.push_back(&timer);
+    waiters_->push_back(&timer);
     struct Unregister {
-      std::vector<asio::steady_timer*>& list;
+      std::shared_ptr<std::vector<asio::steady_timer*>> list;
       asio::steady_timer* t;
-      ~Unregister() { list.erase(std::remove(list.begin(), list.end(), t), list.end()); }
+      ~Unregister() { list->erase(std::remove(list->begin(), list->end(), t), list->end()); }
     } guard{waiters_, &timer};
     boost::system::error_code ec;
     co_await timer.async_wait(asio::redirect_error(asio::use_awaitable, ec));

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -130,7 +131,9 @@ class Bus {
   BusOptions options_;
   std::vector<Filter> filters_;
   std::deque<Frame> rx_;
-  std::vector<asio::steady_timer*> waiters_;
+  // Timers of receive() calls in progress. Shared with those calls, so that a receive coroutine
+  // destroyed after its bus (an io_context torn down with work pending) unregisters safely.
+  std::shared_ptr<std::vector<asio::steady_timer*>> waiters_ = std::make_shared<std::vector<asio::steady_timer*>>();
   BusStats stats_;
   BusState state_ = BusState::active;
 };
