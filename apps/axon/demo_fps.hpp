@@ -1,6 +1,8 @@
 // The fps part of `axon demo`: simulated positioners on a virtual bus driven by the host driver.
 #pragma once
 
+#include <utility>  // before asio/awaitable.hpp, which uses std::exchange without it (Boost 1.74)
+
 #include <boost/asio/any_io_executor.hpp>
 #include <boost/asio/awaitable.hpp>
 

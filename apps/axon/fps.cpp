@@ -14,10 +14,12 @@
 #include "run.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cctype>
 #include <charconv>
 #include <cstdio>
 #include <fstream>
@@ -124,6 +126,15 @@ int with_array(const FpsOptions& o, const Job& job) {
   });
 }
 
+// The robot's handle, or an error naming the robots that were found.
+host::Positioner* robot(host::Array& array, std::uint16_t id) {
+  if (auto* p = array.find(id)) return p;
+  const auto ids = array.ids();
+  throw Exception(Error(host::HostErrc::unknown_positioner,
+                        fmt::format("robot {} did not answer discovery on any bus (found: {})", id,
+                                    ids.empty() ? std::string("none") : fmt::format("{}", fmt::join(ids, " ")))));
+}
+
 // ---- discover / status / position ---------------------------------------------------------------
 
 asio::awaitable<int> job_discover(const FpsOptions& o, host::Array& array, const host::DiscoveryReport& report) {
@@ -168,7 +179,7 @@ asio::awaitable<int> job_position(const FpsOptions& o, const std::vector<std::st
   std::vector<std::uint16_t> ids = id_text.empty() ? array.ids() : need(parse_id_lists(id_text));
   json j = json::object();
   for (auto id : ids) {
-    auto* p = need(array.positioner(id));
+    auto* p = robot(array, id);
     auto r = co_await p->read_position();
     const auto pos = need(std::move(r));
     if (o.json) j[std::to_string(id)] = angles_json(pos);
@@ -188,7 +199,7 @@ struct GotoArgs {
 };
 
 asio::awaitable<int> job_goto(const FpsOptions& o, const GotoArgs& g, host::Array& array, const host::DiscoveryReport&) {
-  auto* p = need(array.positioner(g.id));
+  auto* p = robot(array, g.id);
   const host::ArmAngles value{g.alpha, g.beta};
   spdlog::info("goto: robot {} {} alpha {} beta {}", g.id, g.relative ? "by" : "to", g.alpha, g.beta);
   Result<host::MoveResult> r = Error(CoreErrc::invalid_argument);
@@ -233,7 +244,7 @@ std::map<std::uint16_t, protocol::Trajectory> load_trajectories(const std::strin
       }
     }
     auto t = protocol::Trajectory::from_physical(arms[0], arms[1]);
-    if (!t) throw Exception(Error(t.error().code(), fmt::format("{}: robot {}: {}", file, key, t.error().message())));
+    if (!t) throw Exception(Error(t.error().code, fmt::format("{}: robot {}{}{}", file, key, t.error().detail.empty() ? "" : ": ", t.error().detail)));
     out.emplace(ids.front(), std::move(t).value());
   }
   return out;
@@ -291,7 +302,7 @@ struct CalibrateArgs {
 
 asio::awaitable<int> job_calibrate(const FpsOptions& o, const CalibrateArgs& c, host::Array& array,
                                    const host::DiscoveryReport&) {
-  auto* p = need(array.positioner(c.id));
+  auto* p = robot(array, c.id);
   host::CalibrationPlan plan;
   if (c.motor || c.datum || c.cogging || c.save) {
     plan.motors = c.motor;
@@ -318,7 +329,7 @@ asio::awaitable<int> job_calibrate(const FpsOptions& o, const CalibrateArgs& c, 
 }
 
 asio::awaitable<int> job_datum(const FpsOptions& o, std::uint16_t id, host::Array& array, const host::DiscoveryReport&) {
-  auto* p = need(array.positioner(id));
+  auto* p = robot(array, id);
   spdlog::info("datum: robot {} drives both arms into their hard stops", id);
   auto r = co_await p->go_to_datums(host::Arm::both);
   const auto st = need(std::move(r));
@@ -405,6 +416,7 @@ asio::awaitable<int> job_raw(const FpsOptions& o, const RawArgs& a, host::Array&
   const auto cmd = parse_command(a.command);
   const auto bytes = parse_hex(a.data);
   const auto payload = need(protocol::Payload::from(bytes));
+  robot(array, a.id);
   const auto bus = need(array.bus_of(a.id));
   auto r = co_await array.client(bus).request(a.id, cmd, payload);
   const auto reply = need(std::move(r));
