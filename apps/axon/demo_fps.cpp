@@ -42,10 +42,10 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   for (const auto& [s, n] : states) state_text += fmt::format("{}{} {}", state_text.empty() ? "" : ", ", n, s);
   fmt::print("2. discover (GET_ID broadcast, then firmware and status of each): {} robots, {} ({:.2f} s)\n",
              table.rows.size(), state_text, since());
-  if (!table.rows.empty() && table.rows.front().firmware)
-    fmt::print("   robot {}: firmware {}, status {}\n", table.rows.front().id, table.rows.front().firmware->to_string(),
-               table.rows.front().status ? table.rows.front().status->to_string() : std::string("?"));
-
+  if (!table.rows.empty() && table.rows.front().firmware && table.rows.front().status)
+    fmt::print("   robot {}: firmware {}, {} status flags set, e.g. DATUM_ALPHA_INITIALIZED: {}\n", table.rows.front().id,
+               table.rows.front().firmware->to_string(), table.rows.front().status->names().size(),
+               table.rows.front().status->has(protocol::StatusBit::datum_alpha_initialized) ? "yes" : "no");
   std::map<std::uint16_t, host::ArmAngles> targets{{1, {90, 170}}, {2, {180, 160}}, {3, {270, 175}}, {4, {45, 150}}};
   const auto t_move = since();
   auto r2 = co_await array.goto_absolute(targets);

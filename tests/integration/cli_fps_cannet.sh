@@ -50,4 +50,23 @@ grep -q '99' "$TMP/bad.err" || fail "the error does not name robot 99"
 if fps goto 3 400 180 >"$TMP/far.out" 2>"$TMP/far.err"; then fail "goto beyond the stop succeeded"; else rc=$?; fi
 [ "$rc" = 1 ] || fail "goto beyond the stop exited with $rc"
 grep -Eq 'VALUE_OUT_OF_RANGE|out of range' "$TMP/far.err" || fail "no response code in: $(cat "$TMP/far.err")"
+# A trajectory (JSON this time) the firmware refuses, too fast: exit 1, nothing starts, robot 4 named.
+echo '{"4": {"alpha": [[300, 0.5]]}}' >"$TMP/fast.json"
+if fps --json move --trajectory "$TMP/fast.json" >"$TMP/fast.out" 2>"$TMP/fast.err"; then fail "too-fast trajectory succeeded"; fi
+/usr/bin/python3 - "$TMP/fast.out" <<'PY' || fail "too-fast trajectory report is not what was expected"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert not j["started"], j
+r = j["robots"][0]
+assert r["id"] == 4 and r["state"] == "upload-failed", r
+assert "VALUE_OUT_OF_RANGE" in r["detail"], r
+PY
+fps --json position 4 >"$TMP/pos4.out" 2>"$TMP/pos4.err" || fail "position 4 exited with $?"
+/usr/bin/python3 -c 'import json,sys; p=json.load(open(sys.argv[1]))["4"]; assert abs(p["alpha"])<=0.1, p' "$TMP/pos4.out" ||
+  fail "robot 4 moved after a refused trajectory"
+
+# Ctrl-C: the simulator stops and sums up.
+kill -INT "$SIM_PID"
+wait "$SIM_PID" || fail "axon sim fps exited with $? after SIGINT"
+grep -Eq 'frames processed, .* 0 receive overflows, 0 collisions' "$TMP/sim.err" || fail "no summary from the simulator"
 echo "PASS"
