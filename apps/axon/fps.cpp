@@ -437,6 +437,7 @@ void add_fps_commands(CLI::App& app, GlobalOptions&) {
   static FpsOptions o;
   auto* fps = app.add_subcommand("fps", "fiber positioners: discover, status, moves, trajectories, calibration, firmware");
   fps->require_subcommand(1);
+  fps->fallthrough();  // bus options and --json may also follow the subcommand
   fps->add_option("--gateway", o.gateway, "CAN@net NT gateway (or `axon sim fps`) at HOST[:PORT]");
   fps->add_option("--channels", o.channels, "gateway channels, e.g. 1,2,3,4 (default 1)")->delimiter(',')->check(CLI::Range(1, 4));
   fps->add_option("--socketcand", o.socketcand, "socketcand server at HOST[:PORT]");

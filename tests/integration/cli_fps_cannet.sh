@@ -9,7 +9,7 @@ fps() { "$AXON" fps --gateway "127.0.0.1:$SIM_CANNET_PORT" "$@"; }
 fps discover >"$TMP/discover.out" 2>"$TMP/discover.err" || fail "discover exited with $?"
 grep -Eq ': 6 robots: 1 2 3 4 5 6$' "$TMP/discover.out" || fail "discover did not list robots 1-6"
 
-fps --json status >"$TMP/status.out" 2>"$TMP/status.err" || fail "status exited with $?"
+fps status --json >"$TMP/status.out" 2>"$TMP/status.err" || fail "status exited with $?"
 /usr/bin/python3 - "$TMP/status.out" <<'PY' || fail "status --json is not what was expected"
 import json, sys
 j = json.load(open(sys.argv[1]))
