@@ -6,6 +6,7 @@
 #include "can/socketcand_server.hpp"
 #include "can/virtual_bus.hpp"
 #include "commands.hpp"
+#include "demo_fps.hpp"
 #include "run.hpp"
 
 #include <boost/asio/detached.hpp>
@@ -131,6 +132,8 @@ int run_demo() {
     device->close();
     scd->stop();
     gw->stop();
+    const asio::any_io_executor any_ex = ex;
+    co_await demo_fps(any_ex);
     fmt::print("\ndone. Next: `axon can bridge --listen 127.0.0.1:29536` and connect your own tools.\n");
     co_return 0;
   });

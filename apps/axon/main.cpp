@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
     axon::core::init_logging(global.verbosity);
   });
   add_can_commands(app, global);
+  add_sim_commands(app, global);
+  add_fps_commands(app, global);
   add_demo_command(app, global);
   try {
     app.parse(argc, argv);

@@ -35,3 +35,18 @@ start_bridge() {
     esac
   done
 }
+
+# start_sim_fps ARGS...: starts `axon sim fps ARGS` in the background; sets SIM_CANNET_PORT /
+# SIM_SCD_PORT from its "listening" lines (for the servers asked for).
+start_sim_fps() {
+  "$AXON" sim fps "$@" >"$TMP/sim.out" 2>"$TMP/sim.err" &
+  PIDS+=($!)
+  SIM_PID=$!
+  SIM_CANNET_PORT=""; SIM_SCD_PORT=""
+  for arg in "$@"; do
+    case "$arg" in
+      --gateway) SIM_CANNET_PORT=$(wait_for_line "$TMP/sim.out" '^listening cannet ' | sed 's/.*://') ;;
+      --socketcand) SIM_SCD_PORT=$(wait_for_line "$TMP/sim.out" '^listening socketcand ' | sed 's/.*://') ;;
+    esac
+  done
+}

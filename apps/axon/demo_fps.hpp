@@ -1,0 +1,14 @@
+// The fps part of `axon demo`: simulated positioners on a virtual bus driven by the host driver.
+#pragma once
+
+#include <utility>  // before asio/awaitable.hpp, which uses std::exchange without it (Boost 1.74)
+
+#include <boost/asio/any_io_executor.hpp>
+#include <boost/asio/awaitable.hpp>
+
+namespace axon::app {
+
+// Prints what it does to stdout; throws axon::Exception when a step fails.
+boost::asio::awaitable<void> demo_fps(boost::asio::any_io_executor ex);
+
+}  // namespace axon::app

@@ -1,0 +1,534 @@
+// `axon fps ...`: fiber positioners on one or more CAN buses, through the host driver
+// (docs/fps-host.md). Every subcommand opens the buses, discovers the robots, does its job and
+// closes; data goes to stdout (text or --json), progress and logs to stderr.
+#include "can/bus_spec.hpp"
+#include "can/cannet_client.hpp"
+#include "can/open.hpp"
+#include "commands.hpp"
+#include "fps/host/array.hpp"
+#include "fps/protocol/commands.hpp"
+#include "fps/protocol/response.hpp"
+#include "fps/protocol/trajectory.hpp"
+#include "id_list.hpp"
+#include "net/endpoint.hpp"
+#include "run.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cctype>
+#include <charconv>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <memory>
+
+namespace axon::app {
+namespace {
+
+using json = nlohmann::json;
+namespace host = fps::host;
+namespace protocol = fps::protocol;
+
+struct FpsOptions {
+  std::string gateway;
+  std::vector<int> channels{1};
+  std::string socketcand;
+  std::vector<std::string> scd_channels{"can0"};
+  std::vector<std::string> buses;
+  bool json = false;
+  double timeout_s = 1.0;
+};
+
+// What a subcommand does once the robots are known. Returns the exit code.
+using Job = std::function<asio::awaitable<int>(host::Array&, const host::DiscoveryReport&)>;
+
+Error usage(std::string text) { return Error(CoreErrc::invalid_argument, std::move(text)); }
+
+void print_json(const json& j) {
+  std::fputs(j.dump(2).c_str(), stdout);
+  std::fputc('\n', stdout);
+  std::fflush(stdout);
+}
+
+json angles_json(const host::ArmAngles& a) { return json{{"alpha", a.alpha}, {"beta", a.beta}}; }
+
+json row_json(const host::StatusRow& r) {
+  json j{{"id", r.id}, {"bus", r.bus_name}, {"state", r.state()}, {"ready", r.ready()}};
+  j["firmware"] = r.firmware ? json(r.firmware->to_string()) : json(nullptr);
+  if (r.status) {
+    j["status"] = fmt::format("0x{:016x}", r.status->raw());
+    j["flags"] = r.status->names();
+  }
+  if (r.bootloader_status) j["bootloader_status"] = r.bootloader_status->to_string();
+  j["position"] = r.position ? angles_json(*r.position) : json(nullptr);
+  if (!r.error.empty()) j["error"] = r.error;
+  return j;
+}
+
+// Opens the selected buses, discovers, runs `job`, closes everything.
+int with_array(const FpsOptions& o, const Job& job) {
+  const int sources = (o.gateway.empty() ? 0 : 1) + (o.socketcand.empty() ? 0 : 1) + (o.buses.empty() ? 0 : 1);
+  if (sources == 0) throw Exception(usage("select the buses: --gateway HOST:PORT, --socketcand HOST:PORT or --bus SPEC"));
+  return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
+    const asio::any_io_executor ex = io.get_executor();
+    std::vector<std::unique_ptr<can::Bus>> buses;
+    std::shared_ptr<can::CanNetGateway> gateway;
+    const auto timeout = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.timeout_s));
+    if (!o.gateway.empty()) {
+      const net::Endpoint ep = need(net::parse_endpoint(o.gateway, can::kCanNetPort));
+      std::vector<int> channels = o.channels;
+      const can::CanNetOptions cn;
+      auto r = co_await can::CanNetGateway::connect(ex, ep, channels, cn);
+      gateway = need(std::move(r));
+      for (int c : o.channels) buses.push_back(need(gateway->bus(c)));
+    }
+    std::vector<std::string> specs = o.buses;
+    if (!o.socketcand.empty())
+      for (const auto& c : o.scd_channels) specs.push_back(fmt::format("socketcand://{}/{}", o.socketcand, c));
+    for (const auto& text : specs) {
+      const auto spec = need(can::parse_bus_spec(text));
+      auto r = co_await can::open_bus(ex, spec);
+      buses.push_back(need(std::move(r)));
+    }
+    std::vector<can::Bus*> raw;
+    for (auto& b : buses) raw.push_back(b.get());
+    host::ArrayOptions ao;
+    ao.client.timeout = timeout;
+    auto array = std::make_unique<host::Array>(raw, ao);
+    set_on_signal([&] {
+      spdlog::warn("fps: interrupted: stopping every robot");
+      asio::co_spawn(ex, array->emergency_stop("interrupted (Ctrl-C)"), [&](std::exception_ptr) {
+        for (auto& b : buses) b->close();
+      });
+    });
+
+    int rc = 0;
+    std::exception_ptr failure;
+    try {
+      auto r = co_await array->discover();
+      const auto report = need(std::move(r));
+      for (const auto& p : report.problems) spdlog::warn("discover: {}", p);
+      spdlog::debug("discover: {} robots on {} buses", report.table.rows.size(), buses.size());
+      rc = co_await job(*array, report);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    co_await array->close();
+    array.reset();
+    for (auto& b : buses) b->close();
+    if (gateway) gateway->close();
+    if (failure) std::rethrow_exception(failure);
+    co_return rc;
+  });
+}
+
+// The robot's handle, or an error naming the robots that were found.
+host::Positioner* robot(host::Array& array, std::uint16_t id) {
+  if (auto* p = array.find(id)) return p;
+  const auto ids = array.ids();
+  throw Exception(Error(host::HostErrc::unknown_positioner,
+                        fmt::format("robot {} did not answer discovery on any bus (found: {})", id,
+                                    ids.empty() ? std::string("none") : fmt::format("{}", fmt::join(ids, " ")))));
+}
+
+// ---- discover / status / position ---------------------------------------------------------------
+
+asio::awaitable<int> job_discover(const FpsOptions& o, host::Array& array, const host::DiscoveryReport& report) {
+  if (o.json) {
+    json j{{"buses", json::array()}, {"robots", json::array()}, {"problems", report.problems}};
+    for (std::size_t b = 0; b < array.bus_count(); ++b)
+      j["buses"].push_back(json{{"name", array.bus_name(b)}, {"robots", array.ids_on(b)}});
+    for (const auto& r : report.table.rows) j["robots"].push_back(row_json(r));
+    print_json(j);
+  } else {
+    for (std::size_t b = 0; b < array.bus_count(); ++b) {
+      std::string list;
+      for (auto id : array.ids_on(b)) list += fmt::format("{}{}", list.empty() ? "" : " ", id);
+      fmt::print("{}: {} robots: {}\n", array.bus_name(b), array.ids_on(b).size(), list);
+    }
+    for (const auto& r : report.table.rows)
+      fmt::print("  {:>4}  firmware {}\n", r.id, r.firmware ? r.firmware->to_string() : std::string("?"));
+    for (const auto& p : report.problems) fmt::print("problem: {}\n", p);
+    std::fflush(stdout);
+  }
+  co_return array.ids().empty() ? 1 : 0;
+}
+
+asio::awaitable<int> job_status(const FpsOptions& o, host::Array&, const host::DiscoveryReport& report) {
+  const auto& t = report.table;
+  if (o.json) {
+    json j{{"robots", json::array()}, {"ready", t.count_ready()}, {"problems", report.problems}};
+    for (const auto& r : t.rows) j["robots"].push_back(row_json(r));
+    print_json(j);
+  } else {
+    fmt::print("{}", t.to_text());
+    fmt::print("{} robots, {} ready\n", t.rows.size(), t.count_ready());
+    for (const auto& r : t.rows)
+      if (r.status && !r.ready()) fmt::print("  {}: {}\n", r.id, r.status->to_string());
+    std::fflush(stdout);
+  }
+  co_return 0;
+}
+
+asio::awaitable<int> job_position(const FpsOptions& o, const std::vector<std::string>& id_text, host::Array& array,
+                                  const host::DiscoveryReport&) {
+  std::vector<std::uint16_t> ids = id_text.empty() ? array.ids() : need(parse_id_lists(id_text));
+  json j = json::object();
+  for (auto id : ids) {
+    auto* p = robot(array, id);
+    auto r = co_await p->read_position();
+    const auto pos = need(std::move(r));
+    if (o.json) j[std::to_string(id)] = angles_json(pos);
+    else fmt::print("{:>4}  alpha {:9.3f}  beta {:9.3f}\n", id, pos.alpha, pos.beta);
+  }
+  if (o.json) print_json(j);
+  std::fflush(stdout);
+  co_return 0;
+}
+
+// ---- motion -------------------------------------------------------------------------------------
+
+struct GotoArgs {
+  std::uint16_t id = 0;
+  double alpha = 0, beta = 0;
+  bool relative = false;
+};
+
+asio::awaitable<int> job_goto(const FpsOptions& o, const GotoArgs& g, host::Array& array, const host::DiscoveryReport&) {
+  auto* p = robot(array, g.id);
+  const host::ArmAngles value{g.alpha, g.beta};
+  spdlog::info("goto: robot {} {} alpha {} beta {}", g.id, g.relative ? "by" : "to", g.alpha, g.beta);
+  Result<host::MoveResult> r = Error(CoreErrc::invalid_argument);
+  if (g.relative) r = co_await p->goto_relative(value);
+  else r = co_await p->goto_absolute(value);
+  const auto m = need(std::move(r));
+  if (o.json) print_json(json{{"id", g.id}, {"target", angles_json(m.target)}, {"reached", angles_json(m.reached)}});
+  else fmt::print("robot {} at alpha {:.3f} beta {:.3f} (target {:.3f} {:.3f})\n", g.id, m.reached.alpha, m.reached.beta,
+                  m.target.alpha, m.target.beta);
+  std::fflush(stdout);
+  co_return 0;
+}
+
+// {robot_id: {alpha: [[deg, s], ...], beta: [[deg, s], ...]}} in YAML or JSON.
+std::map<std::uint16_t, protocol::Trajectory> load_trajectories(const std::string& file) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file);
+  } catch (const std::exception& e) {
+    throw Exception(usage(fmt::format("{}: {}", file, e.what())));
+  }
+  if (!root.IsMap() || root.size() == 0) throw Exception(usage(fmt::format("{}: expected a map of robot id -> {{alpha, beta}}", file)));
+  std::map<std::uint16_t, protocol::Trajectory> out;
+  for (const auto& kv : root) {
+    const auto key = kv.first.as<std::string>();
+    const auto ids = need(parse_id_list(key));
+    if (ids.size() != 1) throw Exception(usage(fmt::format("{}: key '{}' must be one robot id", file, key)));
+    std::vector<protocol::ArmPoint> arms[2];
+    const char* names[2] = {"alpha", "beta"};
+    for (int a = 0; a < 2; ++a) {
+      const auto list = kv.second[names[a]];
+      if (!list) continue;
+      if (!list.IsSequence()) throw Exception(usage(fmt::format("{}: robot {} {}: expected a list of [deg, s]", file, key, names[a])));
+      for (const auto& pt : list) {
+        if (!pt.IsSequence() || pt.size() != 2)
+          throw Exception(usage(fmt::format("{}: robot {} {}: each point is [deg, s]", file, key, names[a])));
+        try {
+          arms[a].push_back(protocol::ArmPoint{pt[0].as<double>(), pt[1].as<double>()});
+        } catch (const std::exception& e) {
+          throw Exception(usage(fmt::format("{}: robot {} {}: {}", file, key, names[a], e.what())));
+        }
+      }
+    }
+    auto t = protocol::Trajectory::from_physical(arms[0], arms[1]);
+    if (!t) throw Exception(Error(t.error().code, fmt::format("{}: robot {}{}{}", file, key, t.error().detail.empty() ? "" : ": ", t.error().detail)));
+    out.emplace(ids.front(), std::move(t).value());
+  }
+  return out;
+}
+
+asio::awaitable<int> job_move(const FpsOptions& o, const std::map<std::uint16_t, protocol::Trajectory>& trajectories,
+                              bool load_only, host::Array& array, const host::DiscoveryReport&) {
+  host::TrajectoryOptions to;
+  to.start = !load_only;
+  spdlog::info("move: uploading trajectories to {} robots", trajectories.size());
+  auto r = co_await array.run_trajectories(trajectories, to);
+  const auto report = need(std::move(r));
+  if (o.json) {
+    json j{{"started", report.started}, {"completed", report.completed}, {"outcome", report.outcome}, {"robots", json::array()}};
+    for (const auto& run : report.robots) {
+      json rj{{"id", run.id}, {"state", host::to_string(run.state)}, {"detail", run.detail}};
+      if (run.reached) rj["reached"] = angles_json(*run.reached);
+      if (run.target) rj["target"] = angles_json(*run.target);
+      j["robots"].push_back(rj);
+    }
+    print_json(j);
+  } else {
+    fmt::print("{}\n", report.summary());
+    std::fflush(stdout);
+  }
+  co_return report.ok(load_only) ? 0 : 1;
+}
+
+asio::awaitable<int> job_stop(const FpsOptions& o, bool clear, host::Array& array, const host::DiscoveryReport&) {
+  auto r = co_await array.stop_all(clear);
+  need(std::move(r));
+  const std::string what = clear ? "STOP_TRAJECTORY (collision flags cleared)" : "TRAJECTORY_ABORT";
+  if (o.json) print_json(json{{"sent", what}, {"buses", array.bus_count()}});
+  else fmt::print("{} sent on {} buses\n", what, array.bus_count());
+  std::fflush(stdout);
+  co_return 0;
+}
+
+asio::awaitable<int> job_unlock(const FpsOptions& o, host::Array& array, const host::DiscoveryReport&) {
+  auto r = co_await array.unlock();
+  const auto u = need(std::move(r));
+  if (o.json) print_json(json{{"acknowledged", u.acknowledged}, {"silent", u.silent}});
+  else fmt::print("unlocked: {} robots acknowledged, {} silent{}\n", u.acknowledged.size(), u.silent.size(),
+                  u.silent.empty() ? "" : fmt::format(" ({})", fmt::join(u.silent, " ")));
+  std::fflush(stdout);
+  co_return u.silent.empty() ? 0 : 1;
+}
+
+// ---- calibration, datum -------------------------------------------------------------------------
+
+struct CalibrateArgs {
+  std::uint16_t id = 0;
+  bool motor = false, datum = false, cogging = false, save = false;
+};
+
+asio::awaitable<int> job_calibrate(const FpsOptions& o, const CalibrateArgs& c, host::Array& array,
+                                   const host::DiscoveryReport&) {
+  auto* p = robot(array, c.id);
+  host::CalibrationPlan plan;
+  if (c.motor || c.datum || c.cogging || c.save) {
+    plan.motors = c.motor;
+    plan.datums = c.datum;
+    plan.cogging = c.cogging;
+    plan.save = c.save;
+  }
+  spdlog::info("calibrate: robot {}:{}{}{}{} (this takes a while; the robot's arms move)", c.id,
+               plan.motors ? " motors" : "", plan.datums ? " datums" : "", plan.cogging ? " cogging" : "",
+               plan.save ? " save" : "");
+  auto r = co_await p->calibrate(plan);
+  const auto rep = need(std::move(r));
+  json j{{"id", c.id}, {"saved", rep.saved}, {"flags", rep.final_status.names()}};
+  if (rep.motor_error) j["motor_error"] = json{{"alpha", rep.motor_error->alpha}, {"beta", rep.motor_error->beta}};
+  if (rep.datum_error) j["datum_error"] = json{{"alpha", rep.datum_error->alpha}, {"beta", rep.datum_error->beta}};
+  if (o.json) print_json(j);
+  else {
+    fmt::print("robot {} calibrated{}\n", c.id, rep.saved ? " and saved" : "");
+    if (rep.motor_error) fmt::print("  motor calibration error: alpha {} beta {}\n", rep.motor_error->alpha, rep.motor_error->beta);
+    if (rep.datum_error) fmt::print("  datum calibration error: alpha {} beta {}\n", rep.datum_error->alpha, rep.datum_error->beta);
+    std::fflush(stdout);
+  }
+  co_return 0;
+}
+
+asio::awaitable<int> job_datum(const FpsOptions& o, std::uint16_t id, host::Array& array, const host::DiscoveryReport&) {
+  auto* p = robot(array, id);
+  spdlog::info("datum: robot {} drives both arms into their hard stops", id);
+  auto r = co_await p->go_to_datums(host::Arm::both);
+  const auto st = need(std::move(r));
+  auto rp = co_await p->read_position();
+  const auto pos = need(std::move(rp));
+  if (o.json) print_json(json{{"id", id}, {"position", angles_json(pos)}, {"flags", st.names()}});
+  else fmt::print("robot {}: datums initialised, at alpha {:.3f} beta {:.3f}\n", id, pos.alpha, pos.beta);
+  std::fflush(stdout);
+  co_return 0;
+}
+
+// ---- firmware -----------------------------------------------------------------------------------
+
+asio::awaitable<int> job_upgrade(const FpsOptions& o, const std::vector<std::uint8_t>& image,
+                                 const std::vector<std::uint16_t>& ids, host::Array& array, const host::DiscoveryReport&) {
+  host::UpgradeOptions uo;
+  uo.progress = [](const host::UpgradeProgress& p) {
+    spdlog::info("upgrade: robot {}: {}/{} frames", p.positioner, p.chunks_acked, p.chunks_total);
+  };
+  auto r = co_await array.upgrade_firmware(ids, image, uo);
+  const auto rep = need(std::move(r));
+  if (o.json) {
+    json j{{"size", rep.size}, {"crc32", fmt::format("0x{:08x}", rep.crc32)}, {"ok", rep.ok()}, {"robots", json::array()}};
+    for (const auto& x : rep.robots)
+      j["robots"].push_back(json{{"id", x.id}, {"outcome", host::to_string(x.outcome)}, {"reason", x.reason},
+                                 {"chunks_acked", x.chunks_acked}, {"chunks_total", x.chunks_total},
+                                 {"half_written", x.half_written}});
+    print_json(j);
+  } else {
+    fmt::print("{}\n", rep.summary());
+    std::fflush(stdout);
+  }
+  co_return rep.ok() ? 0 : 1;
+}
+
+// ---- raw ----------------------------------------------------------------------------------------
+
+protocol::CommandId parse_command(const std::string& text) {
+  unsigned n = 0;
+  const auto* end = text.data() + text.size();
+  auto [p, ec] = std::from_chars(text.data(), end, n);
+  if (ec == std::errc() && p == end) {
+    if (n > 255) throw Exception(usage(fmt::format("command {}: expected 0..255", text)));
+    const auto name = protocol::command_name(static_cast<std::uint8_t>(n));
+    const auto* info = protocol::find_command(name);
+    if (!info) throw Exception(usage(fmt::format("command {} is not in either command table", n)));
+    return info->id;
+  }
+  std::string upper = text;
+  for (auto& ch : upper) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  const auto* info = protocol::find_command(upper);
+  if (!info) throw Exception(usage(fmt::format("unknown command name '{}'", text)));
+  return info->id;
+}
+
+std::vector<std::uint8_t> parse_hex(std::string text) {
+  std::string digits;
+  for (char ch : text)
+    if (ch != '.' && ch != ' ' && ch != ':') digits += ch;
+  if (digits.size() % 2 != 0) throw Exception(usage("hex data needs an even number of digits"));
+  std::vector<std::uint8_t> out;
+  for (std::size_t i = 0; i < digits.size(); i += 2) {
+    unsigned v = 0;
+    auto [p, ec] = std::from_chars(digits.data() + i, digits.data() + i + 2, v, 16);
+    if (ec != std::errc() || p != digits.data() + i + 2) throw Exception(usage(fmt::format("bad hex data '{}'", text)));
+    out.push_back(static_cast<std::uint8_t>(v));
+  }
+  return out;
+}
+
+std::string hex(std::span<const std::uint8_t> bytes) {
+  std::string s;
+  for (auto b : bytes) s += fmt::format("{:02X}", b);
+  return s;
+}
+
+struct RawArgs {
+  std::uint16_t id = 0;
+  std::string command;
+  std::string data;
+};
+
+asio::awaitable<int> job_raw(const FpsOptions& o, const RawArgs& a, host::Array& array, const host::DiscoveryReport&) {
+  const auto cmd = parse_command(a.command);
+  const auto bytes = parse_hex(a.data);
+  const auto payload = need(protocol::Payload::from(bytes));
+  robot(array, a.id);
+  const auto bus = need(array.bus_of(a.id));
+  auto r = co_await array.client(bus).request(a.id, cmd, payload);
+  const auto reply = need(std::move(r));
+  const std::string name(protocol::command_name(cmd));
+  if (o.json)
+    print_json(json{{"id", reply.positioner}, {"command", reply.command}, {"name", name},
+                    {"code", protocol::response_name(reply.code)}, {"data", hex(reply.payload.span())}});
+  else
+    fmt::print("robot {} {} ({}): {} data {}\n", reply.positioner, name, reply.command, protocol::response_name(reply.code),
+               reply.payload.span().empty() ? "-" : hex(reply.payload.span()));
+  std::fflush(stdout);
+  co_return 0;
+}
+
+}  // namespace
+
+void add_fps_commands(CLI::App& app, GlobalOptions&) {
+  static FpsOptions o;
+  auto* fps = app.add_subcommand("fps", "fiber positioners: discover, status, moves, trajectories, calibration, firmware");
+  fps->require_subcommand(1);
+  fps->fallthrough();  // bus options and --json may also follow the subcommand
+  fps->add_option("--gateway", o.gateway, "CAN@net NT gateway (or `axon sim fps`) at HOST[:PORT]");
+  fps->add_option("--channels", o.channels, "gateway channels, e.g. 1,2,3,4 (default 1)")->delimiter(',')->check(CLI::Range(1, 4));
+  fps->add_option("--socketcand", o.socketcand, "socketcand server at HOST[:PORT]");
+  fps->add_option("--channel", o.scd_channels, "socketcand channel (repeatable; default can0)");
+  fps->add_option("--bus", o.buses, "any bus spec (repeatable): cannet://HOST/N, socketcand://HOST/CH, socketcan:IF");
+  fps->add_flag("--json", o.json, "machine-readable output");
+  fps->add_option("--timeout", o.timeout_s, "seconds to wait for each reply (default 1)");
+
+  fps->add_subcommand("discover", "robots per bus and their firmware")->callback([] {
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_discover(o, a, r); });
+  });
+  fps->add_subcommand("status", "status table: state, flags, position")->callback([] {
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_status(o, a, r); });
+  });
+
+  static std::vector<std::string> position_ids;
+  auto* pos = fps->add_subcommand("position", "arm angles of the listed robots (default all)");
+  pos->add_option("ids", position_ids, "robot ids: 3, 1-6, 1,4,9");
+  pos->callback([] {
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_position(o, position_ids, a, r); });
+  });
+
+  static GotoArgs go;
+  auto* g = fps->add_subcommand("goto", "move one robot's arms (degrees) and wait");
+  g->add_option("id", go.id, "robot id")->required()->check(CLI::Range(1, 2047));
+  g->add_option("alpha", go.alpha, "alpha angle, degrees")->required();
+  g->add_option("beta", go.beta, "beta angle, degrees")->required();
+  g->add_flag("--relative", go.relative, "move by ALPHA and BETA instead of to them");
+  g->callback([] {
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_goto(o, go, a, r); });
+  });
+
+  static std::string trajectory_file;
+  static bool load_only = false;
+  auto* m = fps->add_subcommand("move", "run trajectories from a file on several robots at once");
+  m->add_option("-t,--trajectory", trajectory_file, "YAML/JSON: {ID: {alpha: [[deg, s], ...], beta: [...]}}")->required();
+  m->add_flag("--load-only", load_only, "upload and validate, do not start");
+  m->callback([] {
+    const auto trajectories = load_trajectories(trajectory_file);
+    exit_code() = with_array(o, [&](host::Array& a, const host::DiscoveryReport& r) { return job_move(o, trajectories, load_only, a, r); });
+  });
+
+  static bool clear_flags = false;
+  auto* s = fps->add_subcommand("stop", "stop every robot on every bus (TRAJECTORY_ABORT broadcast)");
+  s->add_flag("--clear-flags", clear_flags, "send STOP_TRAJECTORY instead, which also clears collision flags");
+  s->callback([] {
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_stop(o, clear_flags, a, r); });
+  });
+  fps->add_subcommand("unlock", "clear collision flags on every bus (STOP_TRAJECTORY) and report who answered")->callback([] {
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_unlock(o, a, r); });
+  });
+
+  static CalibrateArgs cal;
+  auto* c = fps->add_subcommand("calibrate", "calibration sequence (default: motors, datums, save)");
+  c->add_option("id", cal.id, "robot id")->required()->check(CLI::Range(1, 2047));
+  c->add_flag("--motor", cal.motor, "calibrate the motors");
+  c->add_flag("--datum", cal.datum, "calibrate the datums");
+  c->add_flag("--cogging", cal.cogging, "calibrate cogging (long: up to 40 min)");
+  c->add_flag("--save", cal.save, "save the calibration to flash");
+  c->callback([] {
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_calibrate(o, cal, a, r); });
+  });
+
+  static std::uint16_t datum_id = 0;
+  auto* d = fps->add_subcommand("datum", "datum search: both arms into their hard stops");
+  d->add_option("id", datum_id, "robot id")->required()->check(CLI::Range(1, 2047));
+  d->callback([] {
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_datum(o, datum_id, a, r); });
+  });
+
+  static std::string firmware_file;
+  static std::vector<std::string> upgrade_ids;
+  auto* u = fps->add_subcommand("upgrade", "firmware upgrade of robots running their bootloader");
+  u->add_option("--firmware", firmware_file, "firmware image file")->required()->check(CLI::ExistingFile);
+  u->add_option("ids", upgrade_ids, "robot ids: 3, 1-6, 1,4,9")->required();
+  u->callback([] {
+    const auto ids = need(parse_id_lists(upgrade_ids));
+    std::ifstream in(firmware_file, std::ios::binary);
+    const std::vector<std::uint8_t> image((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in.good() && !in.eof()) throw Exception(usage(fmt::format("cannot read {}", firmware_file)));
+    exit_code() = with_array(o, [&](host::Array& a, const host::DiscoveryReport& r) { return job_upgrade(o, image, ids, a, r); });
+  });
+
+  static RawArgs raw;
+  auto* rw = fps->add_subcommand("raw", "send one command and print the reply");
+  rw->add_option("id", raw.id, "robot id")->required()->check(CLI::Range(1, 2047));
+  rw->add_option("command", raw.command, "command number or name (GET_STATUS, 3, ...)")->required();
+  rw->add_option("data", raw.data, "payload in hex, e.g. 0000803F");
+  rw->callback([] {
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_raw(o, raw, a, r); });
+  });
+}
+
+}  // namespace axon::app

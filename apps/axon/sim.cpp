@@ -1,0 +1,142 @@
+// `axon sim fps`: simulated fiber positioners served on virtual buses in this process, exposed as a
+// CAN@net gateway emulator and/or a socketcand server so that other processes (axon fps, python-can,
+// the host software in service) can drive them.
+#include "can/bus_spec.hpp"
+#include "can/cannet_server.hpp"
+#include "can/socketcand_server.hpp"
+#include "can/virtual_bus.hpp"
+#include "commands.hpp"
+#include "core/config.hpp"
+#include "fps/sim/simulator_config.hpp"
+#include "id_list.hpp"
+#include "net/endpoint.hpp"
+#include "run.hpp"
+
+#include <boost/asio/redirect_error.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/use_awaitable.hpp>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+
+namespace axon::app {
+namespace {
+
+namespace sim = fps::sim;
+
+struct SimFpsOptions {
+  std::string robots = "1-20";
+  std::string config;
+  std::string gateway;
+  std::string socketcand;
+  unsigned buses = 1;
+  double time_scale = 1.0;
+  double duration_s = 0;
+};
+
+// The simulator configuration the options describe: a file, or a hexagonal grid of the listed ids
+// spread over can0..canN-1 in consecutive blocks (like daisy chains).
+sim::SimulatorConfig build_config(const SimFpsOptions& o) {
+  if (!o.config.empty()) {
+    const auto node = need(core::ConfigNode::load_file(o.config));
+    auto config = need(sim::SimulatorConfig::from_config(node));
+    if (o.time_scale != 1.0) config.options.time_scale = o.time_scale;
+    return config;
+  }
+  const auto ids = need(parse_id_list(o.robots));
+  std::vector<std::string> channels;
+  for (unsigned i = 0; i < o.buses; ++i) channels.push_back(fmt::format("can{}", i));
+  auto config = need(sim::SimulatorConfig::grid(ids.size(), channels));
+  for (std::size_t i = 0; i < ids.size(); ++i) config.robots[i].config.id = ids[i];
+  config.options.time_scale = o.time_scale;
+  return config;
+}
+
+int run_sim_fps(const SimFpsOptions& o) {
+  if (o.gateway.empty() && o.socketcand.empty())
+    throw Exception(Error(CoreErrc::invalid_argument, "give --gateway HOST:PORT and/or --socketcand HOST:PORT"));
+  if (o.time_scale <= 0) throw Exception(Error(CoreErrc::invalid_argument, "--time-scale must be positive"));
+  const auto config = build_config(o);
+  return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
+    const asio::any_io_executor ex = io.get_executor();
+    can::VirtualBusRegistry registry(ex);
+    // Channels in the order robots name them (can0, can1, ... for generated robots).
+    std::vector<std::string> channels;
+    for (const auto& r : config.robots)
+      if (std::find(channels.begin(), channels.end(), r.channel) == channels.end()) channels.push_back(r.channel);
+    std::sort(channels.begin(), channels.end());
+    for (const auto& c : channels) need(registry.add(c));
+    auto simulator = need(sim::make_simulator(ex, config, registry));
+
+    std::unique_ptr<can::CanNetGatewayEmulator> gateway;
+    std::unique_ptr<can::SocketcandServer> scd;
+    if (!o.gateway.empty()) {
+      const auto ep = need(net::parse_endpoint(o.gateway, can::kCanNetPort));
+      if (channels.size() > 4) spdlog::warn("sim: a CAN@net NT 420 has 4 channels; serving the first 4 of {}", channels.size());
+      std::vector<std::string> served(channels.begin(), channels.begin() + std::min<std::size_t>(4, channels.size()));
+      can::CanNetEmulatorOptions eo;
+      eo.bind_address = ep.host;
+      eo.port = ep.port;
+      gateway = std::make_unique<can::CanNetGatewayEmulator>(ex, registry, served, eo);
+      need(gateway->start());
+      std::printf("listening cannet %s\n", gateway->local_endpoint().to_string().c_str());
+    }
+    if (!o.socketcand.empty()) {
+      const auto ep = need(net::parse_endpoint(o.socketcand, can::kSocketcandPort));
+      scd = need(can::SocketcandServer::create(ex, registry, ep));
+      std::printf("listening socketcand %s\n", scd->local_endpoint().to_string().c_str());
+    }
+    std::fflush(stdout);
+    std::string where;
+    for (std::size_t i = 0; i < channels.size(); ++i) {
+      std::size_t n = 0;
+      for (const auto& r : config.robots) n += r.channel == channels[i] ? 1 : 0;
+      where += fmt::format("{}{} ({} robots{})", where.empty() ? "" : ", ", channels[i], n,
+                           gateway && i < 4 ? fmt::format(", cannet channel {}", i + 1) : "");
+    }
+    spdlog::info("sim: {} positioners at time scale {} on {} (Ctrl-C to stop)", simulator->size(),
+                 config.options.time_scale, where);
+
+    asio::steady_timer until(io, o.duration_s > 0 ? std::chrono::steady_clock::now() +
+                                                         std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.duration_s))
+                                                   : core::TimePoint::max());
+    set_on_signal([&] { until.cancel(); });
+    boost::system::error_code ec;
+    co_await until.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+
+    if (scd) scd->stop();
+    if (gateway) gateway->stop();
+    const auto& s = simulator->stats();
+    spdlog::info("sim: {} frames processed, {} sent ({} unsolicited), {} receive overflows, {} collisions "
+                 "({} neighbour, {} obstacle), {} send errors",
+                 s.frames_processed, s.frames_sent, s.unsolicited, simulator->receive_overflows(),
+                 s.neighbour_collisions + s.obstacle_collisions, s.neighbour_collisions, s.obstacle_collisions,
+                 s.send_errors);
+    simulator->stop();
+    co_return 0;
+  });
+}
+
+}  // namespace
+
+void add_sim_commands(CLI::App& app, GlobalOptions&) {
+  auto* sim_cmd = app.add_subcommand("sim", "device simulators served over CAN@net / socketcand");
+  sim_cmd->require_subcommand(1);
+  static SimFpsOptions fps;
+  auto* f = sim_cmd->add_subcommand("fps", "simulated fiber positioners (calibrated, datums initialised, folded)");
+  f->add_option("--robots", fps.robots, "robot ids: ranges and lists, e.g. 1-20 or 1,3,10-12 (default 1-20)");
+  f->add_option("--config", fps.config, "simulator YAML (docs/fps-simulator.md) instead of --robots/--buses");
+  f->add_option("--gateway", fps.gateway, "serve a CAN@net NT emulator on HOST:PORT (port 0: any)");
+  f->add_option("--socketcand", fps.socketcand, "serve socketcand on HOST:PORT (channels can0..canN-1)");
+  f->add_option("--buses", fps.buses, "spread the robots over this many buses (CAN@net channels 1..N)")
+      ->check(CLI::Range(1u, 24u));
+  f->add_option("--time-scale", fps.time_scale, "simulated seconds per real second (default 1)");
+  f->add_option("--duration", fps.duration_s, "stop after this many seconds (default: until Ctrl-C)");
+  f->get_option("--config")->excludes("--robots")->excludes("--buses");
+  f->callback([] { exit_code() = run_sim_fps(fps); });
+}
+
+}  // namespace axon::app
