@@ -30,23 +30,24 @@ test: release
 bench: release
 	@bash bench/run-all.sh build/release
 
+# The sanitizer builds compile only the unit tests (and the libraries they use).
 asan: deps
 	@cmake --preset asan $(CMAKE_EXTRA) >/dev/null
-	@cmake --build --preset asan -j $(JOBS)
+	@cmake --build --preset asan -j $(JOBS) --target axon_unit_tests_all
 
 test-asan: asan
 	ctest --preset asan -j $(JOBS) -L unit
 
 tsan: deps
 	@cmake --preset tsan $(CMAKE_EXTRA) >/dev/null
-	@cmake --build --preset tsan -j $(JOBS)
+	@cmake --build --preset tsan -j $(JOBS) --target axon_unit_tests_all
 
 test-tsan: tsan
 	ctest --preset tsan -j $(JOBS) -L unit
 
 fuzz: deps
 	@cmake --preset fuzz $(CMAKE_EXTRA) >/dev/null
-	@cmake --build --preset fuzz -j $(JOBS)
+	@cmake --build --preset fuzz -j $(JOBS) --target axon_fuzz_all
 
 # A short run of every fuzz target (CI); FUZZ_SECONDS per target.
 FUZZ_SECONDS ?= 10
