@@ -5,6 +5,7 @@
 #include "can/cannet_client.hpp"
 #include "can/open.hpp"
 #include "commands.hpp"
+#include "core/config.hpp"
 #include "fps/host/array.hpp"
 #include "fps/protocol/commands.hpp"
 #include "fps/protocol/response.hpp"
@@ -18,6 +19,8 @@
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
+
+#include <unistd.h>
 
 #include <cctype>
 #include <charconv>
@@ -33,15 +36,71 @@ using json = nlohmann::json;
 namespace host = fps::host;
 namespace protocol = fps::protocol;
 
+// Empty lists and a negative timeout mean "not given": the --config file or the defaults fill them.
 struct FpsOptions {
+  std::string config;
   std::string gateway;
-  std::vector<int> channels{1};
+  std::vector<int> channels;
   std::string socketcand;
-  std::vector<std::string> scd_channels{"can0"};
+  std::vector<std::string> scd_channels;
   std::vector<std::string> buses;
   bool json = false;
-  double timeout_s = 1.0;
+  bool no_color = false;
+  double timeout_s = -1;
 };
+
+// The bus selection of a --config file: fills what the command line left out (the command line
+// wins). Unknown keys and bad values are errors located by file:line.
+Result<void> apply_config_file(FpsOptions& o) {
+  AXON_TRY(root, core::ConfigNode::load_file(o.config));
+  if (!root.is_map()) return root.error(CoreErrc::config_bad_value, "expected a map of bus options");
+  AXON_TRY(root.reject_unknown({"gateway", "channels", "socketcand", "channel", "buses", "timeout_ms"}));
+  if (root.has("gateway")) {
+    AXON_TRY(v, root.get<std::string>("gateway"));
+    if (o.gateway.empty()) o.gateway = v;
+  }
+  if (root.has("socketcand")) {
+    AXON_TRY(v, root.get<std::string>("socketcand"));
+    if (o.socketcand.empty()) o.socketcand = v;
+  }
+  if (root.has("channels")) {
+    AXON_TRY(node, root.child("channels"));
+    AXON_TRY(items, node.items());
+    std::vector<int> v;
+    for (const auto& item : items) {
+      AXON_TRY(c, item.as<int>());
+      if (c < 1 || c > 4) return item.error(CoreErrc::config_bad_value, "a gateway channel is 1..4");
+      v.push_back(c);
+    }
+    if (o.channels.empty()) o.channels = v;
+  }
+  for (const char* key : {"channel", "buses"}) {
+    if (!root.has(key)) continue;
+    AXON_TRY(node, root.child(key));
+    AXON_TRY(items, node.items());
+    std::vector<std::string> v;
+    for (const auto& item : items) {
+      AXON_TRY(text, item.as<std::string>());
+      v.push_back(text);
+    }
+    auto& target = std::string_view(key) == "channel" ? o.scd_channels : o.buses;
+    if (target.empty()) target = v;
+  }
+  if (root.has("timeout_ms")) {
+    AXON_TRY(ms, root.get_in<int>("timeout_ms", 1, 600000));
+    if (o.timeout_s < 0) o.timeout_s = ms / 1000.0;
+  }
+  return ok();
+}
+
+// The options with the --config file and the defaults applied.
+FpsOptions resolved(FpsOptions o) {
+  if (!o.config.empty()) need(apply_config_file(o));
+  if (o.channels.empty()) o.channels = {1};
+  if (o.scd_channels.empty()) o.scd_channels = {"can0"};
+  if (o.timeout_s < 0) o.timeout_s = 1.0;
+  return o;
+}
 
 // What a subcommand does once the robots are known. Returns the exit code.
 using Job = std::function<asio::awaitable<int>(host::Array&, const host::DiscoveryReport&)>;
@@ -70,7 +129,8 @@ json row_json(const host::StatusRow& r) {
 }
 
 // Opens the selected buses, discovers, runs `job`, closes everything.
-int with_array(const FpsOptions& o, const Job& job) {
+int with_array(const FpsOptions& given, const Job& job) {
+  const FpsOptions o = resolved(given);
   const int sources = (o.gateway.empty() ? 0 : 1) + (o.socketcand.empty() ? 0 : 1) + (o.buses.empty() ? 0 : 1);
   if (sources == 0) throw Exception(usage("select the buses: --gateway HOST:PORT, --socketcand HOST:PORT or --bus SPEC"));
   return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
@@ -158,6 +218,30 @@ asio::awaitable<int> job_discover(const FpsOptions& o, host::Array& array, const
   co_return array.ids().empty() ? 1 : 0;
 }
 
+// The status table with each robot's line coloured by its state (ANSI): ready green, moving or
+// calibrating yellow, anything else (collision, no datum, no reply, bootloader) red.
+std::string colored(const host::StatusTable& t) {
+  const std::string text = t.to_text();
+  std::string out;
+  std::size_t pos = 0;
+  for (std::size_t line = 0; pos < text.size(); ++line) {
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    const std::string_view l(text.data() + pos, end - pos);
+    const char* code = nullptr;
+    if (line > 0 && line - 1 < t.rows.size()) {
+      const auto state = t.rows[line - 1].state();
+      code = state == "ready" ? "32" : (state == "moving" || state == "calibrating") ? "33" : "31";
+    }
+    if (code) {
+      out += fmt::format("\x1b[{}m{}\x1b[0m\n", code, l);
+    } else {
+      out += fmt::format("{}\n", l);
+    }
+    pos = end + 1;
+  }
+  return out;
+}
+
 asio::awaitable<int> job_status(const FpsOptions& o, host::Array&, const host::DiscoveryReport& report) {
   const auto& t = report.table;
   if (o.json) {
@@ -165,7 +249,8 @@ asio::awaitable<int> job_status(const FpsOptions& o, host::Array&, const host::D
     for (const auto& r : t.rows) j["robots"].push_back(row_json(r));
     print_json(j);
   } else {
-    fmt::print("{}", t.to_text());
+    const bool color = !o.no_color && ::isatty(STDOUT_FILENO) != 0;
+    fmt::print("{}", color ? colored(t) : t.to_text());
     fmt::print("{} robots, {} ready\n", t.rows.size(), t.count_ready());
     for (const auto& r : t.rows)
       if (r.status && !r.ready()) fmt::print("  {}: {}\n", r.id, r.status->to_string());
@@ -438,12 +523,15 @@ void add_fps_commands(CLI::App& app, GlobalOptions&) {
   auto* fps = app.add_subcommand("fps", "fiber positioners: discover, status, moves, trajectories, calibration, firmware");
   fps->require_subcommand(1);
   fps->fallthrough();  // bus options and --json may also follow the subcommand
+  fps->add_option("--config", o.config, "YAML bus selection: gateway, channels, socketcand, channel, buses, timeout_ms")
+      ->check(CLI::ExistingFile);
   fps->add_option("--gateway", o.gateway, "CAN@net NT gateway (or `axon sim fps`) at HOST[:PORT]");
   fps->add_option("--channels", o.channels, "gateway channels, e.g. 1,2,3,4 (default 1)")->delimiter(',')->check(CLI::Range(1, 4));
   fps->add_option("--socketcand", o.socketcand, "socketcand server at HOST[:PORT]");
   fps->add_option("--channel", o.scd_channels, "socketcand channel (repeatable; default can0)");
   fps->add_option("--bus", o.buses, "any bus spec (repeatable): cannet://HOST/N, socketcand://HOST/CH, socketcan:IF");
   fps->add_flag("--json", o.json, "machine-readable output");
+  fps->add_flag("--no-color", o.no_color, "no colours in the status table (colours only on a terminal anyway)");
   fps->add_option("--timeout", o.timeout_s, "seconds to wait for each reply (default 1)");
 
   fps->add_subcommand("discover", "robots per bus and their firmware")->callback([] {
