@@ -125,7 +125,8 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
   const bool lock_now = lock_.locked;
   if (!failed.empty() || lock_now) {
     rep.outcome = lock_now ? fmt::format("not started: the array is locked ({})", lock_.reason)
-                           : fmt::format("not started: positioners {} failed validation", fmt::join(failed, ", "));
+                           : fmt::format("not started: positioners {} failed validation or upload (see each robot)",
+                                         fmt::join(failed, ", "));
     // Drop the trajectories that did load, so that nothing (a stray sync pulse) can start them.
     auto results = co_await broadcast_on(involved, CommandId::trajectory_abort);
     (void)results;

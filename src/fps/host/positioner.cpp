@@ -72,8 +72,11 @@ std::string UploadResult::describe() const {
   if (ok()) return fmt::format("loaded ({} points)", points_accepted);
   const std::string why = error ? error->message() : std::string("no reason recorded");
   if (stage == Stage::points && arm && point) {
-    return fmt::format("{} point {} refused ({} points accepted before it): {}", to_string(*arm), *point,
-                       points_accepted, why);
+    // A response code means the robot said no; anything else (timeout, lost bus) means the point
+    // was never confirmed either way.
+    const bool refused = error && error->code.category() == protocol::response_category();
+    return fmt::format("{} point {} {} ({} points accepted before it): {}", to_string(*arm), *point,
+                       refused ? "refused" : "not confirmed", points_accepted, why);
   }
   return fmt::format("{} failed: {}", to_string(stage), why);
 }
