@@ -34,8 +34,7 @@ std::pair<int, std::string> run_command(const std::string& command) {
 TEST(SocketcandPython, PythonCanClientsExchangeFramesThroughTheServer) {
   if (!std::filesystem::exists(kPython) || run_command(std::string(kPython) + " -c 'import can'").first != 0)
     GTEST_SKIP() << "python3-can is not installed";
-  const auto script =
-      std::filesystem::path(__FILE__).parent_path().parent_path() / "integration" / "python_can_socketcand.py";
+  const auto script = std::filesystem::path(AXON_TESTS_DIR) / "integration" / "python_can_socketcand.py";
   ASSERT_TRUE(std::filesystem::exists(script)) << script;
 
   asio::io_context io;
