@@ -1,5 +1,7 @@
 #include "fps/protocol/bootloader_status.hpp"
 
+#include "fps/protocol/names.hpp"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -16,28 +18,13 @@ std::string_view bootloader_bit_name(BootloaderBit b) noexcept {
 
 std::optional<BootloaderBit> bootloader_bit_from_name(std::string_view name) noexcept {
   for (const auto& i : kBootloaderBits) {
-    if (i.name.size() != name.size()) continue;
-    bool same = true;
-    for (std::size_t k = 0; k < name.size() && same; ++k) {
-      same = std::toupper(static_cast<unsigned char>(name[k])) == static_cast<unsigned char>(i.name[k]);
-    }
-    if (same) return i.bit;
+    if (iequals(i.name, name)) return i.bit;
   }
   return std::nullopt;
 }
 
 std::vector<std::string> BootloaderStatus::names() const {
-  std::vector<std::string> out;
-  for (unsigned bit = 0; bit < 32; ++bit) {
-    if ((raw_ & (std::uint32_t{1} << bit)) == 0) continue;
-    const auto b = static_cast<BootloaderBit>(bit);
-    if ((kKnownMask & mask(b)) != 0) {
-      out.emplace_back(bootloader_bit_name(b));
-    } else {
-      out.push_back(fmt::format("BIT_{}", bit));
-    }
-  }
-  return out;
+  return set_bit_names<BootloaderBit>(raw_, kKnownMask, bootloader_bit_name);
 }
 
 std::string BootloaderStatus::to_string() const { return fmt::format("{}", fmt::join(names(), "|")); }

@@ -1,6 +1,7 @@
 #include "fps/protocol/commands.hpp"
 
 #include "fps/protocol/error.hpp"
+#include "fps/protocol/names.hpp"
 
 #include <fmt/format.h>
 
@@ -34,16 +35,6 @@ constexpr bool layouts_consistent() {
 }
 static_assert(layouts_consistent(), "every fixed layout's fields must add up to its size");
 
-constexpr bool eq_nocase(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const auto x = static_cast<unsigned char>(a[i]);
-    const auto y = static_cast<unsigned char>(b[i]);
-    if (std::toupper(x) != std::toupper(y)) return false;
-  }
-  return true;
-}
-
 }  // namespace
 
 Result<const CommandInfo*> lookup_command(std::uint8_t number) {
@@ -53,7 +44,7 @@ Result<const CommandInfo*> lookup_command(std::uint8_t number) {
 
 const CommandInfo* find_command(std::string_view name) noexcept {
   for (const auto& c : kCommands) {
-    if (eq_nocase(c.name, name)) return &c;
+    if (iequals(c.name, name)) return &c;
   }
   return nullptr;
 }

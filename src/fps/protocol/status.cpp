@@ -1,6 +1,7 @@
 #include "fps/protocol/status.hpp"
 
 #include "fps/protocol/error.hpp"
+#include "fps/protocol/names.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -10,16 +11,6 @@
 namespace axon::fps::protocol {
 
 
-namespace {
-bool eq_nocase(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (std::toupper(static_cast<unsigned char>(a[i])) != std::toupper(static_cast<unsigned char>(b[i]))) return false;
-  }
-  return true;
-}
-}  // namespace
-
 std::string_view status_bit_name(StatusBit b) noexcept {
   for (const auto& i : kStatusBits) {
     if (i.bit == b) return i.name;
@@ -28,25 +19,15 @@ std::string_view status_bit_name(StatusBit b) noexcept {
 }
 
 std::optional<StatusBit> status_bit_from_name(std::string_view name) noexcept {
-  if (eq_nocase(name, "SYSTEM_INITIALIZED")) return StatusBit::system_initialized;
+  if (iequals(name, "SYSTEM_INITIALIZED")) return StatusBit::system_initialized;
   for (const auto& i : kStatusBits) {
-    if (eq_nocase(i.name, name)) return i.bit;
+    if (iequals(i.name, name)) return i.bit;
   }
   return std::nullopt;
 }
 
 std::vector<std::string> PositionerStatus::names() const {
-  std::vector<std::string> out;
-  for (unsigned bit = 0; bit < 64; ++bit) {
-    if ((raw_ & (std::uint64_t{1} << bit)) == 0) continue;
-    const auto b = static_cast<StatusBit>(bit);
-    if ((kKnownMask & mask(b)) != 0) {
-      out.emplace_back(status_bit_name(b));
-    } else {
-      out.push_back(fmt::format("BIT_{}", bit));
-    }
-  }
-  return out;
+  return set_bit_names<StatusBit>(raw_, kKnownMask, status_bit_name);
 }
 
 std::string PositionerStatus::to_string() const { return fmt::format("{}", fmt::join(names(), "|")); }
