@@ -229,3 +229,15 @@ TEST(C4gPacket, FieldNamesForPrinting) {
   EXPECT_NE(s.find("NUM=4660"), std::string::npos);
   EXPECT_NE(s.find("[1] SM=1"), std::string::npos);
 }
+
+TEST(C4gPacket, RealTimeEntryPointsAreNoexceptAndWorkOnCallerStorage) {
+  Packet p = sample(6);
+  std::array<std::byte, kMaxPacketSize> buf{};
+  static_assert(noexcept(encode_packet(p, std::span<std::byte>(buf))));
+  static_assert(noexcept(decode_packet(std::span<const std::byte>(buf), p)));
+  static_assert(noexcept(decode_packet(std::span<const std::byte>(buf), p, 6)));
+  ASSERT_TRUE(encode_packet(p, buf).ok());
+  Packet out;
+  ASSERT_TRUE(decode_packet(std::span<const std::byte>(buf.data(), packet_size(6)), out, 6).ok());
+  EXPECT_EQ(out, p);
+}
