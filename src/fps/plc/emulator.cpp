@@ -59,7 +59,9 @@ class PlcEmulator::Impl {
 
 Result<void> PlcEmulator::Impl::open() {
   AXON_TRY(options.map.validate());
-  for (const auto& name : options.script.sensors()) AXON_TRY(input(name));
+  for (const auto& name : options.script.sensors()) {
+    AXON_TRY(input(name));
+  }
   std::string host = options.bind_address == "localhost" ? "127.0.0.1" : options.bind_address;
   in_addr probe{};
   if (inet_pton(AF_INET, host.c_str(), &probe) != 1)
@@ -269,7 +271,9 @@ Result<std::optional<double>> PlcEmulator::sensor(std::string_view name) const {
 }
 
 Result<void> PlcEmulator::set_script(SensorScript script) {
-  for (const auto& name : script.sensors()) AXON_TRY(impl_->input(name));
+  for (const auto& name : script.sensors()) {
+    AXON_TRY(impl_->input(name));
+  }
   std::lock_guard lock(impl_->mu);
   impl_->options.script = std::move(script);
   impl_->started = std::chrono::steady_clock::now();
