@@ -20,14 +20,15 @@ bool is_modbus_exception(int err) { return err > MODBUS_ENOBASE && err < EMBXGTA
 }  // namespace
 
 std::string PlcStatus::to_text() const {
-  std::string s;
-  auto onoff = [](bool b) { return b ? "on " : "off"; };
-  s += "sextant            1   2   3   4   5   6\n";
-  s += "positioner power ";
-  for (bool b : positioner_power) s += fmt::format(" {}", onoff(b));
-  s += "\ngateway power    ";
-  for (bool b : gateway_power) s += fmt::format(" {}", onoff(b));
-  s += fmt::format("\nsync line         {}\n", sync_line ? "high" : "low");
+  std::string s = fmt::format("{:<16}", "sextant");
+  for (int k = 1; k <= kSextants; ++k) s += fmt::format(" {:>3}", k);
+  auto row = [&](const char* label, const std::array<bool, kSextants>& v) {
+    s += fmt::format("\n{:<16}", label);
+    for (bool b : v) s += fmt::format(" {:>3}", b ? "on" : "off");
+  };
+  row("positioner power", positioner_power);
+  row("gateway power", gateway_power);
+  s += fmt::format("\n{:<16} {}\n", "sync line", sync_line ? "high" : "low");
   auto line = [](const SensorReading& r) {
     return fmt::format("{:<20} {}\n", r.name, r.value ? fmt::format("{:.2f} {}", *r.value, r.unit) : std::string("FAULT"));
   };
