@@ -85,25 +85,30 @@ void FocalPlane::compute_neighbours() {
   const auto& opt = spec_.neighbours;
   neighbours_.assign(robots.size(), {});
   for (std::size_t i = 0; i < robots.size(); ++i) {
-    std::vector<std::pair<double, std::uint16_t>> near;
-    std::vector<std::pair<double, int>> fids;
+    // Distances quantised to 10 um so that equal distances on the grid sort by id, however the
+    // positions were rounded when written.
+    std::vector<std::pair<long long, std::uint16_t>> near;
+    std::vector<std::pair<long long, int>> fids;
+    auto key = [](double d) { return std::llround(d * 100.0); };
     for (std::size_t j = 0; j < robots.size(); ++j) {
       if (i == j) continue;
       const double d = distance(robots[i].x_mm, robots[i].y_mm, robots[j].x_mm, robots[j].y_mm);
-      if (d <= opt.robot_radius_mm || d <= opt.adjacent_radius_mm) near.emplace_back(d, robots[j].id);
+      if (d <= opt.robot_radius_mm || d <= opt.adjacent_radius_mm) near.emplace_back(key(d), robots[j].id);
     }
     for (const auto& f : spec_.fiducials) {
       const double d = distance(robots[i].x_mm, robots[i].y_mm, f.x_mm, f.y_mm);
-      if (d <= opt.fiducial_radius_mm) fids.emplace_back(d, f.id);
+      if (d <= opt.fiducial_radius_mm) fids.emplace_back(key(d), f.id);
     }
     std::sort(near.begin(), near.end());
     std::sort(fids.begin(), fids.end());
     auto& n = neighbours_[i];
-    for (const auto& [d, id] : near) {
+    for (const auto& [k, id] : near) {
+      const auto* o = &robots[index_.at(id)];
+      const double d = distance(robots[i].x_mm, robots[i].y_mm, o->x_mm, o->y_mm);
       if (d <= opt.robot_radius_mm) n.robots.push_back(id);
       if (d <= opt.adjacent_radius_mm) n.adjacent.push_back(id);
     }
-    for (const auto& [d, id] : fids) n.fiducials.push_back(id);
+    for (const auto& [k, id] : fids) n.fiducials.push_back(id);
   }
 }
 
