@@ -26,13 +26,13 @@ if "$AXON" fps layout show "$TMP/typo.yaml" >"$TMP/typo.out" 2>"$TMP/typo.err"; 
 grep -q 'typo.yaml:3:.*buss' "$TMP/typo.err" || fail "typo error does not name line 3 and the key"
 
 start_sim_fps --robots 1-6 --gateway 127.0.0.1:0
-"$AXON" fps --gateway "127.0.0.1:$SIM_CANNET_PORT" layout check "$DATA/benchtop.yaml" >"$TMP/check.out" 2>"$TMP/check.err" \
+"$AXON" fps --gateway "127.0.0.1:$SIM_CANNET_PORT" layout check --window 2 "$DATA/benchtop.yaml" >"$TMP/check.out" 2>"$TMP/check.err" \
   || fail "check of the benchtop layout exited with $?"
 grep -q '^OK: 6 matched' "$TMP/check.out" || fail "check did not match 6 robots"
 kill "$SIM_PID"; wait "$SIM_PID" 2>/dev/null || true
 
 start_sim_fps --robots 1-5,9 --gateway 127.0.0.1:0
-if "$AXON" fps --gateway "127.0.0.1:$SIM_CANNET_PORT" layout check --json "$DATA/benchtop.yaml" >"$TMP/bad.json" 2>"$TMP/bad.err"; then
+if "$AXON" fps --gateway "127.0.0.1:$SIM_CANNET_PORT" layout check --window 2 --json "$DATA/benchtop.yaml" >"$TMP/bad.json" 2>"$TMP/bad.err"; then
   fail "check with a missing robot exited 0"
 fi
 /usr/bin/python3 - "$TMP/bad.json" <<'PY' || fail "check --json did not report 6 missing and 9 unexpected"
