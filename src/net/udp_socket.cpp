@@ -105,6 +105,11 @@ Result<UdpSocket> UdpSocket::open(const SocketAddress& local, const UdpOptions& 
   if (options.tos >= 0) {
     AXON_TRY(set(IPPROTO_IP, IP_TOS, options.tos, "IP_TOS"));
   }
+  {
+    const int one = 1;
+    // Destination address per datagram, so a socket bound to any address knows which one was hit.
+    (void)::setsockopt(s.fd_, IPPROTO_IP, IP_PKTINFO, &one, sizeof one);
+  }
   if (options.kernel_timestamps) {
     const int one = 1;
     // A refusal is not fatal: arrival times then come from the clock at return.
@@ -173,8 +178,8 @@ void UdpSocket::clear_interrupt() noexcept {
 Result<Datagram> UdpSocket::receive_ready(std::span<std::byte> buffer) {
   sockaddr_in from{};
   iovec iov{buffer.data(), buffer.size()};
-  // Room for one SCM_TIMESTAMPNS message; on the stack, so nothing is allocated per packet.
-  alignas(cmsghdr) unsigned char control[CMSG_SPACE(sizeof(timespec))];
+  // Room for SCM_TIMESTAMPNS and IP_PKTINFO; on the stack, so nothing is allocated per packet.
+  alignas(cmsghdr) unsigned char control[CMSG_SPACE(sizeof(timespec)) + CMSG_SPACE(sizeof(in_pktinfo))];
   msghdr msg{};
   msg.msg_name = &from;
   msg.msg_namelen = sizeof from;
@@ -195,6 +200,7 @@ Result<Datagram> UdpSocket::receive_ready(std::span<std::byte> buffer) {
   d.wire_size = static_cast<std::size_t>(n);
   d.size = std::min(d.wire_size, buffer.size());
   d.from = from_sockaddr(from);
+  d.to = local_;
   d.wall_ns = wall_now;
   for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
     if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
@@ -203,6 +209,10 @@ Result<Datagram> UdpSocket::receive_ready(std::span<std::byte> buffer) {
       d.wall_ns = static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
       d.kernel_timestamp = true;
       d.wakeup_latency_ns = wall_now - d.wall_ns;
+    } else if (c->cmsg_level == IPPROTO_IP && c->cmsg_type == IP_PKTINFO) {
+      in_pktinfo info{};
+      std::memcpy(&info, CMSG_DATA(c), sizeof info);
+      d.to.ip = ntohl(info.ipi_addr.s_addr);
     }
   }
   peer_ = d.from;

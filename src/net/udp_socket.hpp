@@ -52,6 +52,7 @@ struct Datagram {
   std::size_t size = 0;       // bytes stored in the caller's buffer
   std::size_t wire_size = 0;  // bytes the datagram carried; larger than size when truncated
   SocketAddress from;
+  SocketAddress to;  // the address it was sent to (tells which local address when bound to any)
   std::int64_t wall_ns = 0;           // arrival, ns since the epoch: the kernel's stamp if any
   std::int64_t steady_ns = 0;         // CLOCK_MONOTONIC when receive() got the datagram
   std::int64_t wakeup_latency_ns = 0; // wall clock at return minus the kernel stamp (0 without one)

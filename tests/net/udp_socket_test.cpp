@@ -33,6 +33,16 @@ TEST(UdpSocket, BindsEphemeralPortAndReportsIt) {
   EXPECT_EQ(s.local_address().to_string(), fmt::format("127.0.0.1:{}", s.local_port()));
 }
 
+TEST(UdpSocket, BoundToAnyAddressReportsTheDestinationOfEachDatagram) {
+  auto server = UdpSocket::open(SocketAddress{0, 0}).value();
+  EXPECT_EQ(server.local_address().ip, 0u);
+  auto client = open_loopback();
+  ASSERT_TRUE(client.send_to(bytes("a"), SocketAddress{0x7f000001, server.local_port()}));
+  std::array<std::byte, 8> buf{};
+  auto d = server.receive(buf, 2s).value();
+  EXPECT_EQ(d.to, (SocketAddress{0x7f000001, server.local_port()}));
+}
+
 TEST(UdpSocket, OpensFromHostPortText) {
   auto s = UdpSocket::open(Endpoint{"127.0.0.1", 0}).value();
   EXPECT_NE(s.local_port(), 0);
@@ -66,6 +76,7 @@ TEST(UdpSocket, RoundTripRemembersThePeerAndReplies) {
   EXPECT_EQ(d.value().wire_size, 4u);
   EXPECT_FALSE(d.value().truncated());
   EXPECT_EQ(d.value().from, client.local_address());
+  EXPECT_EQ(d.value().to, server.local_address());
   ASSERT_TRUE(server.peer());
   EXPECT_EQ(*server.peer(), client.local_address());
 
