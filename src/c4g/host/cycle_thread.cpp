@@ -95,6 +95,9 @@ void CycleThread::run() {
       continue;
     }
     const std::span<const std::byte> reply(tx_.data(), n);
+    // The capture stamps the answer as it leaves: before the send, so that it never appears after
+    // a next request the peer sent in reaction to it.
+    const std::int64_t wall_send = recorder_ ? clock_ns(CLOCK_REALTIME) : 0;
     auto sent = socket_.send_to(reply, d.from);
     const std::int64_t t2 = clock_ns(CLOCK_MONOTONIC);
     const std::int64_t wall2 = clock_ns(CLOCK_REALTIME);
@@ -105,7 +108,7 @@ void CycleThread::run() {
     bump(counters_.replies);
     timing_.record(d.steady_ns, t2);
     reply_latency_.add(wall2 - d.wall_ns);
-    if (recorder_) recorder_->record(d.to, d.from, reply, wall2);
+    if (recorder_) recorder_->record(d.to, d.from, reply, wall_send);
   }
 }
 

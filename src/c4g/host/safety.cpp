@@ -91,13 +91,17 @@ void Safety::make_drive_off(const protocol::Packet& request, protocol::Packet& r
   }
 }
 
-FaultReason Safety::apply(const protocol::Packet& request, protocol::Packet& reply) noexcept {
+void Safety::begin_cycle() noexcept {
   if (reset_requested_.exchange(false, std::memory_order_acq_rel)) {
     reason_.store(FaultReason::none, std::memory_order_release);
     fault_axis_.store(-1, std::memory_order_relaxed);
     drive_off_done_ = false;
     have_last_ = {};
   }
+}
+
+FaultReason Safety::apply(const protocol::Packet& request, protocol::Packet& reply) noexcept {
+  begin_cycle();
   const auto req = request.open_axes();
   auto rep = reply.open_axes();
   const std::size_t n = std::min(req.size(), rep.size());

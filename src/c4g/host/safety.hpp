@@ -76,6 +76,8 @@ class Safety {
   // From the initialization packet: thresholds and current limits in open order. Cycle thread.
   void configure(const protocol::InitPacket& init, const protocol::AxisMap& map) noexcept;
 
+  // Applies a pending reset(); call before deciding whether the user's controller runs.
+  void begin_cycle() noexcept;
   // Checks the reply against the controller's packet and fixes it in place (clamps currents, or
   // replaces it with a drive-off / following-error request when a fault is or becomes latched).
   // Returns the fault in force after this cycle (none when the reply went out as built).

@@ -234,6 +234,7 @@ std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Data
   build_safe_reply(request_, safe_);
   reply_ = safe_;
   bool used_controller = false;
+  safety_.begin_cycle();
   if (!safety_.faulted()) {
     const CycleContext ctx{request_, have_init_ ? &init_ : nullptr, have_axes_ ? &axes_ : nullptr, cyclic_count_,
                            info.wall_ns};
