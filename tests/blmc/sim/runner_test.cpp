@@ -141,3 +141,26 @@ TEST(BlmcSimRunner, RealTimeTickRunsTheBoards) {
   EXPECT_GE(board->next_cycle_time(), 10ms);
   EXPECT_TRUE(host->try_receive());  // the power-up status
 }
+
+TEST(BlmcSimRunner, ALateHostTripsTheReceiveTimeout) {
+  Rig rig;
+  rig.command(0, "ENABLE_SYS=1");
+  rig.command(0, "ENABLE_MTR1=1");
+  rig.run_for(rig.boards[0]->config().alignment_time + 5ms);
+  ASSERT_TRUE(rig.boards[0]->status().motor1_ready);
+  rig.command(0, "SET_CAN_RECV_TIMEOUT=20");
+  const auto iq = protocol::encode_iq_ref({0.2, 0.0}).value();
+  // A host loop at 1 kHz keeps the board running ...
+  for (int k = 0; k < 100; ++k) {
+    rig.send(0, iq);
+    rig.run_for(1ms);
+  }
+  EXPECT_TRUE(rig.boards[0]->status().system_enabled);
+  EXPECT_GT(rig.boards[0]->motor(0).velocity_rev_s(), 0.0);
+  // ... until it misses its deadlines for longer than the timeout (the test simply stops sending).
+  rig.run_for(19ms);
+  EXPECT_EQ(rig.boards[0]->status().error, protocol::ErrorCode::none);
+  rig.run_for(3ms);
+  EXPECT_EQ(rig.boards[0]->status().error, protocol::ErrorCode::can_recv_timeout);
+  EXPECT_FALSE(rig.boards[0]->status().system_enabled);
+}
