@@ -14,6 +14,7 @@ void add_can_commands(CLI::App& app, GlobalOptions& global);
 void add_demo_command(CLI::App& app, GlobalOptions& global);
 void add_sim_commands(CLI::App& app, GlobalOptions& global);
 void add_fps_commands(CLI::App& app, GlobalOptions& global);
+void add_blmc_commands(CLI::App& app, GlobalOptions& global);
 
 // Exit code chosen by the subcommand that ran.
 int& exit_code();

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   add_can_commands(app, global);
   add_sim_commands(app, global);
   add_fps_commands(app, global);
+  add_blmc_commands(app, global);
   add_demo_command(app, global);
   try {
     app.parse(argc, argv);
