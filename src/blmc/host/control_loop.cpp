@@ -49,7 +49,7 @@ ControlLoop::ControlLoop(std::vector<CyclicPort*> ports, Controller& controller,
 ControlLoop::~ControlLoop() { stop(); }
 
 std::optional<LoopFault> ControlLoop::fault() const noexcept {
-  if (!faulted()) return std::nullopt;
+  if (!faulted() || running()) return std::nullopt;
   return fault_;
 }
 
@@ -106,10 +106,16 @@ void ControlLoop::step(core::TimePoint deadline, core::TimePoint now) noexcept {
       trip = true;
     }
   }
+  if (halted_ && !trip && fault_.fault.board_error == protocol::ErrorCode::none) {
+    // Learn the board's own reason from a status that came after the trip.
+    const auto& st = inputs_[fault_.board].status;
+    if (st.count > status_at_trip_) fault_.fault.board_error = st.value.error;
+  }
   if (trip) {
     // Stop everything: zero current and disable the motors of every board, then publish.
     for (auto* p : ports_) p->send_disable();
     halted_ = true;
+    status_at_trip_ = inputs_[fault_.board].status.count;
     faulted_.store(true, std::memory_order_release);
   } else {
     for (std::size_t i = 0; i < n; ++i) ports_[i]->send_currents(halted_ ? MotorPair{} : requests_[i]);
@@ -189,7 +195,11 @@ void ControlLoop::run() noexcept {
         timing_.skipped(static_cast<std::uint64_t>(k));
       }
     }
-    if (halted_ && options_.stop_on_fault) break;
+    if (halted_ && options_.stop_on_fault) {
+      const auto& st = ports_[fault_.board]->latest().status;
+      const bool answered = st.count > status_at_trip_ || fault_.fault.kind == FaultKind::board_error;
+      if (answered || now - fault_.fault.at >= options_.fault_grace) break;
+    }
   }
   running_.store(false, std::memory_order_release);
 }

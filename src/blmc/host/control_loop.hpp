@@ -85,6 +85,11 @@ struct LoopOptions {
   std::vector<int> cpus;                  // pin the loop thread to these CPUs (empty: no pinning)
   std::size_t record_capacity = 4096;     // CycleRecords queued for the consumer
   bool stop_on_fault = true;
+  // After a fault the loop keeps sending zero current for up to this long, waiting for the
+  // board's next status frame, so that a fault seen first as stale data (a board that disabled
+  // itself stops sending data at once, its status comes once per second) is reported with the
+  // board's error code. 0 ends at once.
+  core::Duration fault_grace = std::chrono::milliseconds(1200);
 };
 
 // What one cycle did, for logging and monitoring (trivially copyable, fixed size).
@@ -134,6 +139,8 @@ class ControlLoop {
   [[nodiscard]] std::uint64_t records_dropped() const noexcept { return dropped_.load(std::memory_order_relaxed); }
 
   [[nodiscard]] bool faulted() const noexcept { return faulted_.load(std::memory_order_acquire); }
+  // The fault, complete once the loop thread ended (running() false); faulted() says earlier
+  // that one happened.
   [[nodiscard]] std::optional<LoopFault> fault() const noexcept;
   [[nodiscard]] std::uint64_t cycles() const noexcept { return cycles_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t overruns() const noexcept { return overruns_.load(std::memory_order_relaxed); }
@@ -168,6 +175,7 @@ class ControlLoop {
   core::TimePoint prev_start_{};
   bool started_controller_ = false;
   bool halted_ = false;  // a fault zeroed everything
+  std::uint64_t status_at_trip_ = 0;
 };
 
 }  // namespace axon::blmc::host

@@ -20,6 +20,8 @@ const char* to_string(FaultKind k) noexcept {
 }
 
 std::string Fault::describe() const {
+  if (kind != FaultKind::board_error && kind != FaultKind::none && board_error != protocol::ErrorCode::none)
+    return fmt::format("{} (board error {})", without_board_error().describe(), protocol::name(board_error));
   switch (kind) {
     case FaultKind::none: return "no fault";
     case FaultKind::board_error: return fmt::format("board error {}", protocol::name(board_error));

@@ -65,7 +65,14 @@ struct Fault {
 
   // For logs and users (allocates: call outside the real-time cycle), e.g.
   // "board error ENCODER", "stale data: no velocity frame for 0.012 s (limit 0.010 s)".
+  // A stale-data or other host-side fault also names the board's error code when the board's
+  // next status told it (ControlLoop waits for it briefly).
   [[nodiscard]] std::string describe() const;
+  [[nodiscard]] Fault without_board_error() const noexcept {
+    Fault f = *this;
+    f.board_error = protocol::ErrorCode::none;
+    return f;
+  }
 };
 
 struct SafetyCounters {
