@@ -1,0 +1,248 @@
+// ControlLoop without a bus: ports fed by hand, cycles run with step() and a manual clock, and one
+// run of the real thread that asserts behaviour only (no timing).
+#include "blmc/host/control_loop.hpp"
+#include "blmc/host/homing.hpp"
+#include "blmc/host/pd_controller.hpp"
+#include "rig.hpp"
+
+#include <gtest/gtest.h>
+
+#include <thread>
+
+namespace axon::blmc::host {
+namespace {
+
+using testing::pair_frame;
+using testing::status_frame;
+using protocol::MessageId;
+namespace proto = axon::blmc::protocol;
+
+void feed(CyclicPort& p, std::vector<can::Frame> frames) {
+  for (const auto& f : frames) ASSERT_TRUE(p.link().deliver(f));
+}
+void feed_data(CyclicPort& p, double pos1 = 0, double pos2 = 0) {
+  feed(p, {pair_frame(MessageId::current, 0, 0), pair_frame(MessageId::position, pos1, pos2),
+           pair_frame(MessageId::velocity, 0, 0), pair_frame(MessageId::adc6, 0.5, 0.5)});
+}
+std::vector<can::Frame> drain(CyclicPort& p) {
+  std::vector<can::Frame> out;
+  can::Frame f;
+  while (p.link().take(f)) out.push_back(f);
+  return out;
+}
+
+struct Constant final : Controller {
+  MotorPair value{};
+  int calls = 0;
+  void update(const ControlInput&, std::span<MotorPair> c) noexcept override {
+    ++calls;
+    for (auto& x : c) x = value;
+  }
+};
+
+TEST(BlmcControlLoop, CycleSendsSafeCurrentsAndRecords) {
+  core::ManualClock clock;
+  CyclicPort port(64);
+  Constant ctl;
+  ctl.value = {5.0, -0.5};
+  SafetyLimits lim;
+  lim.max_current_a = 2.0;
+  ControlLoop loop({&port}, ctl, {lim}, {}, clock);
+  feed(port, {status_frame(true, true, true, true, true)});
+  feed_data(port, 0.25, -0.25);
+  loop.step(clock.now(), clock.now());
+  const auto sent = drain(port);
+  ASSERT_EQ(sent.size(), 1u);
+  const auto iq = protocol::decode_pair(MessageId::iq_ref, sent[0]).value();
+  EXPECT_DOUBLE_EQ(iq.motor1, 2.0);
+  EXPECT_DOUBLE_EQ(iq.motor2, -0.5);
+  CycleRecord rec;
+  ASSERT_TRUE(loop.pop_record(rec));
+  EXPECT_EQ(rec.cycle, 0u);
+  EXPECT_EQ(rec.boards, 1);
+  EXPECT_DOUBLE_EQ(rec.board[0].position.motor1, 0.25);
+  EXPECT_DOUBLE_EQ(rec.board[0].command.motor1, 2.0);
+  EXPECT_FALSE(loop.faulted());
+}
+
+TEST(BlmcControlLoop, TimingBookkeepingWithAManualClock) {
+  core::ManualClock clock;
+  CyclicPort port(64);
+  Constant ctl;
+  SafetyLimits lim;
+  lim.stale_after = std::chrono::hours(1);
+  lim.status_stale_after = std::chrono::hours(1);
+  ControlLoop loop({&port}, ctl, {lim}, {}, clock);
+  auto deadline = clock.now();
+  for (int i = 0; i < 5; ++i) {
+    clock.advance(i == 3 ? 1300us : 1000us);
+    deadline += 1ms;
+    loop.step(deadline, clock.now());
+  }
+  const auto s = loop.stats();
+  EXPECT_EQ(s.cycles, 5u);
+  EXPECT_EQ(s.jitter_max, 300us);
+  EXPECT_EQ(s.late_max, 300us);
+  EXPECT_EQ(ctl.calls, 5);
+  EXPECT_EQ(loop.cycles(), 5u);
+}
+
+TEST(BlmcControlLoop, StaleDataDisablesEveryBoardAndReports) {
+  core::ManualClock clock;
+  CyclicPort a(64), b(64);
+  Constant ctl;
+  ctl.value = {1, 1};
+  ControlLoop loop({&a, &b}, ctl, {SafetyLimits{}}, {}, clock);
+  feed(a, {status_frame(true, true, true, true, true)});
+  feed(b, {status_frame(true, true, true, true, true)});
+  feed_data(a);
+  feed_data(b);
+  loop.step(clock.now(), clock.now());
+  EXPECT_EQ(drain(a).size(), 1u);
+  EXPECT_EQ(drain(b).size(), 1u);
+  // Board b keeps talking, board a goes quiet.
+  for (int i = 0; i < 12; ++i) {
+    clock.advance(1ms);
+    feed_data(b);
+    loop.step(clock.now(), clock.now());
+    if (loop.faulted()) break;
+  }
+  ASSERT_TRUE(loop.faulted());
+  const auto f = loop.fault().value();
+  EXPECT_EQ(f.board, 0u);
+  EXPECT_EQ(f.fault.kind, FaultKind::stale_data);
+  // Both boards got zero current and their motors disabled in the tripping cycle.
+  for (auto* p : {&a, &b}) {
+    auto frames = drain(*p);
+    ASSERT_GE(frames.size(), 3u);
+    const auto tail = std::vector<can::Frame>(frames.end() - 3, frames.end());
+    EXPECT_EQ(protocol::decode_pair(MessageId::iq_ref, tail[0]).value(), (MotorPair{0, 0}));
+    EXPECT_EQ(protocol::decode_command(tail[1]).value().to_string(), "ENABLE_MTR1=0");
+    EXPECT_EQ(protocol::decode_command(tail[2]).value().to_string(), "ENABLE_MTR2=0");
+  }
+  // Later cycles only send zeros.
+  clock.advance(1ms);
+  loop.step(clock.now(), clock.now());
+  auto later = drain(b);
+  ASSERT_EQ(later.size(), 1u);
+  EXPECT_EQ(protocol::decode_pair(MessageId::iq_ref, later[0]).value(), (MotorPair{0, 0}));
+}
+
+TEST(BlmcControlLoop, BoardErrorIsReportedByName) {
+  core::ManualClock clock;
+  CyclicPort port(64);
+  Constant ctl;
+  ControlLoop loop({&port}, ctl, {SafetyLimits{}}, {}, clock);
+  feed(port, {status_frame(false, false, true, false, true, protocol::ErrorCode::encoder)});
+  feed_data(port);
+  loop.step(clock.now(), clock.now());
+  ASSERT_TRUE(loop.faulted());
+  EXPECT_EQ(loop.fault()->fault.describe(), "board error ENCODER");
+}
+
+TEST(BlmcControlLoop, RejectsBadConfiguration) {
+  Constant ctl;
+  CyclicPort p(4);
+  EXPECT_THROW(ControlLoop({}, ctl, {SafetyLimits{}}), Exception);
+  EXPECT_THROW(ControlLoop({&p}, ctl, {SafetyLimits{}, SafetyLimits{}, SafetyLimits{}}), Exception);
+}
+
+TEST(BlmcControlLoop, ThreadRunsTheControllerAndStops) {
+  CyclicPort port(4096);
+  Constant ctl;
+  ctl.value = {0.1, 0.2};
+  SafetyLimits lim;
+  lim.stale_after = std::chrono::hours(1);
+  lim.status_stale_after = std::chrono::hours(1);
+  LoopOptions opt;
+  opt.realtime = false;
+  ControlLoop loop({&port}, ctl, {lim}, opt);
+  ASSERT_TRUE(loop.start());
+  std::size_t sent = 0;
+  for (int i = 0; i < 5000 && sent < 20; ++i) {
+    can::Frame f;
+    while (port.link().take(f)) ++sent;
+    std::this_thread::sleep_for(1ms);
+  }
+  loop.stop();
+  EXPECT_FALSE(loop.running());
+  EXPECT_GE(sent, 20u);
+  EXPECT_GE(loop.stats().cycles, 20u);
+  CycleRecord r;
+  std::size_t records = 0;
+  while (loop.pop_record(r)) ++records;
+  EXPECT_EQ(records + loop.records_dropped(), loop.stats().cycles);
+}
+
+TEST(BlmcControlLoop, ThreadEndsOnFault) {
+  CyclicPort port(4096);
+  Constant ctl;
+  LoopOptions opt;
+  opt.realtime = false;
+  ControlLoop loop({&port}, ctl, {SafetyLimits{}}, opt);  // nothing ever arrives: stale
+  ASSERT_TRUE(loop.start());
+  for (int i = 0; i < 5000 && loop.running(); ++i) std::this_thread::sleep_for(1ms);
+  EXPECT_FALSE(loop.running());
+  ASSERT_TRUE(loop.faulted());
+  EXPECT_EQ(loop.fault()->fault.kind, FaultKind::stale_data);
+}
+
+TEST(BlmcHoming, MovesUntilTheIndexThenHoldsThere) {
+  core::ManualClock clock;
+  CyclicPort port(256);
+  HomingOptions ho;
+  ho.motors = {true, false};
+  ho.speed_rev_s = 1.0;
+  HomingController homing(1, ho);
+  SafetyLimits lim;
+  lim.stale_after = std::chrono::hours(1);
+  lim.status_stale_after = std::chrono::hours(1);
+  ControlLoop loop({&port}, homing, {lim}, {}, clock);
+  feed(port, {status_frame(true, true, true, true, true)});
+  feed_data(port, 0.0, 0.0);
+  loop.step(clock.now(), clock.now());
+  (void)drain(port);
+  clock.advance(100ms);  // target has moved 0.1 rev ahead: positive current
+  feed_data(port, 0.0, 0.0);
+  loop.step(clock.now(), clock.now());
+  auto f = drain(port);
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_GT(protocol::decode_pair(MessageId::iq_ref, f[0]).value().motor1, 0.0);
+  EXPECT_EQ(protocol::decode_pair(MessageId::iq_ref, f[0]).value().motor2, 0.0);
+  EXPECT_FALSE(homing.done());
+  // The index passes at 0.375 rev; the motor overshoots to 0.45.
+  feed(port, {proto::encode(proto::EncoderIndex{0.375, 0}).value()});
+  feed_data(port, 0.45, 0.0);
+  clock.advance(1ms);
+  loop.step(clock.now(), clock.now());
+  EXPECT_TRUE(homing.done());
+  ASSERT_EQ(homing.result(0, 0).state, MotorHoming::State::found);
+  EXPECT_DOUBLE_EQ(homing.result(0, 0).index_rev, 0.375);
+  EXPECT_TRUE(homing.all_found());
+  f = drain(port);
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_LT(protocol::decode_pair(MessageId::iq_ref, f[0]).value().motor1, 0.0);  // pulls back to the index
+}
+
+TEST(BlmcHoming, FailsAfterMaxTravel) {
+  core::ManualClock clock;
+  CyclicPort port(256);
+  HomingOptions ho;
+  ho.motors = {false, true};
+  ho.max_travel_rev = 0.5;
+  HomingController homing(1, ho);
+  SafetyLimits lim;
+  lim.stale_after = std::chrono::hours(1);
+  lim.status_stale_after = std::chrono::hours(1);
+  ControlLoop loop({&port}, homing, {lim}, {}, clock);
+  feed_data(port);
+  loop.step(clock.now(), clock.now());
+  clock.advance(2s);
+  loop.step(clock.now(), clock.now());
+  EXPECT_TRUE(homing.done());
+  EXPECT_EQ(homing.result(0, 1).state, MotorHoming::State::failed);
+  EXPECT_FALSE(homing.all_found());
+}
+
+}  // namespace
+}  // namespace axon::blmc::host
