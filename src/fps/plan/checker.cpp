@@ -117,6 +117,9 @@ void TrajectoryChecker::run(Worker& w, std::span<const RobotTrajectory> trajecto
   const std::size_t n = m.size();
   w.poses.assign(n, Pose{std::numeric_limits<double>::quiet_NaN(), 0});
   w.segs.resize(n);
+  w.mid.resize(n);
+  w.half.resize(n);
+  for (std::size_t i = 0; i < n; ++i) w.half[i] = 0.5 * m.robot(i).collision_length_mm();
   w.alpha.resize(n);
   w.beta.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -135,9 +138,22 @@ void TrajectoryChecker::run(Worker& w, std::span<const RobotTrajectory> trajecto
       if (p != w.poses[i]) {  // a robot standing still keeps its segment (NaN at start: always differs)
         w.poses[i] = p;
         w.segs[i] = m.robot(i).collision_segment(p);
+        w.mid[i] = 0.5 * (w.segs[i].a + w.segs[i].b);
       }
     }
-    for (std::size_t k = 0; k < rp.size(); ++k) note(w.robot_pairs[k], m.clearance(rp[k], w.segs), t);
+    for (std::size_t k = 0; k < rp.size(); ++k) {
+      // Each segment lies within half its length of its midpoint, so the midpoints' distance
+      // minus both half lengths and the limit is a lower bound of the clearance. When that bound
+      // cannot beat the pair's smallest clearance so far (which is >= 0 unless it collided
+      // already), the sample can change nothing for this pair: skip the exact distance.
+      const RobotPair& p = rp[k];
+      PairOutcome& o = w.robot_pairs[k];
+      const double room = w.half[p.a] + w.half[p.b] + p.limit_mm + o.min_clearance_mm;
+      if (room >= 0 && room < std::numeric_limits<double>::infinity() &&
+          norm2(w.mid[p.a] - w.mid[p.b]) > room * room && (o.collided || o.min_clearance_mm >= 0))
+        continue;
+      note(o, m.clearance(p, w.segs), t);
+    }
     if (obstacles)
       for (std::size_t k = 0; k < op.size(); ++k) note(w.obstacle_pairs[k], m.clearance(op[k], w.segs), t);
   }

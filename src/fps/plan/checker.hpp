@@ -68,6 +68,8 @@ class TrajectoryChecker {
   struct Worker {
     std::vector<Pose> poses;
     std::vector<Segment> segs;
+    std::vector<Vec2> mid;      // segment midpoints
+    std::vector<double> half;   // half the segment lengths
     std::vector<AngleCursor> alpha, beta;
     std::vector<PairOutcome> robot_pairs, obstacle_pairs;
   };
