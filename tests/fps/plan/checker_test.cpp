@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 #include <vector>
 
 namespace axon::fps::plan {
@@ -129,6 +130,49 @@ TEST(PlanChecker, SweepOverFiducialAndStaticCheck) {
   o.obstacles = false;
   ASSERT_TRUE(checker.check(std::vector{RobotTrajectory::hold({30, 0})}, o, r));
   EXPECT_TRUE(r.ok());
+}
+
+TEST(PlanChecker, MatchesBruteForceOnRandomHexMoves) {
+  // Seven robots (a centre and its hex ring) move between random poses; the report must equal a
+  // plain evaluation of every pair at the same sample times.
+  std::vector<RobotSpec> robots{{1, {0, 0}, {}, {}, 2.0}};
+  for (int k = 0; k < 6; ++k)
+    robots.push_back({2 + k, {22.4 * std::cos(k * std::numbers::pi / 3), 22.4 * std::sin(k * std::numbers::pi / 3)},
+                      {}, {}, 2.0});
+  const auto model = build(robots);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> a(0, 360), b(0, 180), dur(2, 8);
+  for (int round = 0; round < 5; ++round) {
+    std::vector<RobotTrajectory> traj;
+    for (std::size_t i = 0; i < model.size(); ++i)
+      traj.push_back(RobotTrajectory::linear({a(rng), b(rng)}, {a(rng), b(rng)}, 0, dur(rng)));
+    TrajectoryChecker checker(model);
+    CheckReport r;
+    CheckOptions o;
+    o.threads = 1;
+    o.max_step_mm = 0.2;
+    ASSERT_TRUE(checker.check(traj, o, r));
+    std::vector<PairOutcome> expect(model.robot_pairs().size());
+    std::vector<Pose> poses(model.size());
+    std::vector<Segment> segs(model.size());
+    for (std::size_t s = 0; s < r.samples; ++s) {
+      const double t = s + 1 == r.samples ? r.end_s : r.start_s + static_cast<double>(s) * r.step_s;
+      for (std::size_t i = 0; i < model.size(); ++i) poses[i] = {angle_at(traj[i].alpha, t), angle_at(traj[i].beta, t)};
+      model.segments(poses, segs);
+      for (std::size_t k = 0; k < expect.size(); ++k) {
+        const double c = model.clearance(model.robot_pairs()[k], segs);
+        if (c < expect[k].min_clearance_mm) expect[k].min_clearance_mm = c, expect[k].min_clearance_s = t;
+        if (c < 0 && !expect[k].collided) expect[k].collided = true, expect[k].first_collision_s = t;
+      }
+    }
+    for (std::size_t k = 0; k < expect.size(); ++k) {
+      EXPECT_EQ(r.robot_pairs[k].collided, expect[k].collided) << k;
+      EXPECT_NEAR(r.robot_pairs[k].min_clearance_mm, expect[k].min_clearance_mm, 1e-9) << k;
+      if (expect[k].collided) {
+        EXPECT_NEAR(r.robot_pairs[k].first_collision_s, expect[k].first_collision_s, 1e-12) << k;
+      }
+    }
+  }
 }
 
 TEST(PlanChecker, RejectsBadTrajectories) {
