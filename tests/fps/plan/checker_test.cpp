@@ -1,0 +1,206 @@
+// The dense-sampling checker: collisions that only happen mid-move, clearances, sampling step.
+#include "fps/plan/checker.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+namespace axon::fps::plan {
+namespace {
+
+CollisionModel build(std::vector<RobotSpec> robots, std::vector<FiducialSpec> fids = {}) {
+  auto m = CollisionModel::build(robots, ArmDesign{}, fids);
+  EXPECT_TRUE(m) << m.error().message();
+  return std::move(m).value();
+}
+
+double static_clearance(const CollisionModel& m, const std::vector<Pose>& poses) {
+  std::vector<Segment> s(m.size());
+  m.segments(poses, s);
+  std::vector<Contact> c;
+  return m.find_contacts(s, c);
+}
+
+// Robot 1 at the origin sweeps alpha from -60 to +60 deg in 10 s (12 deg/s) with beta 0.
+// Robot 2 at (24, 0) holds alpha 90, beta 0: its segment runs up from (24, 7.4) to (24, 22.1).
+// Robot 1's segment end (22.1 mm out) passes closest to (24, 7.4) at alpha = atan2(7.4, 24) =
+// 17.14 deg (t = 77.14 / 12 = 6.43 s): gap hypot(24, 7.4) - 22.1 = 3.0149, clearance -0.9851.
+// At both ends the arms are far apart.
+struct Sweep {
+  CollisionModel model = build({{1, {0, 0}, {}, {}, 2.0}, {2, {24, 0}, {}, {}, 2.0}});
+  std::vector<RobotTrajectory> traj{RobotTrajectory::linear({-60, 0}, {60, 0}, 0, 10),
+                                    RobotTrajectory::hold({90, 0})};
+};
+
+TEST(PlanChecker, CatchesCollisionThatOnlyHappensMidMove) {
+  Sweep s;
+  EXPECT_GT(static_clearance(s.model, {{-60, 0}, {90, 0}}), 5.0);
+  EXPECT_GT(static_clearance(s.model, {{60, 0}, {90, 0}}), 5.0);
+
+  TrajectoryChecker checker(s.model);
+  CheckReport r;
+  ASSERT_TRUE(checker.check(s.traj, {}, r));
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.collided_pairs, 1u);
+  ASSERT_EQ(r.robot_pairs.size(), 1u);
+  const PairOutcome& p = r.robot_pairs[0];
+  EXPECT_TRUE(p.collided);
+  const double t_min = (std::atan2(7.4, 24.0) * 180 / std::numbers::pi + 60) / 12;
+  EXPECT_NEAR(p.min_clearance_s, t_min, 0.02);
+  EXPECT_NEAR(p.min_clearance_mm, std::hypot(24.0, 7.4) - 22.1 - 4, 1e-3);
+  EXPECT_DOUBLE_EQ(r.min_clearance_mm, p.min_clearance_mm);
+  // Contact starts before the closest approach and after the start.
+  EXPECT_GT(p.first_collision_s, 0.0);
+  EXPECT_LT(p.first_collision_s, t_min);
+  // The reported first collision really is one, and a step earlier was clear.
+  auto pose_at = [&](double t) { return Pose{angle_at(s.traj[0].alpha, t), 0}; };
+  EXPECT_LT(static_clearance(s.model, {pose_at(p.first_collision_s), {90, 0}}), 0);
+  EXPECT_GE(static_clearance(s.model, {pose_at(p.first_collision_s - r.step_s), {90, 0}}), 0);
+}
+
+TEST(PlanChecker, StepKeepsEveryArmPointWithinTheLimit) {
+  Sweep s;
+  TrajectoryChecker checker(s.model);
+  CheckReport r;
+  CheckOptions o;
+  o.max_step_mm = 0.05;
+  ASSERT_TRUE(checker.check(s.traj, o, r));
+  // 12 deg/s at up to 22.1 mm from the alpha axis: 4.63 mm/s, so steps of at most 10.8 ms.
+  const double speed = 12 * std::numbers::pi / 180 * 22.1;
+  EXPECT_LE(r.step_s * speed, 0.05 + 1e-12);
+  EXPECT_GT(r.step_s * speed, 0.045);
+  EXPECT_DOUBLE_EQ(r.start_s, 0);
+  EXPECT_DOUBLE_EQ(r.end_s, 10);
+  EXPECT_EQ(r.samples, static_cast<std::size_t>(std::round(10 / r.step_s)) + 1);
+}
+
+TEST(PlanChecker, SameReportWithOneOrTwoThreads) {
+  Sweep s;
+  // A slower step so the run is long enough to be split.
+  TrajectoryChecker checker(s.model);
+  CheckReport one, two;
+  CheckOptions o;
+  o.max_step_mm = 0.01;
+  o.threads = 1;
+  ASSERT_TRUE(checker.check(s.traj, o, one));
+  o.threads = 2;
+  ASSERT_TRUE(checker.check(s.traj, o, two));
+  ASSERT_GT(one.samples, 512u);
+  EXPECT_DOUBLE_EQ(one.robot_pairs[0].first_collision_s, two.robot_pairs[0].first_collision_s);
+  EXPECT_DOUBLE_EQ(one.robot_pairs[0].min_clearance_mm, two.robot_pairs[0].min_clearance_mm);
+  EXPECT_DOUBLE_EQ(one.robot_pairs[0].min_clearance_s, two.robot_pairs[0].min_clearance_s);
+}
+
+TEST(PlanChecker, ClearMoveReportsItsClearance) {
+  // Robot 2 moved to (30, 0): closest approach hypot(30, 7.4) - 22.1 = 8.799, clearance 4.799.
+  auto model = build({{1, {0, 0}, {}, {}, 2.0}, {2, {30, 0}, {}, {}, 2.0}});
+  std::vector<RobotTrajectory> traj{RobotTrajectory::linear({-60, 0}, {60, 0}, 0, 10), RobotTrajectory::hold({90, 0})};
+  TrajectoryChecker checker(model);
+  CheckReport r;
+  ASSERT_TRUE(checker.check(traj, {}, r));
+  EXPECT_TRUE(r.ok());
+  EXPECT_FALSE(r.robot_pairs[0].collided);
+  EXPECT_TRUE(std::isnan(r.robot_pairs[0].first_collision_s));
+  EXPECT_NEAR(r.min_clearance_mm, std::hypot(30.0, 7.4) - 22.1 - 4, 1e-3);
+}
+
+TEST(PlanChecker, SweepOverFiducialAndStaticCheck) {
+  // A fiducial at radius 15 mm, 30 deg: robot 1's stretched arm passes right over it.
+  const Vec2 fid{15 * std::cos(std::numbers::pi / 6), 15 * std::sin(std::numbers::pi / 6)};
+  auto model = build({{1, {0, 0}, {}, {}, 2.0}}, {{3, fid, 3.0}});
+  TrajectoryChecker checker(model);
+  CheckReport r;
+  ASSERT_TRUE(checker.check(std::vector{RobotTrajectory::linear({-60, 0}, {-20, 0}, 0, 5)}, {}, r));
+  EXPECT_TRUE(r.ok());
+  ASSERT_TRUE(checker.check(std::vector{RobotTrajectory::linear({-60, 0}, {60, 0}, 0, 10)}, {}, r));
+  EXPECT_FALSE(r.ok());
+  ASSERT_EQ(r.obstacle_pairs.size(), 1u);
+  EXPECT_TRUE(r.obstacle_pairs[0].collided);
+  // Right through it (-5 mm); the samples miss the exact instant by at most one step (0.05 mm).
+  EXPECT_NEAR(r.obstacle_pairs[0].min_clearance_mm, -5.0, 0.05);
+  // Nothing moves: a single sample, still checked.
+  ASSERT_TRUE(checker.check(std::vector{RobotTrajectory::hold({30, 0})}, {}, r));
+  EXPECT_EQ(r.samples, 1u);
+  EXPECT_FALSE(r.ok());
+  // Obstacles can be left out.
+  CheckOptions o;
+  o.obstacles = false;
+  ASSERT_TRUE(checker.check(std::vector{RobotTrajectory::hold({30, 0})}, o, r));
+  EXPECT_TRUE(r.ok());
+}
+
+TEST(PlanChecker, MatchesBruteForceOnRandomHexMoves) {
+  // Seven robots (a centre and its hex ring) move between random poses; the report must equal a
+  // plain evaluation of every pair at the same sample times.
+  std::vector<RobotSpec> robots{{1, {0, 0}, {}, {}, 2.0}};
+  for (int k = 0; k < 6; ++k)
+    robots.push_back({2 + k, {22.4 * std::cos(k * std::numbers::pi / 3), 22.4 * std::sin(k * std::numbers::pi / 3)},
+                      {}, {}, 2.0});
+  const auto model = build(robots);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> a(0, 360), b(0, 180), dur(2, 8);
+  for (int round = 0; round < 5; ++round) {
+    std::vector<RobotTrajectory> traj;
+    for (std::size_t i = 0; i < model.size(); ++i)
+      traj.push_back(RobotTrajectory::linear({a(rng), b(rng)}, {a(rng), b(rng)}, 0, dur(rng)));
+    TrajectoryChecker checker(model);
+    CheckReport r;
+    CheckOptions o;
+    o.threads = 1;
+    o.max_step_mm = 0.2;
+    ASSERT_TRUE(checker.check(traj, o, r));
+    std::vector<PairOutcome> expect(model.robot_pairs().size());
+    std::vector<Pose> poses(model.size());
+    std::vector<Segment> segs(model.size());
+    for (std::size_t s = 0; s < r.samples; ++s) {
+      const double t = s + 1 == r.samples ? r.end_s : r.start_s + static_cast<double>(s) * r.step_s;
+      for (std::size_t i = 0; i < model.size(); ++i) poses[i] = {angle_at(traj[i].alpha, t), angle_at(traj[i].beta, t)};
+      model.segments(poses, segs);
+      for (std::size_t k = 0; k < expect.size(); ++k) {
+        const double c = model.clearance(model.robot_pairs()[k], segs);
+        if (c < expect[k].min_clearance_mm) expect[k].min_clearance_mm = c, expect[k].min_clearance_s = t;
+        if (c < 0 && !expect[k].collided) expect[k].collided = true, expect[k].first_collision_s = t;
+      }
+    }
+    for (std::size_t k = 0; k < expect.size(); ++k) {
+      EXPECT_EQ(r.robot_pairs[k].collided, expect[k].collided) << k;
+      EXPECT_NEAR(r.robot_pairs[k].min_clearance_mm, expect[k].min_clearance_mm, 1e-9) << k;
+      if (expect[k].collided) {
+        EXPECT_NEAR(r.robot_pairs[k].first_collision_s, expect[k].first_collision_s, 1e-12) << k;
+      }
+    }
+  }
+}
+
+TEST(PlanChecker, RejectsBadTrajectories) {
+  Sweep s;
+  TrajectoryChecker checker(s.model);
+  CheckReport r;
+  EXPECT_EQ(checker.check(std::span(s.traj).first(1), {}, r).error(), PlanErrc::bad_trajectory);
+  auto bad = s.traj;
+  bad[1].beta = {{2, 0}, {1, 5}};
+  auto e = checker.check(bad, {}, r);
+  ASSERT_FALSE(e);
+  EXPECT_EQ(e.error(), PlanErrc::bad_trajectory);
+  EXPECT_NE(e.error().detail.find("robot 2"), std::string::npos);
+  bad[1].beta.clear();
+  EXPECT_EQ(checker.check(bad, {}, r).error(), PlanErrc::bad_trajectory);
+}
+
+TEST(PlanTrajectory, InterpolationAndCursor) {
+  const std::vector<TimedAngle> pts{{1, 10}, {3, 30}, {4, 0}};
+  EXPECT_DOUBLE_EQ(angle_at(pts, 0), 10);
+  EXPECT_DOUBLE_EQ(angle_at(pts, 2), 20);
+  EXPECT_DOUBLE_EQ(angle_at(pts, 3.5), 15);
+  EXPECT_DOUBLE_EQ(angle_at(pts, 9), 0);
+  EXPECT_DOUBLE_EQ(max_speed(pts), 30);
+  AngleCursor c(pts);
+  for (double t = 0; t <= 5; t += 0.25) EXPECT_DOUBLE_EQ(c.at(t), angle_at(pts, t)) << t;
+  EXPECT_DOUBLE_EQ(c.at(2), 20);  // going back restarts
+}
+
+}  // namespace
+}  // namespace axon::fps::plan
