@@ -186,6 +186,7 @@ void Controller::encode_cyclic(std::int32_t force_mode) {
     const AxisSim& ax = axes_[i];
     P::Axis& a = p.axes[i];
     a.mode = phase_ == Phase::sync ? 0 : (force_mode != 0 ? force_mode : ax.mode);
+    axes_[i].sent_mode = a.mode;
     a.d1 = static_cast<float>(ax.ref_pos);
     a.d2 = static_cast<float>(ax.ref_vel * period_);
     a.d3 = static_cast<float>(ax.model.position());
@@ -406,7 +407,8 @@ void Controller::handle_request(std::size_t i, std::int32_t req) {
   const std::int32_t cur = ax.mode;
   const bool repeated = req == ax.last_request;
   ax.last_request = req;
-  if (req == cur) return;
+  // The PC answers the packet it got: repeating that packet's code is no request.
+  if (req == cur || req == ax.sent_mode) return;
   const bool pc_special = req == P::code(P::Mode::freezing_active) || req == P::code(P::Mode::drive_off) ||
                           req == P::code(P::Mode::server_restart) || req == P::code(P::Mode::following_error);
   auto refuse = [&](std::string_view why) {
@@ -472,7 +474,7 @@ void Controller::set_mode(std::size_t i, std::int32_t mode, std::string_view) {
   const std::int32_t base = base_mode(mode);
   if ((base == 1 || base == 2) && base_mode(ax.mode) != base) {
     ax.hold_pos = ax.model.position();
-    ax.scs = 0;
+    ax.scs = robot_.scs_ramp_s > 0 ? 0.0 : 1.0;  // no ramp: the PC's current applies at once
   }
   ax.mode = mode;
 }
@@ -713,7 +715,8 @@ void Controller::step_physics() {
       c.position = ax.prev_ref_pos + (dsa_ref - ax.prev_ref_pos) * k / dsa_ticks;
       ax.model.step(c, powered);
     }
-    if (ax.model.saturated()) ++stats_.saturated_cycles;
+    const bool pc_current = base == 1 || base == 2 || base == 9;
+    if (ax.model.saturated() || (pc_current && a.powered && std::fabs(pc.d5) > limit)) ++stats_.saturated_cycles;
     ax.prev_ref_pos = dsa_ref;
     ax.dsa_ref = dsa_ref;
     ax.ref_pos = reported;

@@ -138,6 +138,7 @@ class Controller {
     double scs = 0;           // soft control switching: 0 = DSA, 1 = PC
     protocol::Axis pc{};      // the PC's data from the last good reply
     std::int32_t last_request = 0;
+    std::int32_t sent_mode = 0;   // the code in the last packet sent
     float measure = 0;        // 1xx: the last measure from the PC
     ExitSeq exit;
   };
