@@ -13,6 +13,8 @@ struct GlobalOptions {
 void add_can_commands(CLI::App& app, GlobalOptions& global);
 void add_demo_command(CLI::App& app, GlobalOptions& global);
 void add_sim_commands(CLI::App& app, GlobalOptions& global);
+// `axon sim c4g`, registered by add_sim_commands under `sim` (apps/axon/sim_c4g.cpp).
+void add_sim_c4g_command(CLI::App& sim_cmd);
 void add_fps_commands(CLI::App& app, GlobalOptions& global);
 
 // Exit code chosen by the subcommand that ran.

@@ -137,6 +137,7 @@ void add_sim_commands(CLI::App& app, GlobalOptions&) {
   f->add_option("--duration", fps.duration_s, "stop after this many seconds (default: until Ctrl-C)");
   f->get_option("--config")->excludes("--robots")->excludes("--buses");
   f->callback([] { exit_code() = run_sim_fps(fps); });
+  add_sim_c4g_command(*sim_cmd);
 }
 
 }  // namespace axon::app
