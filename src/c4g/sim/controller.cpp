@@ -319,7 +319,6 @@ void Controller::end_cycle() {
   if (phase_ != Phase::failed) advance_modes();
   if (scenario_started_) run_scenario();
 
-  ++stats_.ticks;
   awaiting_ = false;
 
   for (std::size_t arm = 1; arm <= P::kMaxArms; ++arm) {
@@ -342,6 +341,7 @@ void Controller::end_cycle() {
       emit(EventLevel::info, event::kModeChange, std::move(text));
     }
   }
+  ++stats_.ticks;
 }
 
 void Controller::cyclic_tick() {
