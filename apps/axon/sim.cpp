@@ -233,6 +233,8 @@ void add_sim_commands(CLI::App& app, GlobalOptions&) {
   b->add_option("--fault-plan", blmc.fault_plan, "fault plan YAML (docs/blmc-simulator.md)");
   b->add_option("--duration", blmc.duration_s, "stop after this many seconds (default: until Ctrl-C)");
   b->callback([] { exit_code() = run_sim_blmc(blmc); });
+
+  add_sim_c4g_command(*sim_cmd);
 }
 
 }  // namespace axon::app
