@@ -110,6 +110,7 @@ void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) 
     case Phase::waiting:
       if (!all_in || stop_requested()) return;
       t_ = 0;
+      ticks_ = 0;
       last_ = {};
       set_phase(Phase::correcting);
       ph = Phase::correcting;
@@ -133,7 +134,7 @@ void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) 
       break;
   }
 
-  t_ += period;
+  t_ = static_cast<double>(++ticks_) * period;
   elapsed_.store(t_, std::memory_order_relaxed);
   double env = 1.0;
   if (ph == Phase::correcting) {
@@ -151,7 +152,8 @@ void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) 
   }
   if (ph == Phase::fading) {
     env = options_.ramp_s > 0 ? std::max(0.0, 1.0 - (t_ - fade_start_) / options_.ramp_s) : 0.0;
-    if (env <= 0.0) {
+    if (env < 1e-9) {
+      env = 0.0;
       set_phase(Phase::exiting);
       ph = Phase::exiting;
     }

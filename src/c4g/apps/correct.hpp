@@ -64,6 +64,7 @@ class CorrectApp final : public App {
   std::array<double, protocol::kAxesPerArm> amplitude_{}, frequency_{};
   std::array<double, protocol::kAxesPerArm> last_{};  // last motor-side correction
   double t_ = 0;
+  std::uint64_t ticks_ = 0;
   double fade_start_ = 0;
 };
 

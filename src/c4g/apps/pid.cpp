@@ -80,6 +80,7 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
       last_ref_[j] = hold_[j];
     }
     t_ = 0;
+    ticks_ = 0;
     env_ = 0;
     mode_ = mode1 ? 1 : 2;
     active_mode_.store(mode_, std::memory_order_relaxed);
@@ -100,7 +101,7 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
 
   const bool leaving_by_pc = mode_ == 1;
   if (m0 == code(Mode::mode1)) {
-    t_ += period;
+    t_ = static_cast<double>(++ticks_) * period;
     elapsed_.store(t_, std::memory_order_relaxed);
     if (ph == Phase::controlling) {
       env_ = options_.ramp_s > 0 ? std::min(1.0, t_ / options_.ramp_s) : 1.0;
@@ -112,13 +113,14 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
     }
     if (ph == Phase::fading) {
       env_ = options_.ramp_s > 0 ? std::max(0.0, env_ - period / options_.ramp_s) : 0.0;
-      if (env_ <= 0.0) {
+      if (env_ < 1e-9) {
+        env_ = 0.0;
         set_phase(Phase::exiting);
         ph = Phase::exiting;
       }
     }
   } else if (m0 == code(Mode::mode2)) {
-    t_ += period;
+    t_ = static_cast<double>(++ticks_) * period;
     elapsed_.store(t_, std::memory_order_relaxed);
   }
 

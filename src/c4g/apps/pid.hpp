@@ -94,6 +94,7 @@ class PidApp final : public App {
   std::array<double, protocol::kAxesPerArm> hold_{};      // motor position when mode 1 started
   std::array<double, protocol::kAxesPerArm> last_ref_{};  // last mode-1 target
   double t_ = 0;
+  std::uint64_t ticks_ = 0;
   double env_ = 0;
   std::int32_t mode_ = 0;  // 1 or 2 while controlling
 };

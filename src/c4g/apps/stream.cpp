@@ -65,7 +65,7 @@ void StreamApp::setup(const protocol::InitPacket& init, const protocol::AxisMap&
         return;
       }
     }
-  hold_cycles_ = static_cast<std::size_t>(std::ceil(options_.hold_s / period));
+  hold_cycles_ = static_cast<std::size_t>(std::ceil(options_.hold_s / period - 1e-9));
 }
 
 double StreamApp::command(std::size_t j, double s) const noexcept {
@@ -151,6 +151,7 @@ void StreamApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
   if (ph == Phase::playing) {
     if (stop_requested() && rate_ == 1.0) note(kNoteStopping);
     if (stop_requested()) rate_ = std::max(0.0, rate_ - view_->period_s / std::max(options_.stop_ramp_s, view_->period_s));
+    if (rate_ < 1e-9) rate_ = 0;
     s_ += rate_;
     if (s_ >= static_cast<double>(rows_ - 1)) {
       s_ = static_cast<double>(rows_ - 1);
