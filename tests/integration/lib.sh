@@ -55,7 +55,7 @@ start_sim_fps() {
 # skip_without_sim_c4g: ends the test with success when this axon has no `axon sim c4g` yet (the
 # simulator is developed on its own branch).
 skip_without_sim_c4g() {
-  if ! "$AXON" sim c4g --help >/dev/null 2>&1; then echo "SKIP: axon sim c4g not available"; exit 0; fi
+  if ! "$AXON" sim --help 2>/dev/null | grep -Eq '^ +c4g '; then echo "SKIP: axon sim c4g not available"; exit 0; fi
 }
 # start_c4g_serve ARGS...: starts `axon c4g serve --listen 127.0.0.1:0 ARGS` in the background; sets
 # C4G_PORT and SERVE_PID.
