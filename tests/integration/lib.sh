@@ -50,3 +50,36 @@ start_sim_fps() {
     esac
   done
 }
+
+# ---- c4g ----
+# skip_without_sim_c4g: ends the test with success when this axon has no `axon sim c4g` yet (the
+# simulator is developed on its own branch).
+skip_without_sim_c4g() {
+  if ! "$AXON" sim --help 2>/dev/null | grep -Eq '^ +c4g '; then echo "SKIP: axon sim c4g not available"; exit 0; fi
+}
+# start_c4g_serve ARGS...: starts `axon c4g serve --listen 127.0.0.1:0 ARGS` in the background; sets
+# C4G_PORT and SERVE_PID.
+start_c4g_serve() {
+  "$AXON" c4g serve --listen 127.0.0.1:0 --status-interval 0.5 "$@" >"$TMP/serve.out" 2>"$TMP/serve.err" &
+  SERVE_PID=$!
+  PIDS+=($SERVE_PID)
+  C4G_PORT=$(wait_for_line "$TMP/serve.out" '^listening c4g ' | sed 's/.*://')
+}
+# run_sim_c4g SCENARIO_YAML [ARGS...]: runs the six-axis simulator against the server until its
+# scenario ends; SIM_RC holds its exit code.
+run_sim_c4g() {
+  local scenario=$1
+  shift
+  printf '%s\n' "$scenario" >"$TMP/scenario.yaml"
+  SIM_RC=0
+  timeout 60 "$AXON" sim c4g --robot six-axis --server "127.0.0.1:$C4G_PORT" --scenario "$TMP/scenario.yaml" "$@" \
+    >"$TMP/sim.out" 2>"$TMP/sim.err" || SIM_RC=$?
+}
+# wait_serve [SECONDS]: waits for the server to exit by itself; SERVE_RC holds its exit code.
+wait_serve() {
+  local limit=${1:-20} i=0
+  while kill -0 "$SERVE_PID" 2>/dev/null && [ $i -lt $((limit * 20)) ]; do sleep 0.05; i=$((i + 1)); done
+  kill -0 "$SERVE_PID" 2>/dev/null && fail "axon c4g serve did not stop"
+  SERVE_RC=0
+  wait "$SERVE_PID" || SERVE_RC=$?
+}

@@ -1,0 +1,383 @@
+// `axon c4g`: the PC side of the robot controller's open interface.
+//   serve      runs a c4g::host::Server with one of the built-in applications (src/c4g/apps)
+//   init-info  prints an initialization packet from a 1200-byte file or from a capture
+// The ready line `listening c4g HOST:PORT`, events and status lines go to stdout; logs to stderr.
+#include "c4g/apps/app.hpp"
+#include "c4g/apps/correct.hpp"
+#include "c4g/apps/echo.hpp"
+#include "c4g/apps/moni.hpp"
+#include "c4g/apps/monitor.hpp"
+#include "c4g/apps/pid.hpp"
+#include "c4g/apps/stream.hpp"
+#include "c4g/apps/trajectory.hpp"
+#include "c4g/host/server.hpp"
+#include "c4g/protocol/axis_map.hpp"
+#include "c4g/protocol/init_packet.hpp"
+#include "commands.hpp"
+#include "net/endpoint.hpp"
+#include "run.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <pcap/pcap.h>
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <numbers>
+#include <thread>
+
+namespace axon::app {
+namespace {
+
+namespace apps = c4g::apps;
+namespace host = c4g::host;
+namespace protocol = c4g::protocol;
+using json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+struct ServeOptions {
+  std::string listen = fmt::format("{}:{}", host::kDefaultServerAddress, host::kDefaultPort);
+  std::string app;
+  // stream / correct / pid
+  std::string file;
+  int mode = 4;
+  std::string units;
+  bool relative = false;
+  double start_tolerance_deg = 0.5;
+  double max_motor_speed = 100.0;
+  std::size_t arm = 1;
+  std::vector<double> amplitude_deg;
+  std::vector<double> frequency_hz;
+  double open_time_s = 0;
+  double ramp_s = 0.5;
+  std::vector<double> kp, kv, ki;
+  bool no_dynamic_model = false;
+  // recording
+  int moni = -1;
+  std::string csv;
+  // server
+  std::string numbering = "same";
+  std::string pcap;
+  int rt_priority = 0;
+  std::vector<int> cpus;
+  bool busy_poll = false;
+  double max_step = 0;
+  double duration_s = 0;
+  double status_interval_s = 1.0;
+  double stop_timeout_s = 5.0;
+  bool json = false;
+};
+
+std::atomic<int> g_signals{0};
+extern "C" void on_stop_signal(int) { g_signals.fetch_add(1); }
+
+Exception bad(std::string text) { return Exception(Error(CoreErrc::invalid_argument, std::move(text))); }
+
+std::vector<double> deg_to_rad(const std::vector<double>& v) {
+  std::vector<double> out;
+  for (double d : v) out.push_back(d * std::numbers::pi / 180.0);
+  return out;
+}
+
+std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
+  std::optional<apps::AngleUnit> unit;
+  if (!o.units.empty()) {
+    unit = apps::parse_angle_unit(o.units);
+    if (!unit) throw bad("--units must be rad or deg");
+  }
+  if (o.app == "monitor") return std::make_unique<apps::MonitorApp>();
+  if (o.app == "echo") return std::make_unique<apps::EchoApp>();
+  if (o.app == "stream") {
+    if (o.file.empty()) throw bad("--app stream needs --file TRAJECTORY.csv");
+    apps::StreamOptions s;
+    s.trajectory = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(o.file, unit)));
+    s.mode = o.mode;
+    s.arm = o.arm;
+    s.relative = o.relative;
+    s.start_tolerance_rad = o.start_tolerance_deg * std::numbers::pi / 180.0;
+    s.max_motor_speed = o.max_motor_speed;
+    s.stop_ramp_s = std::min(o.ramp_s, 0.5);
+    if (o.mode != 4 && o.mode != 5) throw bad("--app stream: --mode must be 4 or 5");
+    return std::make_unique<apps::StreamApp>(std::move(s));
+  }
+  if (o.app == "correct") {
+    apps::CorrectOptions c;
+    c.arm = o.arm;
+    if (!o.file.empty()) c.values = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(o.file, unit)));
+    c.amplitude_rad = deg_to_rad(o.amplitude_deg);
+    c.frequency_hz = o.frequency_hz;
+    c.open_time_s = o.open_time_s;
+    c.ramp_s = o.ramp_s;
+    c.max_motor_speed = o.max_motor_speed;
+    return std::make_unique<apps::CorrectApp>(std::move(c));
+  }
+  if (o.app == "pid") {
+    apps::PidOptions p;
+    p.arm = o.arm;
+    p.amplitude_rad = deg_to_rad(o.amplitude_deg);
+    p.frequency_hz = o.frequency_hz;
+    p.open_time_s = o.open_time_s;
+    p.ramp_s = o.ramp_s;
+    p.dynamic_model_feedforward = !o.no_dynamic_model;
+    const std::size_t n = std::max({o.kp.size(), o.kv.size(), o.ki.size()});
+    auto pick = [](const std::vector<double>& v, std::size_t i, double def) {
+      return v.empty() ? def : (i < v.size() ? v[i] : v.back());
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      const apps::PidGains d;
+      p.gains.push_back({pick(o.kp, i, d.kp), pick(o.kv, i, d.kv), pick(o.ki, i, d.ki)});
+    }
+    return std::make_unique<apps::PidApp>(std::move(p));
+  }
+  throw bad(fmt::format("unknown --app '{}' (monitor, echo, stream, correct, pid)", o.app));
+}
+
+json timing_json(const host::Server& server) {
+  const auto& t = server.cycle().timing();
+  const auto& h = t.cycle_times();
+  auto s = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-9; };
+  return json{{"cycles", t.cycles()},
+              {"worst_cycle_time_s", s(t.worst_cycle_time_ns())},
+              {"inter_packet_period_s", {s(t.min_inter_step_ns()), s(t.max_inter_step_ns())}},
+              {"jitter_s", {s(t.min_jitter_ns()), s(t.max_jitter_ns())}},
+              {"jitter_percent", {t.min_percent_jitter(), t.max_percent_jitter()}},
+              {"cycle_time_p50_s", s(h.percentile(50))},
+              {"cycle_time_p99_s", s(h.percentile(99))},
+              {"cycle_time_p999_s", s(h.percentile(99.9))},
+              {"cycle_time_max_s", s(h.max())},
+              {"missed_deadlines", t.missed_deadlines()},
+              {"deadline_s", s(t.config().deadline_ns)}};
+}
+
+int run_serve(const ServeOptions& o) {
+  auto app = make_app(o);
+  host::ServerOptions so;
+  so.listen = need(net::parse_endpoint(o.listen, host::kDefaultPort));
+  if (o.numbering == "same") so.numbering = protocol::ReplyNumbering::same;
+  else if (o.numbering == "next") so.numbering = protocol::ReplyNumbering::next;
+  else throw bad("--numbering must be same or next");
+  so.pcap_path = o.pcap;
+  so.cycle.realtime.fifo_priority = o.rt_priority;
+  so.cycle.realtime.lock_memory = o.rt_priority > 0;
+  so.cycle.realtime.cpus = o.cpus;
+  so.udp.busy_poll = o.busy_poll;
+  if (o.max_step > 0)
+    for (auto& a : so.safety.axes) a.max_step = static_cast<float>(o.max_step);
+
+  std::unique_ptr<apps::MoniCsvWriter> csv;
+  if (!o.csv.empty()) {
+    csv = need(apps::MoniCsvWriter::open(o.csv, o.moni < 0 ? 0 : o.moni));
+    app->record_samples(8192);
+  } else if (o.moni >= 0) {
+    throw bad("--moni needs --csv FILE");
+  }
+
+  struct sigaction sa{};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+
+  auto server = need(host::Server::start(*app, so));
+  std::printf("listening c4g %s\n", server->local_address().to_string().c_str());
+  std::fflush(stdout);
+  for (const auto& step : server->realtime_report().steps)
+    if (!step.granted) spdlog::warn("c4g serve: {} refused: {}", step.name, step.reason);
+
+  const auto start = Clock::now();
+  auto next_status = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.status_interval_s));
+  auto pump = [&] {
+    for (const auto& e : app->drain_events())
+      std::printf("event cycle %llu: %s\n", static_cast<unsigned long long>(e.cycle), app->describe(e).c_str());
+    if (csv) app->drain_samples([&](const apps::Sample& s) { csv->write(s.cycle, s.wall_ns, s.request, s.reply); });
+    std::fflush(stdout);
+  };
+  auto status_line = [&] {
+    const auto& t = server->cycle().timing();
+    std::printf("status %s | %s | cycle time last %.1f us worst %.1f us, missed %llu\n", app->status().c_str(),
+                std::string(host::to_string(server->state())).c_str(), static_cast<double>(t.last_cycle_time_ns()) * 1e-3,
+                static_cast<double>(t.worst_cycle_time_ns()) * 1e-3, static_cast<unsigned long long>(t.missed_deadlines()));
+  };
+
+  std::string why = "stopped";
+  while (true) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    pump();
+    const auto now = Clock::now();
+    if (g_signals.load() > 0) { why = "signal"; break; }
+    if (o.duration_s > 0 && now - start >= std::chrono::duration<double>(o.duration_s)) { why = "duration reached"; break; }
+    if (app->finished()) { why = "application finished"; break; }
+    if (app->has_error()) {
+      why = "application error";
+      if (app->drive_off_on_error()) server->safety().trip(host::FaultReason::user_request);
+      break;
+    }
+    if (app->controller_exited()) { why = "controller ended the exchange (504)"; break; }
+    if (o.status_interval_s > 0 && now >= next_status) {
+      status_line();
+      next_status = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.status_interval_s));
+    }
+  }
+
+  // Leave cleanly: the app ends its open modes (replies stay safe meanwhile); if the controller does
+  // not come back to mode 0 in time, ask for drive off and give it a moment to obey.
+  spdlog::info("c4g serve: stopping ({})", why);
+  app->request_stop();
+  auto settled = [&] {
+    return app->quiescent() || server->state() == host::ServerState::silent ||
+           server->state() == host::ServerState::waiting || app->controller_exited();
+  };
+  auto wait_until = [&](double seconds) {
+    const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    while (!settled() && Clock::now() < until && g_signals.load() < 2) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      pump();
+    }
+    return settled();
+  };
+  if (!wait_until(o.stop_timeout_s)) {
+    spdlog::warn("c4g serve: the controller is still in an open mode after {} s: asking for drive off", o.stop_timeout_s);
+    server->safety().trip(host::FaultReason::user_request);
+    wait_until(1.0);
+  }
+  server->stop();
+  pump();
+  if (csv) csv->flush();
+
+  const bool faulted = server->safety().faulted() && server->safety().reason() != host::FaultReason::user_request;
+  const int rc = app->has_error() || faulted ? 1 : 0;
+  if (o.json) {
+    const auto& c = server->counters();
+    json j{{"app", std::string(app->name())},
+           {"reason", why},
+           {"app_cycles", app->cycles()},
+           {"finished", app->finished()},
+           {"error", app->error()},
+           {"packets", c.packets.load()},
+           {"init_packets", c.init_packets.load()},
+           {"cyclic_packets", c.cyclic_packets.load()},
+           {"protocol_errors", c.protocol_errors.load()},
+           {"safe_replies", c.safe_replies.load()},
+           {"refused_mode_changes", c.refused_mode_changes.load()},
+           {"controller_late", c.controller_late.load()},
+           {"safety_fault", std::string(host::to_string(server->safety().reason()))},
+           {"currents_clamped", server->safety().counters().currents_clamped.load()},
+           {"timing", timing_json(*server)}};
+    if (csv) j["csv_rows"] = csv->rows();
+    if (server->recorder()) j["pcap_written"] = server->recorder()->written();
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("stopped: %s\n%s%s", why.c_str(), server->summary().c_str(), app->summary().c_str());
+    if (csv) std::printf("CSV %s: %llu rows (moni type %d)\n", csv->path().c_str(), static_cast<unsigned long long>(csv->rows()),
+                         o.moni < 0 ? 0 : o.moni);
+    if (app->has_error()) std::printf("error: %s\n", app->error().c_str());
+  }
+  std::fflush(stdout);
+  return rc;
+}
+
+// The first 1200-byte UDP payload of a capture (Ethernet / IPv4 / UDP, as PcapRecorder and
+// tcpdump on an Ethernet interface write them).
+std::vector<std::byte> init_from_pcap(const std::string& path) {
+  char err[PCAP_ERRBUF_SIZE] = {};
+  pcap_t* p = pcap_open_offline(path.c_str(), err);
+  if (!p) throw bad(fmt::format("cannot read capture {}: {}", path, err));
+  std::vector<std::byte> out;
+  const int link = pcap_datalink(p);
+  pcap_pkthdr* hdr = nullptr;
+  const u_char* data = nullptr;
+  while (out.empty() && pcap_next_ex(p, &hdr, &data) == 1) {
+    std::size_t off = link == DLT_EN10MB ? 14 : (link == DLT_RAW ? 0 : SIZE_MAX);
+    if (off == SIZE_MAX || hdr->caplen < off + 28) continue;
+    if (link == DLT_EN10MB && (data[12] != 0x08 || data[13] != 0x00)) continue;
+    const std::size_t ihl = (data[off] & 0x0F) * 4u;
+    if ((data[off] >> 4) != 4 || data[off + 9] != 17) continue;
+    const std::size_t udp = off + ihl;
+    const std::size_t len = (static_cast<std::size_t>(data[udp + 4]) << 8 | data[udp + 5]);
+    if (len != 8 + protocol::kInitPacketSize || hdr->caplen < udp + len) continue;
+    const auto* payload = reinterpret_cast<const std::byte*>(data + udp + 8);
+    out.assign(payload, payload + protocol::kInitPacketSize);
+  }
+  pcap_close(p);
+  if (out.empty()) throw bad(fmt::format("{}: no 1200-byte initialization packet in the capture", path));
+  return out;
+}
+
+int run_init_info(const std::string& file, bool from_pcap) {
+  std::vector<std::byte> bytes;
+  if (from_pcap) {
+    bytes = init_from_pcap(file);
+  } else {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw bad(fmt::format("cannot open {}", file));
+    std::vector<char> raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (char c : raw) bytes.push_back(static_cast<std::byte>(c));
+  }
+  const auto init = need(protocol::decode_init(bytes));
+  std::printf("%s", protocol::to_string(init).c_str());
+  auto map = protocol::AxisMap::from_init(init);
+  if (!map) {
+    std::printf("axis map: %s\n", map.error().detail.c_str());
+    return 1;
+  }
+  for (std::size_t i = 0; i < map.value().count(); ++i) {
+    const auto ref = map.value().logical(i);
+    std::printf("open axis %zu = arm %u axis %u\n", i + 1, static_cast<unsigned>(ref.arm), static_cast<unsigned>(ref.axis));
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_c4g_commands(CLI::App& app, GlobalOptions&) {
+  auto* c4g = app.add_subcommand("c4g", "robot controller open interface: the PC-side real-time server");
+  c4g->require_subcommand(1);
+
+  static ServeOptions so;
+  auto* s = c4g->add_subcommand("serve", "serve the controller's packets with a built-in application (docs/c4g-cli.md)");
+  s->add_option("--listen", so.listen, "HOST:PORT to serve on (default the manual's 10.2.12.149:1000; port 0: any)");
+  s->add_option("--app", so.app, "monitor (mode 0), echo (0'), stream (4/5), correct (7), pid (1/2)")->required();
+  s->add_option("--file", so.file, "stream: trajectory CSV; correct: correction values CSV");
+  s->add_option("--mode", so.mode, "stream: 4 (absolute targets) or 5 (increments)");
+  s->add_option("--units", so.units, "angles in the CSV: rad or deg (else the file's '# units:' line, else rad)");
+  s->add_flag("--relative", so.relative, "stream: the trajectory is offsets from the robot's position at the start");
+  s->add_option("--start-tolerance", so.start_tolerance_deg, "stream: start-point tolerance [deg] (default 0.5)");
+  s->add_option("--max-motor-speed", so.max_motor_speed, "continuity limit [motor turns/s] (default 100)");
+  s->add_option("--arm", so.arm, "the arm the application drives (default 1)")->check(CLI::Range(1, 4));
+  s->add_option("--amplitude", so.amplitude_deg, "correct/pid: sine amplitude per axis [deg, link side]")->delimiter(',');
+  s->add_option("--frequency", so.frequency_hz, "correct/pid: sine frequency per axis [Hz] (default 0.5)")->delimiter(',');
+  s->add_option("--open-time", so.open_time_s, "correct/pid: leave the open mode after this long [s] (0: until stopped)");
+  s->add_option("--ramp", so.ramp_s, "fade in/out time of corrections and sines [s] (default 0.5)");
+  s->add_option("--kp", so.kp, "pid: position gain per axis [1/s]")->delimiter(',');
+  s->add_option("--kv", so.kv, "pid: velocity gain per axis [A/(turn/s)]")->delimiter(',');
+  s->add_option("--ki", so.ki, "pid: velocity integral rate per axis [1/s]")->delimiter(',');
+  s->add_flag("--no-dynamic-model", so.no_dynamic_model, "pid: do not feed the controller's dynamic-model current forward");
+  s->add_option("--moni", so.moni, "with --csv: monitoring view 19..24 of the manual (default 0: every field)");
+  s->add_option("--csv", so.csv, "write every cycle to this CSV file");
+  s->add_option("--numbering", so.numbering, "reply number: same (the manual) or next (NUM + 1)");
+  s->add_option("--pcap", so.pcap, "record every datagram into this pcap file");
+  s->add_option("--rt-priority", so.rt_priority, "SCHED_FIFO priority of the cycle thread (and mlockall)")->check(CLI::Range(0, 99));
+  s->add_option("--cpu", so.cpus, "pin the cycle thread to this CPU (repeatable)");
+  s->add_flag("--busy-poll", so.busy_poll, "spin on the socket instead of sleeping (a dedicated core)");
+  s->add_option("--max-step", so.max_step, "Safety: max change of a commanded position per cycle [motor turns] (0: off)");
+  s->add_option("--duration", so.duration_s, "stop after this many seconds (default: until Ctrl-C or the app finishes)");
+  s->add_option("--status-interval", so.status_interval_s, "seconds between status lines (0: none; default 1)");
+  s->add_option("--stop-timeout", so.stop_timeout_s, "seconds to wait for mode 0 when stopping before drive off (default 5)");
+  s->add_flag("--json", so.json, "print the final report as JSON");
+  s->callback([] { exit_code() = run_serve(so); });
+
+  static std::string init_file;
+  static bool from_pcap = false;
+  auto* i = c4g->add_subcommand("init-info", "print an initialization packet (1200-byte file, or the first one in a pcap)");
+  i->add_option("file", init_file, "the file")->required();
+  i->add_flag("--from-pcap", from_pcap, "the file is a capture: use its first 1200-byte UDP payload");
+  i->callback([] { exit_code() = run_init_info(init_file, from_pcap); });
+}
+
+}  // namespace axon::app

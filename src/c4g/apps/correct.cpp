@@ -1,0 +1,207 @@
+#include "c4g/apps/correct.hpp"
+
+#include "c4g/protocol/mode.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace axon::c4g::apps {
+
+using protocol::code;
+using protocol::Mode;
+
+CorrectApp::CorrectApp(CorrectOptions options) : options_(std::move(options)) {
+  for (auto& a : applied_) a.store(0, std::memory_order_relaxed);
+  if (!options_.values && options_.amplitude_rad.empty())
+    throw Exception(Error(CoreErrc::invalid_argument, "correct: give amplitudes (a sine) or a file of values"));
+  if (options_.ramp_s < 0 || options_.open_time_s < 0)
+    throw Exception(Error(CoreErrc::invalid_argument, "correct: times must not be negative"));
+}
+
+void CorrectApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) {
+  if (phase() == Phase::done || phase() == Phase::refused) return;
+  set_phase(Phase::waiting);
+  auto v = make_arm_view(init, axes, options_.arm);
+  if (!v) {
+    fail("correct: %s", v.error().detail.c_str());
+    set_phase(Phase::refused);
+    return;
+  }
+  view_ = std::move(v).value();
+  const std::size_t n = view_->count;
+  const double period = view_->period_s;
+  const double max_step = options_.max_motor_speed * period;
+  if (options_.values) {
+    const Trajectory& f = *options_.values;
+    if (f.axes() != n) {
+      fail("correct: the file has %zu axes, arm %zu has %zu", f.axes(), options_.arm, n);
+      set_phase(Phase::refused);
+      return;
+    }
+    // Continuity of the file as it will be played, from a zero correction.
+    protocol::ArmTransform::Vector link(static_cast<Eigen::Index>(n)), prev = protocol::ArmTransform::Vector::Zero(static_cast<Eigen::Index>(n));
+    const auto rows = static_cast<std::size_t>(std::ceil(f.end_time() / period)) + 1;
+    for (std::size_t k = 1; k <= rows; ++k) {
+      correction(static_cast<double>(k) * period, 1.0, link);
+      const auto step = view_->transform.motor_velocity(link - prev);
+      for (std::size_t j = 0; j < n; ++j)
+        if (std::fabs(step[static_cast<Eigen::Index>(j)]) > max_step) {
+          fail("correct: the correction is not continuous: axis %zu moves %.4f motor turns in one cycle at t=%.3f s "
+               "(limit %.4f)",
+               j + 1, std::fabs(step[static_cast<Eigen::Index>(j)]), static_cast<double>(k) * period, max_step);
+          set_phase(Phase::refused);
+          return;
+        }
+      prev = link;
+    }
+  } else {
+    for (std::size_t j = 0; j < n; ++j) {
+      const auto& a = options_.amplitude_rad;
+      const auto& f = options_.frequency_hz;
+      amplitude_[j] = a.size() == 1 ? a[0] : (j < a.size() ? a[j] : 0.0);
+      frequency_[j] = f.empty() ? 0.5 : (f.size() == 1 ? f[0] : (j < f.size() ? f[j] : 0.0));
+    }
+    // Peak motor speed: |K_r| times the link peak speeds 2 pi f A (over 2 pi per turn).
+    const auto& kr = view_->transform.kr();
+    for (std::size_t i = 0; i < n; ++i) {
+      double peak = 0;
+      for (std::size_t j = 0; j < n; ++j)
+        peak += std::fabs(kr(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j))) * std::fabs(frequency_[j] * amplitude_[j]);
+      if (peak > options_.max_motor_speed) {
+        fail("correct: the sine needs up to %.1f motor turns/s on axis %zu (limit %.1f)", peak, i + 1, options_.max_motor_speed);
+        set_phase(Phase::refused);
+        return;
+      }
+    }
+  }
+}
+
+void CorrectApp::correction(double t, double env, protocol::ArmTransform::Vector& link) const noexcept {
+  const std::size_t n = view_->count;
+  if (options_.values) {
+    std::array<double, protocol::kAxesPerArm> pos{}, vel{};
+    options_.values->sample(t, std::span<double>(pos.data(), n), std::span<double>(vel.data(), n));
+    for (std::size_t j = 0; j < n; ++j) link[static_cast<Eigen::Index>(j)] = env * pos[j];
+  } else {
+    for (std::size_t j = 0; j < n; ++j)
+      link[static_cast<Eigen::Index>(j)] = env * amplitude_[j] * std::sin(2.0 * std::numbers::pi * frequency_[j] * t);
+  }
+}
+
+void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
+  if (!view_) return;
+  const auto& req = ctx.request;
+  const std::size_t n = view_->count, first = view_->first;
+  if (first + n > req.count) return;
+  bool all_in = true;
+  for (std::size_t j = 0; j < n; ++j) all_in = all_in && req.axes[first + j].mode == code(Mode::mode7);
+  const std::int32_t m0 = req.axes[first].mode;
+  Phase ph = phase();
+  const double period = view_->period_s;
+
+  switch (ph) {
+    case Phase::done: return;
+    case Phase::refused:
+      if (all_in) exit_from_open(reply, view_->arm);  // the safe reply adds nothing
+      return;
+    case Phase::waiting:
+      if (!all_in || stop_requested()) return;
+      t_ = 0;
+      ticks_ = 0;
+      last_ = {};
+      set_phase(Phase::correcting);
+      ph = Phase::correcting;
+      note(kNoteStarted);
+      break;
+    case Phase::exiting:
+      if (m0 == code(Mode::mode0)) {
+        set_phase(Phase::done);
+        note(kNoteDone);
+        return;
+      }
+      if (all_in) exit_from_open(reply, view_->arm);
+      return;  // 7, 7', 7'': zero increments (the safe reply)
+    case Phase::correcting:
+    case Phase::fading:
+      if (!all_in) {
+        fail("correct: the controller left mode 7 during the correction (axis 1 of arm %zu in mode %d)", view_->arm, m0);
+        set_phase(Phase::refused);
+        return;
+      }
+      break;
+  }
+
+  t_ = static_cast<double>(++ticks_) * period;
+  elapsed_.store(t_, std::memory_order_relaxed);
+  double env = 1.0;
+  if (ph == Phase::correcting) {
+    const bool file_end = options_.values && t_ >= options_.values->end_time() && !stop_requested();
+    const bool time_up = options_.open_time_s > 0 && t_ >= options_.open_time_s;
+    if (file_end) {
+      set_phase(Phase::exiting);
+      ph = Phase::exiting;
+    } else if (stop_requested() || time_up) {
+      fade_start_ = t_;
+      set_phase(Phase::fading);
+      ph = Phase::fading;
+      note(kNoteFading);
+    }
+  }
+  if (ph == Phase::fading) {
+    env = options_.ramp_s > 0 ? std::max(0.0, 1.0 - (t_ - fade_start_) / options_.ramp_s) : 0.0;
+    if (env < 1e-9) {
+      env = 0.0;
+      set_phase(Phase::exiting);
+      ph = Phase::exiting;
+    }
+  }
+  protocol::ArmTransform::Vector link(static_cast<Eigen::Index>(n));
+  correction(t_, env, link);
+  const auto motor = view_->transform.motor_velocity(link);
+  const double max_step = options_.max_motor_speed * period;
+  for (std::size_t j = 0; j < n; ++j) {
+    const double inc = motor[static_cast<Eigen::Index>(j)] - last_[j];
+    if (!(std::fabs(inc) <= max_step)) {
+      fail("correct: increment of %.4f motor turns on axis %zu exceeds %.4f", inc, j + 1, max_step);
+      set_phase(Phase::refused);
+      for (std::size_t i = 0; i < n; ++i) reply.axis(first + i).d1 = 0;
+      exit_from_open(reply, view_->arm);
+      return;
+    }
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    const double c = motor[static_cast<Eigen::Index>(j)];
+    reply.axis(first + j).d1 = static_cast<float>(c - last_[j]);
+    applied_[j].store(c, std::memory_order_relaxed);
+    last_[j] = c;
+  }
+  if (ph == Phase::exiting) exit_from_open(reply, view_->arm);
+}
+
+std::string CorrectApp::note_text(std::int32_t c) const {
+  switch (c) {
+    case kNoteStarted: return fmt::format("correct: correction started (mode 7, arm {})", options_.arm);
+    case kNoteFading: return "correct: fading the correction out";
+    case kNoteDone: return "correct: done, the arm is back in mode 0";
+    default: return App::note_text(c);
+  }
+}
+
+std::string CorrectApp::status() const {
+  static constexpr std::string_view names[] = {"waiting for mode 7", "correcting", "fading", "exiting", "done", "refused"};
+  std::string out = App::status() + fmt::format(" {} t={:.3f} s correction[turns]", names[static_cast<int>(phase())],
+                                                elapsed_.load(std::memory_order_relaxed));
+  for (std::size_t j = 0; j < 6 && j < protocol::kAxesPerArm; ++j) out += fmt::format(" {:.4f}", applied(j));
+  return out;
+}
+
+std::string CorrectApp::summary() const {
+  static constexpr std::string_view names[] = {"waiting", "correcting", "fading", "exiting", "done", "refused"};
+  return App::summary() + fmt::format("correct: {:.3f} s corrected, phase {}\n", elapsed_.load(std::memory_order_relaxed),
+                                      names[static_cast<int>(phase())]);
+}
+
+}  // namespace axon::c4g::apps

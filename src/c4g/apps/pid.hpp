@@ -1,0 +1,102 @@
+// `pid` (modes 1 and 2): the PC closes the position and velocity loops and sends motor currents.
+//
+// Per axis of one arm, motor side (turns, turns/s, A), each cycle:
+//   v_ref = v_target + kp (p_target - p_actual)            position loop (P)
+//   u     = kv (v_ref - v_actual) + integral + feed-forward velocity loop (PI)
+//   D5    = u clamped to the axis's current limit (initialization packet)
+// Anti-windup: the integral only grows while the output is not saturated or the error drives it
+// back out of saturation, and it never exceeds the limit on its own. The feed-forward is the
+// controller's dynamic-model current (EXT1) unless disabled: in open modes that current no longer
+// reaches the drive by itself (manual 14.12.4).
+//
+// Targets: mode 1 (the PC generates the trajectory) holds the position found when the mode starts,
+// or tracks a sine (link-side amplitude and frequency per axis) around it, faded in and out over
+// ramp_s; D1/D2 carry the target position and velocity (delta motor turns); it leaves with exit
+// from open after open_time (or a stop request) and keeps holding through 1'. Mode 2 (the
+// controller generates the trajectory) tracks the controller's D1/D2; the controller ends it.
+// Velocities on the wire are per cycle: actual velocity = D4 / period.
+//
+// Safety: the server's Safety layer checks the following error (508) and clamps D5 again; this app
+// also tracks the largest following error for the status line.
+#pragma once
+
+#include "c4g/apps/app.hpp"
+
+#include <vector>
+
+namespace axon::c4g::apps {
+
+struct PidGains {
+  double kp = 10.0;  // [1/s]
+  double kv = 0.5;   // [A / (turn/s)]
+  double ki = 5.0;   // [1/s] integral rate of the velocity loop
+};
+
+struct PidOptions {
+  std::size_t arm = 1;
+  std::vector<PidGains> gains;  // per axis; one entry: every axis; empty: defaults
+  std::vector<double> amplitude_rad;  // mode 1 sine, link side; empty: hold
+  std::vector<double> frequency_hz;
+  bool dynamic_model_feedforward = true;
+  double open_time_s = 0;  // mode 1: leave after this long (0: until a stop request)
+  double ramp_s = 0.5;
+};
+
+// One axis's loops: pure, for tests and for the app.
+class AxisPid {
+ public:
+  void reset(double integral = 0) noexcept { integral_ = integral; }
+  // Returns the saturated current; limit <= 0: no limit.
+  double update(const PidGains& g, double p_target, double v_target, double p_actual, double v_actual, double feedforward,
+                double limit, double dt) noexcept;
+  [[nodiscard]] double integral() const noexcept { return integral_; }
+  [[nodiscard]] bool saturated() const noexcept { return saturated_; }
+
+ private:
+  double integral_ = 0;
+  bool saturated_ = false;
+};
+
+class PidApp final : public App {
+ public:
+  enum class Phase : std::uint8_t { waiting, controlling, fading, exiting, done, refused };
+  enum : std::int32_t { kNoteStarted = 1, kNoteLeaving, kNoteDone };
+
+  explicit PidApp(PidOptions options);
+  [[nodiscard]] std::string_view name() const noexcept override { return "pid"; }
+  [[nodiscard]] std::string status() const override;
+  [[nodiscard]] std::string summary() const override;
+  [[nodiscard]] bool finished() const noexcept override { return phase() == Phase::done; }
+  [[nodiscard]] bool drive_off_on_error() const noexcept override { return true; }
+  [[nodiscard]] Phase phase() const noexcept { return phase_.load(std::memory_order_acquire); }
+  [[nodiscard]] double max_following_error() const noexcept { return max_error_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t saturated_cycles() const noexcept { return saturated_cycles_.load(std::memory_order_relaxed); }
+
+ protected:
+  void setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) override;
+  void step(const host::CycleContext& ctx, host::ReplyBuilder& reply) override;
+  [[nodiscard]] std::string note_text(std::int32_t code) const override;
+
+ private:
+  void set_phase(Phase p) noexcept { phase_.store(p, std::memory_order_release); }
+
+  PidOptions options_;
+  std::optional<ArmView> view_;
+  std::atomic<Phase> phase_{Phase::waiting};
+  std::atomic<double> max_error_{0};
+  std::atomic<std::uint64_t> saturated_cycles_{0};
+  std::atomic<double> elapsed_{0};
+  std::atomic<int> active_mode_{0};
+  // Cycle thread.
+  std::array<PidGains, protocol::kAxesPerArm> gains_{};
+  std::array<double, protocol::kAxesPerArm> amplitude_{}, frequency_{}, limit_{};
+  std::array<AxisPid, protocol::kAxesPerArm> loops_{};
+  std::array<double, protocol::kAxesPerArm> hold_{};      // motor position when mode 1 started
+  std::array<double, protocol::kAxesPerArm> last_ref_{};  // last mode-1 target
+  double t_ = 0;
+  std::uint64_t ticks_ = 0;
+  double env_ = 0;
+  std::int32_t mode_ = 0;  // 1 or 2 while controlling
+};
+
+}  // namespace axon::c4g::apps

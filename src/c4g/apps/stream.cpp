@@ -1,0 +1,226 @@
+#include "c4g/apps/stream.hpp"
+
+#include "c4g/protocol/mode.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace axon::c4g::apps {
+
+using protocol::code;
+using protocol::Mode;
+
+namespace {
+constexpr double kDeg = 180.0 / std::numbers::pi;
+}
+
+StreamApp::StreamApp(StreamOptions options) : options_(std::move(options)) {
+  if (!options_.trajectory) throw Exception(Error(CoreErrc::invalid_argument, "stream: no trajectory"));
+  if (options_.mode != 4 && options_.mode != 5)
+    throw Exception(Error(CoreErrc::invalid_argument, fmt::format("stream: mode {} (4 or 5)", options_.mode)));
+}
+
+void StreamApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) {
+  if (phase() == Phase::done || phase() == Phase::refused) return;  // one run per serve
+  set_phase(Phase::waiting);
+  auto v = make_arm_view(init, axes, options_.arm);
+  if (!v) {
+    fail("stream: %s", v.error().detail.c_str());
+    set_phase(Phase::refused);
+    return;
+  }
+  view_ = std::move(v).value();
+  const Trajectory& traj = *options_.trajectory;
+  const std::size_t n = view_->count;
+  if (traj.axes() != n) {
+    fail("stream: the trajectory has %zu axes, arm %zu has %zu", traj.axes(), options_.arm, n);
+    set_phase(Phase::refused);
+    return;
+  }
+  const double period = view_->period_s;
+  period_.store(period, std::memory_order_relaxed);
+  rows_ = static_cast<std::size_t>(std::floor(traj.duration() / period + 1e-9)) + 1;
+  if (traj.start_time() + static_cast<double>(rows_ - 1) * period < traj.end_time() - 1e-12) ++rows_;  // end exactly
+  table_.assign(rows_ * n, 0.0);
+  std::vector<double> pos(n), vel(n);
+  protocol::ArmTransform::Vector link(static_cast<Eigen::Index>(n));
+  for (std::size_t k = 0; k < rows_; ++k) {
+    const double t = std::min(traj.start_time() + static_cast<double>(k) * period, traj.end_time());
+    traj.sample(t, pos, vel);
+    for (std::size_t j = 0; j < n; ++j) link[static_cast<Eigen::Index>(j)] = pos[j];
+    const auto motor = view_->transform.motor_velocity(link);  // the linear part K_r q / 2 pi
+    for (std::size_t j = 0; j < n; ++j) table_[k * n + j] = motor[static_cast<Eigen::Index>(j)];
+  }
+  const double max_step = options_.max_motor_speed * period;
+  for (std::size_t k = 1; k < rows_; ++k)
+    for (std::size_t j = 0; j < n; ++j) {
+      const double step = std::fabs(table_[k * n + j] - table_[(k - 1) * n + j]);
+      if (step > max_step) {
+        fail("stream: the trajectory is not continuous: axis %zu moves %.4f motor turns in one cycle at t=%.3f s "
+             "(limit %.4f = %.1f turns/s x %.4f s)",
+             j + 1, step, traj.start_time() + static_cast<double>(k) * period, max_step, options_.max_motor_speed, period);
+        set_phase(Phase::refused);
+        return;
+      }
+    }
+  hold_cycles_ = static_cast<std::size_t>(std::ceil(options_.hold_s / period - 1e-9));
+}
+
+double StreamApp::command(std::size_t j, double s) const noexcept {
+  const std::size_t n = view_->count;
+  const double top = static_cast<double>(rows_ - 1);
+  s = std::clamp(s, 0.0, top);
+  const auto k = static_cast<std::size_t>(std::floor(s));
+  const double a = s - static_cast<double>(k);
+  const double p0 = table_[k * n + j];
+  const double p1 = k + 1 < rows_ ? table_[(k + 1) * n + j] : p0;
+  return base_[j] + p0 + a * (p1 - p0);
+}
+
+void StreamApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
+  if (!view_ || rows_ == 0) return;
+  const auto& req = ctx.request;
+  const std::size_t n = view_->count, first = view_->first;
+  if (first + n > req.count) return;
+  const std::int32_t mode = options_.mode;
+  const std::int32_t standby = mode == 4 ? code(Mode::mode4_standby) : code(Mode::mode5_standby);
+  bool all_in = true;
+  for (std::size_t j = 0; j < n; ++j) all_in = all_in && req.axes[first + j].mode == mode;
+  const std::int32_t m0 = req.axes[first].mode;
+  Phase ph = phase();
+
+  if (ph == Phase::waiting) {
+    if (!all_in || stop_requested()) return;
+    protocol::ArmTransform::Vector motor(static_cast<Eigen::Index>(n));
+    for (std::size_t j = 0; j < n; ++j) motor[static_cast<Eigen::Index>(j)] = req.axes[first + j].d3;
+    const auto link = view_->transform.link_position(motor);
+    const auto& q0 = view_->transform.calibration();
+    const Trajectory& traj = *options_.trajectory;
+    for (std::size_t j = 0; j < n; ++j) {
+      const double start = traj.value(0, j);
+      const double here = options_.relative ? 0.0 : link[static_cast<Eigen::Index>(j)];
+      if (std::fabs(start - here) > options_.start_tolerance_rad) {
+        if (options_.relative)
+          fail("stream: start point: a relative trajectory must start at 0, axis %zu starts at %.3f deg", j + 1, start * kDeg);
+        else
+          fail("stream: start point: axis %zu is at %.3f deg, the trajectory starts at %.3f deg (tolerance %.3f deg)",
+               j + 1, here * kDeg, start * kDeg, options_.start_tolerance_rad * kDeg);
+        set_phase(Phase::refused);
+        ph = Phase::refused;
+        break;
+      }
+    }
+    if (ph == Phase::waiting) {
+      for (std::size_t j = 0; j < n; ++j)
+        base_[j] = options_.relative ? req.axes[first + j].d3 - table_[j] : q0[static_cast<Eigen::Index>(j)];
+      for (std::size_t j = 0; j < n; ++j) last_[j] = command(j, 0);
+      s_ = 0;
+      rate_ = 1;
+      held_ = 0;
+      set_phase(Phase::playing);
+      ph = Phase::playing;
+      note(kNoteStarted);
+    }
+  }
+
+  if (ph == Phase::refused) {
+    // Nothing moves: mode 4 holds (the server's safe reply: last target or actual position), mode 5
+    // adds nothing; leave the open mode.
+    if (all_in) exit_from_open(reply, view_->arm);
+    return;
+  }
+  if (ph == Phase::done) return;
+
+  if (ph == Phase::playing || ph == Phase::holding || ph == Phase::exiting) {
+    if (m0 == code(Mode::mode0) && ph == Phase::exiting) {
+      set_phase(Phase::done);
+      note(kNoteDone);
+      return;
+    }
+    if (!all_in && m0 != standby) {
+      fail("stream: the controller left mode %d during the trajectory (axis 1 of arm %zu in mode %d) at t=%.3f s", mode,
+           view_->arm, m0, s_ * view_->period_s);
+      set_phase(Phase::refused);
+      return;
+    }
+  }
+
+  // Advance.
+  if (ph == Phase::playing) {
+    if (stop_requested() && rate_ == 1.0) note(kNoteStopping);
+    if (stop_requested()) rate_ = std::max(0.0, rate_ - view_->period_s / std::max(options_.stop_ramp_s, view_->period_s));
+    if (rate_ < 1e-9) rate_ = 0;
+    s_ += rate_;
+    if (s_ >= static_cast<double>(rows_ - 1)) {
+      s_ = static_cast<double>(rows_ - 1);
+      set_phase(Phase::holding);
+      ph = Phase::holding;
+      note(kNoteEnded);
+    } else if (rate_ <= 0.0) {
+      set_phase(Phase::exiting);
+      ph = Phase::exiting;
+    }
+  } else if (ph == Phase::holding) {
+    if (++held_ >= hold_cycles_ || stop_requested()) {
+      set_phase(Phase::exiting);
+      ph = Phase::exiting;
+    }
+  }
+  if (m0 == standby) {
+    // Leaving (4' / 5'): hold the last target, no increments.
+    for (std::size_t j = 0; j < n; ++j) {
+      auto& r = reply.axis(first + j);
+      r.d1 = mode == 4 ? static_cast<float>(last_[j]) : 0.0f;
+      r.d2 = 0;
+    }
+    if (ph == Phase::playing || ph == Phase::holding) set_phase(Phase::exiting);
+    return;
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    const double c = command(j, s_);
+    const double delta = c - last_[j];
+    auto& r = reply.axis(first + j);
+    r.d1 = static_cast<float>(mode == 4 ? c : delta);
+    r.d2 = static_cast<float>(delta);
+    last_[j] = c;
+  }
+  progress_.store(s_, std::memory_order_relaxed);
+  if (ph == Phase::exiting) exit_from_open(reply, view_->arm);
+}
+
+void StreamApp::silence() noexcept {
+  const Phase p = phase();
+  if (p == Phase::playing || p == Phase::holding) {
+    fail("stream: packets stopped during the trajectory");
+    set_phase(Phase::refused);
+  }
+}
+
+std::string StreamApp::note_text(std::int32_t c) const {
+  switch (c) {
+    case kNoteStarted: return fmt::format("stream: trajectory started (mode {}, arm {}, {} cycles)", options_.mode, options_.arm, rows_);
+    case kNoteEnded: return "stream: trajectory ended, holding the last point";
+    case kNoteDone: return "stream: done, the arm is back in mode 0";
+    case kNoteStopping: return "stream: stop requested, slowing down to rest";
+    default: return App::note_text(c);
+  }
+}
+
+std::string StreamApp::status() const {
+  static constexpr std::string_view names[] = {"waiting for mode", "playing", "holding", "exiting", "done", "refused"};
+  const double period = period_.load(std::memory_order_relaxed);
+  return App::status() + fmt::format(" {} t={:.3f}/{:.3f} s", names[static_cast<int>(phase())], progress() * period,
+                                     rows_ > 0 ? static_cast<double>(rows_ - 1) * period : 0.0);
+}
+
+std::string StreamApp::summary() const {
+  static constexpr std::string_view names[] = {"waiting", "playing", "holding", "exiting", "done", "refused"};
+  const double period = period_.load(std::memory_order_relaxed);
+  return App::summary() + fmt::format("stream: played {:.3f} s of {:.3f} s, phase {}\n", progress() * period,
+                                      rows_ > 0 ? static_cast<double>(rows_ - 1) * period : 0.0,
+                                      names[static_cast<int>(phase())]);
+}
+
+}  // namespace axon::c4g::apps

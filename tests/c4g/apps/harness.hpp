@@ -1,0 +1,82 @@
+// Drives a c4g application with synthetic controller packets, without sockets: the app's on_init
+// and on_cycle are called directly with a reply pre-filled like the server's safe reply.
+#pragma once
+
+#include "c4g/apps/app.hpp"
+#include "c4g/protocol/axis_map.hpp"
+#include "c4g/protocol/example_init.hpp"
+#include "c4g/protocol/mode.hpp"
+#include "c4g/protocol/transform.hpp"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <vector>
+
+namespace axon::c4g::apps::test {
+
+struct Harness {
+  protocol::InitPacket init = protocol::test::manual_example_init();  // six axes on arm 1, 2 ms
+  protocol::AxisMap map;
+  protocol::Packet req;
+  protocol::Packet rep;
+  std::uint64_t cycle = 0;
+
+  Harness() {
+    req.count = 6;
+    req.infpar = protocol::kDrivesOn;
+  }
+  void start(App& app) {
+    map = protocol::AxisMap::from_init(init).value();
+    app.on_init(init, map);
+  }
+  [[nodiscard]] protocol::ArmTransform transform() const { return protocol::ArmTransform::from_init(init, 1).value(); }
+  [[nodiscard]] double period() const { return init.period_ms * 1e-3; }
+
+  void set_modes(std::int32_t mode) {
+    for (std::size_t i = 0; i < req.count; ++i) req.axes[i].mode = mode;
+  }
+  // The robot's actual motor positions (D3) and the controller's target (D1) at a link position [rad].
+  void place_at_link(const std::array<double, 6>& q) {
+    protocol::ArmTransform::Vector link(6);
+    for (int i = 0; i < 6; ++i) link[i] = q[static_cast<std::size_t>(i)];
+    const auto motor = transform().motor_position(link);
+    for (std::size_t i = 0; i < 6; ++i) {
+      req.axes[i].d3 = static_cast<float>(motor[static_cast<Eigen::Index>(i)]);
+      req.axes[i].d1 = req.axes[i].d3;
+    }
+  }
+  // One cycle: the reply starts as the server's safe reply (modes echoed, data zero; 0' echoes
+  // targets; 4 holds the actual position).
+  const protocol::Packet& run(App& app) {
+    rep = protocol::Packet{};
+    rep.num = req.num;
+    rep.count = req.count;
+    for (std::size_t i = 0; i < req.count; ++i) {
+      rep.axes[i].mode = req.axes[i].mode;
+      if (req.axes[i].mode == protocol::code(protocol::Mode::mode4)) rep.axes[i].d1 = req.axes[i].d3;
+    }
+    const host::CycleContext ctx{req, &init, &map, cycle, static_cast<std::int64_t>(cycle) * 2'000'000};
+    host::ReplyBuilder builder(rep);
+    app.on_cycle(ctx, builder);
+    ++cycle;
+    req.num = (req.num + 1) & 0x7FFF;
+    return rep;
+  }
+  [[nodiscard]] bool exit_requested() const { return protocol::exit_from_open(rep.infpar, 1); }
+};
+
+// The texts of the events the app queued.
+inline std::vector<std::string> event_texts(App& app) {
+  std::vector<std::string> out;
+  for (const auto& e : app.drain_events()) out.push_back(app.describe(e));
+  return out;
+}
+
+inline bool contains(const std::vector<std::string>& lines, std::string_view needle) {
+  for (const auto& l : lines)
+    if (l.find(needle) != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace axon::c4g::apps::test

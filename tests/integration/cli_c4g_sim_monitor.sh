@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Mode 0 against the simulator in another process: the monitor app logs drives on and the end of
+# the exchange (504), records a capture that tcpdump and init-info read, and exits by itself.
+source "$(dirname "$0")/lib.sh"
+skip_without_sim_c4g
+start_c4g_serve --app monitor --pcap "$TMP/run.pcap" --csv "$TMP/moni.csv" --moni 20
+run_sim_c4g "steps:
+  - drive_on
+  - move: {arm: 1, deg: [5, 0, 0, 0, 0, 0], duration: 0.3}
+  - delay: 0.1
+  - exit_open"
+[ "$SIM_RC" = 0 ] || fail "simulator exit code $SIM_RC"
+wait_serve
+[ "$SERVE_RC" = 0 ] || fail "serve exit code $SERVE_RC"
+grep -q "arm 1: drives on" "$TMP/serve.out" || fail "no drives-on event"
+grep -q "controller ended the exchange (504)" "$TMP/serve.out" || fail "504 not seen"
+grep -q "Worst cycle time" "$TMP/serve.out" || fail "no timing report"
+[ "$(head -1 "$TMP/moni.csv" | cut -d, -f3)" = "a1_c4g_d1" ] || fail "moni 20 header"
+[ "$(wc -l <"$TMP/moni.csv")" -gt 100 ] || fail "moni CSV too short"
+"$AXON" c4g init-info --from-pcap "$TMP/run.pcap" >"$TMP/info.out" || fail "init-info"
+grep -q "open axis 6 = arm 1 axis 6" "$TMP/info.out" || fail "init-info content"
+if command -v tcpdump >/dev/null; then
+  tcpdump -nn -r "$TMP/run.pcap" 2>/dev/null | grep -q "UDP, length 1200" || fail "tcpdump does not show the initialization packet"
+fi
+echo ok
