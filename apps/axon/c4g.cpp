@@ -16,6 +16,7 @@
 #include "commands.hpp"
 #include "net/endpoint.hpp"
 #include "run.hpp"
+#include "stop_signals.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -74,8 +75,6 @@ struct ServeOptions {
   bool json = false;
 };
 
-std::atomic<int> g_signals{0};
-extern "C" void on_stop_signal(int) { g_signals.fetch_add(1); }
 
 Exception bad(std::string text) { return Exception(Error(CoreErrc::invalid_argument, std::move(text))); }
 
@@ -178,11 +177,7 @@ int run_serve(const ServeOptions& o) {
     throw bad("--moni needs --csv FILE");
   }
 
-  struct sigaction sa{};
-  sa.sa_handler = on_stop_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
+  StopSignals signals;
 
   auto server = need(host::Server::start(*app, so));
   std::printf("listening c4g %s\n", server->local_address().to_string().c_str());
@@ -210,7 +205,7 @@ int run_serve(const ServeOptions& o) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     pump();
     const auto now = Clock::now();
-    if (g_signals.load() > 0) { why = "signal"; break; }
+    if (signals.count() > 0) { why = "signal"; break; }
     if (o.duration_s > 0 && now - start >= std::chrono::duration<double>(o.duration_s)) { why = "duration reached"; break; }
     if (app->finished()) { why = "application finished"; break; }
     if (app->has_error()) {
@@ -235,7 +230,7 @@ int run_serve(const ServeOptions& o) {
   };
   auto wait_until = [&](double seconds) {
     const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
-    while (!settled() && Clock::now() < until && g_signals.load() < 2) {
+    while (!settled() && Clock::now() < until && signals.count() < 2) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
       pump();
     }

@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "net/endpoint.hpp"
 #include "run.hpp"
+#include "stop_signals.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -35,8 +36,6 @@ struct SimC4gOptions {
   bool json = false;
 };
 
-std::atomic<bool> g_stop{false};
-extern "C" void on_stop_signal(int) { g_stop.store(true); }
 
 double us(std::int64_t ns) { return static_cast<double>(ns) / 1000.0; }
 
@@ -61,12 +60,10 @@ int run_sim_c4g(const SimC4gOptions& o) {
   std::fprintf(stderr, "sim c4g: robot %s, %zu open axes, %d ms, scenario '%s', server %s, from %s\n",
                controller.robot().name.c_str(), controller.axis_count(), controller.init().period_ms,
                scenario.name.c_str(), server.to_string().c_str(), udp.local_endpoint().to_string().c_str());
-  g_stop = false;
-  std::signal(SIGINT, on_stop_signal);
-  std::signal(SIGTERM, on_stop_signal);
+  std::optional<StopSignals> signals(std::in_place);
   sim::RunOptions ro;
   ro.duration_s = o.duration_s;
-  ro.stop = &g_stop;
+  ro.stop = signals->flag();
   if (o.reply_deadline_us > 0)
     ro.reply_deadline = std::chrono::nanoseconds(static_cast<std::int64_t>(o.reply_deadline_us * 1000));
   nlohmann::json events = nlohmann::json::array();
@@ -77,8 +74,7 @@ int run_sim_c4g(const SimC4gOptions& o) {
     if (o.json) events.push_back({{"t", e.time_s}, {"cycle", e.cycle}, {"level", sim::to_string(e.level)}, {"name", e.name}, {"text", e.text}});
   };
   const auto report = sim::run_client(controller, udp, ro);
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  signals.reset();
 
   const auto& s = controller.stats();
   const bool completed = controller.scenario_done() || (controller.scenario_running_forever() && report.stopped);

@@ -1,0 +1,48 @@
+#pragma once
+// SIGINT/SIGTERM for commands whose main thread polls instead of running an io_context (the c4g
+// server and controller simulator: their loops run on plain threads). While a StopSignals object
+// lives, each signal bumps a counter and raises a flag; the destructor restores the default action.
+#include <atomic>
+#include <csignal>
+
+namespace axon::app {
+
+class StopSignals {
+ public:
+  StopSignals() {
+    count_().store(0);
+    flag_().store(false);
+    struct sigaction sa{};
+    sa.sa_handler = &StopSignals::on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+  }
+  ~StopSignals() {
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+  // How many signals arrived (a second one usually means "stop now, skip the clean-up").
+  int count() const noexcept { return count_().load(); }
+  // Raised by the first signal; loops that take an atomic<bool>* stop flag can watch it directly.
+  std::atomic<bool>* flag() noexcept { return &flag_(); }
+
+ private:
+  static std::atomic<int>& count_() noexcept {
+    static std::atomic<int> n{0};
+    return n;
+  }
+  static std::atomic<bool>& flag_() noexcept {
+    static std::atomic<bool> f{false};
+    return f;
+  }
+  static void on_signal(int) noexcept {
+    count_().fetch_add(1);
+    flag_().store(true);
+  }
+};
+
+}  // namespace axon::app
