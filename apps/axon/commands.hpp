@@ -14,6 +14,10 @@ void add_can_commands(CLI::App& app, GlobalOptions& global);
 void add_demo_command(CLI::App& app, GlobalOptions& global);
 void add_sim_commands(CLI::App& app, GlobalOptions& global);
 void add_fps_commands(CLI::App& app, GlobalOptions& global);
+// These add to the groups above (call after them): `fps layout`, `fps plc`, `sim plc`.
+void add_fps_layout_commands(CLI::App& app, GlobalOptions& global);
+void add_fps_plc_commands(CLI::App& app, GlobalOptions& global);
+void add_sim_plc_command(CLI::App& app, GlobalOptions& global);
 
 // Exit code chosen by the subcommand that ran.
 int& exit_code();

@@ -32,6 +32,9 @@ int main(int argc, char** argv) {
   add_can_commands(app, global);
   add_sim_commands(app, global);
   add_fps_commands(app, global);
+  add_fps_layout_commands(app, global);
+  add_fps_plc_commands(app, global);
+  add_sim_plc_command(app, global);
   add_demo_command(app, global);
   try {
     app.parse(argc, argv);

@@ -1,0 +1,285 @@
+#include "c4g/host/server.hpp"
+
+#include "c4g/protocol/mode.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <time.h>
+
+#include <cstring>
+#include <iterator>
+
+namespace axon::c4g::host {
+
+using protocol::code;
+using protocol::Mode;
+
+std::string_view to_string(ServerState s) noexcept {
+  switch (s) {
+    case ServerState::waiting: return "waiting for the first packet";
+    case ServerState::syncing: return "answering, no initialization packet yet";
+    case ServerState::running: return "running";
+    case ServerState::silent: return "no packets (controller stopped or restarting)";
+    case ServerState::stopped: return "stopped";
+  }
+  return "unknown";
+}
+
+namespace {
+std::int64_t steady_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+void bump(std::atomic<std::uint64_t>& a) noexcept { a.fetch_add(1, std::memory_order_relaxed); }
+
+std::int32_t read_i32(std::span<const std::byte> in, std::size_t offset) noexcept {
+  std::uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | std::to_integer<std::uint32_t>(in[offset + static_cast<std::size_t>(i)]);
+  return static_cast<std::int32_t>(v);
+}
+}  // namespace
+
+Server::Server(Controller& controller, const ServerOptions& options)
+    : controller_(controller), options_(options), safety_(options.safety) {}
+
+Result<std::unique_ptr<Server>> Server::start(Controller& controller, const ServerOptions& options) {
+  std::unique_ptr<Server> s(new Server(controller, options));
+  AXON_TRY(socket, net::UdpSocket::open(options.listen, options.udp));
+  if (!options.pcap_path.empty()) {
+    AXON_TRY(rec, PcapRecorder::open(options.pcap_path, options.pcap));
+    s->recorder_ = std::move(rec);
+  }
+  CycleOptions cycle = options.cycle;
+  cycle.max_reply = std::max(cycle.max_reply, protocol::kMaxPacketSize);
+  cycle.max_datagram = std::max(cycle.max_datagram, protocol::kInitPacketSize + 1);
+  CycleHandler& handler = *s;
+  s->cycle_ = std::make_unique<CycleThread>(std::move(socket), handler, cycle, s->recorder_.get());
+  s->cycle_->start();
+  spdlog::info("c4g server listening on {} (replies numbered {})", s->local_address().to_string(),
+               options.numbering == protocol::ReplyNumbering::same ? "as received" : "NUM + 1");
+  return s;
+}
+
+Server::~Server() { stop(); }
+
+void Server::stop() {
+  if (cycle_) cycle_->stop();
+  if (recorder_) recorder_->close();
+  state_.store(ServerState::stopped, std::memory_order_release);
+}
+
+std::optional<protocol::InitPacket> Server::init() const {
+  std::lock_guard lock(init_mutex_);
+  return init_copy_;
+}
+
+void Server::on_timeout(bool before_first) noexcept {
+  if (before_first) return;
+  state_.store(ServerState::silent, std::memory_order_release);
+  controller_.on_silence();
+}
+
+std::size_t Server::on_packet(std::span<const std::byte> in, const net::Datagram& info, std::span<std::byte> out) noexcept {
+  bump(counters_.packets);
+  if (state_.load(std::memory_order_relaxed) == ServerState::waiting ||
+      state_.load(std::memory_order_relaxed) == ServerState::silent)
+    state_.store(have_init_ ? ServerState::running : ServerState::syncing, std::memory_order_release);
+  if (info.truncated()) {
+    bump(counters_.protocol_errors);
+    bump(counters_.unanswered);
+    return 0;
+  }
+  switch (protocol::classify(in.size())) {
+    case protocol::DatagramKind::init: return answer_init(in, out);
+    case protocol::DatagramKind::cyclic: return answer_cyclic(in, info, out);
+    case protocol::DatagramKind::unknown: break;
+  }
+  bump(counters_.protocol_errors);
+  bump(counters_.unanswered);
+  return 0;
+}
+
+std::size_t Server::answer_init(std::span<const std::byte> in, std::span<std::byte> out) noexcept {
+  bump(counters_.init_packets);
+  // Decoding the initialization packet may allocate (error texts); it happens once per start-up,
+  // before the cyclic exchange, so the cycle's no-allocation rule is kept where it matters.
+  try {
+    auto decoded = protocol::decode_init(in);
+    if (!decoded) {
+      bump(counters_.protocol_errors);
+      // Answer with the number anyway, so the controller is not kept waiting: one axis, mode 0.
+      protocol::Packet p;
+      p.num = protocol::reply_number(read_i32(in, 0) & protocol::kMaxProtocolNumber, options_.numbering);
+      p.count = 1;
+      return protocol::encode_packet(p, out).ok() ? protocol::packet_size(1) : 0;
+    }
+    init_ = std::move(decoded).value();
+    have_init_ = true;
+    auto map = protocol::AxisMap::from_init(init_);
+    have_axes_ = static_cast<bool>(map);
+    if (have_axes_) {
+      axes_ = map.value();
+      safety_.configure(init_, axes_);
+    } else {
+      bump(counters_.protocol_errors);
+    }
+    {
+      std::lock_guard lock(init_mutex_);
+      init_copy_ = init_;
+    }
+    have_target_ = {};
+    exit_sent_ = {};
+    cyclic_count_ = 0;
+    state_.store(ServerState::running, std::memory_order_release);
+    if (have_axes_) {
+      try {
+        controller_.on_init(init_, axes_);
+      } catch (...) {
+        bump(counters_.controller_exceptions);
+        safety_.trip(FaultReason::controller_exception);
+      }
+    }
+  } catch (...) {
+    bump(counters_.protocol_errors);
+    return 0;
+  }
+  protocol::Packet p;
+  p.num = protocol::reply_number(init_.protocol_number, options_.numbering);
+  p.count = static_cast<std::size_t>(init_.open_axes);
+  for (std::size_t i = 0; i < p.count; ++i) {
+    const std::int32_t m = have_axes_ ? axes_.startup_mode(i) : 0;
+    p.axes[i].mode = protocol::is_known_mode(m) ? m : code(Mode::mode0);
+  }
+  return protocol::encode_packet(p, out).ok() ? protocol::packet_size(p.count) : 0;
+}
+
+std::size_t Server::answer_bad_cyclic(std::span<const std::byte> in, std::span<std::byte> out) noexcept {
+  bump(counters_.protocol_errors);
+  safety_.trip(FaultReason::bad_packet);
+  // Answer with drive off on every axis the datagram's size announces, under its number.
+  protocol::Packet p;
+  p.num = protocol::reply_number(read_i32(in, 0) & protocol::kMaxProtocolNumber, options_.numbering);
+  p.count = (in.size() - protocol::kHeaderSize) / protocol::kAxisSize;
+  if (p.count == 0 || p.count > protocol::kMaxAxes) {
+    bump(counters_.unanswered);
+    return 0;
+  }
+  Safety::make_drive_off(p, p);
+  return protocol::encode_packet(p, out).ok() ? protocol::packet_size(p.count) : 0;
+}
+
+void Server::build_safe_reply(const protocol::Packet& req, protocol::Packet& rep) noexcept {
+  rep.num = protocol::reply_number(req.num, options_.numbering);
+  rep.infpar = 0;
+  rep.cmd = 0;
+  rep.count = req.count;
+  for (std::size_t i = 0; i < req.count; ++i) {
+    const auto& q = req.axes[i];
+    auto& r = rep.axes[i];
+    r = protocol::Axis{};
+    r.mode = q.mode;
+    switch (q.mode) {
+      case code(Mode::mode0_prime):  // the echo test: targets come back unchanged
+        r.d1 = q.d1;
+        r.d2 = q.d2;
+        break;
+      case code(Mode::mode4):
+      case code(Mode::mode4_standby):  // absolute target: hold it, never command zero
+        r.d1 = have_target_[i] ? last_target_[i] : q.d3;
+        break;
+      default: break;  // increments and contributions: zero is "no change"
+    }
+  }
+}
+
+void Server::enforce_mode_rules(const protocol::Packet& req, protocol::Packet& rep) noexcept {
+  rep.num = protocol::reply_number(req.num, options_.numbering);  // not the controller's to change
+  rep.count = req.count;
+  for (std::size_t i = 0; i < req.count; ++i) {
+    const std::size_t arm = have_axes_ ? axes_.logical(i).arm : 1;
+    if (req.axes[i].mode == code(Mode::mode0)) exit_sent_[i] = false;
+    const auto change = protocol::check_mode_change(req.axes[i].mode, rep.axes[i].mode, exit_sent_[i]);
+    if (change != protocol::ModeChange::allowed && change != protocol::ModeChange::unchanged) {
+      bump(counters_.refused_mode_changes);
+      rep.axes[i].mode = req.axes[i].mode;
+    }
+    if (protocol::exit_from_open(rep.infpar, arm)) exit_sent_[i] = true;
+  }
+}
+
+std::size_t Server::encode(const protocol::Packet& req, protocol::Packet& rep, std::span<std::byte> out) noexcept {
+  // Remember absolute targets so a later safe reply holds them.
+  for (std::size_t i = 0; i < rep.count; ++i) {
+    if (req.axes[i].mode == code(Mode::mode4) || req.axes[i].mode == code(Mode::mode4_standby)) {
+      last_target_[i] = rep.axes[i].d1;
+      have_target_[i] = true;
+    } else {
+      have_target_[i] = false;
+    }
+  }
+  if (protocol::encode_packet(rep, out).ok()) return protocol::packet_size(rep.count);
+  safety_.trip(FaultReason::not_finite);
+  Safety::make_drive_off(req, rep);
+  return protocol::encode_packet(rep, out).ok() ? protocol::packet_size(rep.count) : 0;
+}
+
+std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Datagram& info, std::span<std::byte> out) noexcept {
+  bump(counters_.cyclic_packets);
+  const auto fault = have_init_ && have_axes_
+                         ? protocol::decode_packet(in, request_, static_cast<std::size_t>(init_.open_axes))
+                         : protocol::decode_packet(in, request_);
+  if (!fault.ok()) return answer_bad_cyclic(in, out);
+
+  build_safe_reply(request_, safe_);
+  reply_ = safe_;
+  bool used_controller = false;
+  safety_.begin_cycle();
+  if (!safety_.faulted()) {
+    const CycleContext ctx{request_, have_init_ ? &init_ : nullptr, have_axes_ ? &axes_ : nullptr, cyclic_count_,
+                           info.wall_ns};
+    ReplyBuilder builder(reply_);
+    const std::int64_t t0 = steady_ns();
+    try {
+      controller_.on_cycle(ctx, builder);
+      used_controller = true;
+    } catch (...) {
+      bump(counters_.controller_exceptions);
+      safety_.trip(FaultReason::controller_exception);
+      reply_ = safe_;
+    }
+    const std::int64_t took = steady_ns() - t0;
+    if (took > options_.controller_budget.count()) {
+      bump(counters_.controller_late);
+      if (options_.max_late_cycles > 0 && ++late_in_row_ >= options_.max_late_cycles)
+        safety_.trip(FaultReason::controller_late);
+    } else {
+      late_in_row_ = 0;
+    }
+    if (used_controller) enforce_mode_rules(request_, reply_);
+  }
+  if (!used_controller) bump(counters_.safe_replies);
+  ++cyclic_count_;
+  safety_.apply(request_, reply_);
+  return encode(request_, reply_, out);
+}
+
+std::string Server::summary() const {
+  std::string out = fmt::format("State: {}\n", to_string(state()));
+  auto it = std::back_inserter(out);
+  fmt::format_to(it,
+                 "Packets {} (init {}, cyclic {}), protocol errors {}, unanswered {}, controller exceptions {}, "
+                 "late {}, refused mode changes {}, safe replies {}\n",
+                 counters_.packets.load(), counters_.init_packets.load(), counters_.cyclic_packets.load(),
+                 counters_.protocol_errors.load(), counters_.unanswered.load(), counters_.controller_exceptions.load(),
+                 counters_.controller_late.load(), counters_.refused_mode_changes.load(), counters_.safe_replies.load());
+  fmt::format_to(it, "Safety: {} (axis {}), currents clamped {}, drive-off replies {}, following-error replies {}\n",
+                 to_string(safety_.reason()), safety_.fault_axis(), safety_.counters().currents_clamped.load(),
+                 safety_.counters().drive_off_replies.load(), safety_.counters().following_error_replies.load());
+  out += cycle_->summary();
+  if (recorder_)
+    fmt::format_to(it, "Capture {}: {} written, {} dropped\n", recorder_->path(), recorder_->written(), recorder_->dropped());
+  return out;
+}
+
+}  // namespace axon::c4g::host

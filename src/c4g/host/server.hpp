@@ -1,0 +1,185 @@
+// The PC side of the open interface: a UDP server that answers every packet of the robot
+// controller within the cycle, from the very first one.
+//
+// Threads: the cycle runs on a CycleThread (real-time when permitted). Per packet it decodes,
+// builds the safe reply for the current modes, lets the user's Controller refine it, applies the
+// Safety layer and sends. The user's Controller runs inline on the cycle thread: it must be quick
+// and should not allocate; the Server catches its exceptions and times it (see docs/c4g-server.md
+// for why inline rather than on a worker thread with a deadline).
+//
+// Packets:
+//   - the initialization packet (1200 bytes): decoded, kept (init()), turned into an AxisMap and
+//     the Safety thresholds/limits; answered with a cyclic packet of its axis count carrying its
+//     protocol number and the start-up modes, data zero (the manual does not define this answer;
+//     the controller only checks the number);
+//   - cyclic packets (12 + 36 n bytes): answered with the same protocol number (the manual) or
+//     NUM + 1 (field libraries, ServerOptions::numbering);
+//   - anything else: counted as a protocol error; a cyclic-sized packet that fails to decode (NaN,
+//     wrong axis count, NUM out of range) is still answered, with drive off, and latches a fault;
+//     a datagram of no known size cannot be answered meaningfully and is not.
+//
+// Safe reply (used before the controller runs, when it throws, when it is faulted): every axis
+// echoes its mode; data are zero except where zero would move the robot: mode 0' echoes targets
+// (the manual's echo test), modes 4/4' hold the last commanded target (else the actual position).
+// Modes 1 and 2 (PC closes the loops) have no passive safe reply: a fault there asks for drive off.
+#pragma once
+
+#include "c4g/host/cycle_thread.hpp"
+#include "c4g/host/pcap_recorder.hpp"
+#include "c4g/host/safety.hpp"
+#include "c4g/protocol/axis_map.hpp"
+#include "c4g/protocol/init_packet.hpp"
+#include "c4g/protocol/packet.hpp"
+#include "core/error.hpp"
+#include "net/endpoint.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+namespace axon::c4g::host {
+
+// The manual's addresses: the PC serves on 10.2.12.149, the controller sends from 10.2.12.150,
+// port 1000 (field notes).
+inline constexpr const char* kDefaultServerAddress = "10.2.12.149";
+inline constexpr std::uint16_t kDefaultPort = 1000;
+
+// What the Controller sees of one cycle.
+struct CycleContext {
+  const protocol::Packet& request;    // the controller's packet, decoded
+  const protocol::InitPacket* init;   // nullptr until the initialization packet arrived
+  const protocol::AxisMap* axes;      // nullptr until then (or if its axis lists were bad)
+  std::uint64_t cycle;                // cyclic packets handled so far (0 for the first)
+  std::int64_t arrival_wall_ns;       // kernel arrival stamp (or clock at receive)
+};
+
+// Helps the controller fill the reply, which arrives pre-filled with the safe reply.
+class ReplyBuilder {
+ public:
+  explicit ReplyBuilder(protocol::Packet& reply) noexcept : reply_(reply) {}
+  [[nodiscard]] std::size_t axis_count() const noexcept { return reply_.count; }
+  protocol::Axis& axis(std::size_t open_index) noexcept { return reply_.axes[open_index < protocol::kMaxAxes ? open_index : 0]; }
+  void set_mode(std::size_t open_index, std::int32_t mode) noexcept { axis(open_index).mode = mode; }
+  // Asks the controller to leave the open mode for an arm (1..4): INFPAR byte = 1.
+  void exit_from_open(std::size_t arm) noexcept { reply_.infpar = protocol::request_exit_from_open(reply_.infpar, arm); }
+  void set_cmd(std::int32_t cmd) noexcept { reply_.cmd = cmd; }
+  protocol::Packet& packet() noexcept { return reply_; }
+
+ private:
+  protocol::Packet& reply_;
+};
+
+// The user's control law. on_cycle runs on the cycle thread for every cyclic packet while no
+// fault is latched; it may throw (the Server then latches a fault and drives off).
+class Controller {
+ public:
+  virtual ~Controller() = default;
+  virtual void on_init(const protocol::InitPacket& init, const protocol::AxisMap& axes) { (void)init, (void)axes; }
+  virtual void on_cycle(const CycleContext& ctx, ReplyBuilder& reply) = 0;
+  // No packet within the cycle timeout (the controller stopped or restarted). Cycle thread.
+  virtual void on_silence() noexcept {}
+};
+
+struct ServerOptions {
+  net::Endpoint listen{kDefaultServerAddress, kDefaultPort};
+  protocol::ReplyNumbering numbering = protocol::ReplyNumbering::same;
+  net::UdpOptions udp;
+  CycleOptions cycle;
+  SafetyConfig safety;
+  std::string pcap_path;  // empty: no recording
+  PcapOptions pcap;
+  // Controller budget: a call longer than this counts as late; this many late calls in a row
+  // latch a fault (0 disables).
+  std::chrono::nanoseconds controller_budget = std::chrono::microseconds(400);
+  int max_late_cycles = 3;
+};
+
+enum class ServerState : std::uint8_t {
+  waiting,   // no packet yet
+  syncing,   // answering packets, no initialization packet yet
+  running,   // initialization packet received, cyclic packets flowing
+  silent,    // packets stopped arriving (cycle timeout)
+  stopped,
+};
+std::string_view to_string(ServerState s) noexcept;
+
+struct ServerCounters {
+  std::atomic<std::uint64_t> packets{0};           // datagrams received
+  std::atomic<std::uint64_t> init_packets{0};
+  std::atomic<std::uint64_t> cyclic_packets{0};
+  std::atomic<std::uint64_t> protocol_errors{0};   // datagrams that did not decode
+  std::atomic<std::uint64_t> unanswered{0};        // datagrams with no answer (unknown size)
+  std::atomic<std::uint64_t> controller_exceptions{0};
+  std::atomic<std::uint64_t> controller_late{0};
+  std::atomic<std::uint64_t> refused_mode_changes{0};  // controller asked for a change the rules forbid
+  std::atomic<std::uint64_t> safe_replies{0};      // cycles answered without the controller's reply
+};
+
+class Server : private CycleHandler {
+ public:
+  // Binds, opens the capture if asked, starts the cycle thread. The controller must outlive the
+  // server.
+  static Result<std::unique_ptr<Server>> start(Controller& controller, const ServerOptions& options = {});
+  ~Server() override;  // stop()
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  void stop();
+
+  [[nodiscard]] net::SocketAddress local_address() const noexcept { return cycle_->local_address(); }
+  [[nodiscard]] ServerState state() const noexcept { return state_.load(std::memory_order_acquire); }
+  // The last initialization packet received (copy; any thread).
+  [[nodiscard]] std::optional<protocol::InitPacket> init() const;
+  [[nodiscard]] const protocol::Packet& last_request_unsafe() const noexcept { return request_; }  // cycle thread only
+  [[nodiscard]] const ServerCounters& counters() const noexcept { return counters_; }
+  [[nodiscard]] Safety& safety() noexcept { return safety_; }
+  [[nodiscard]] const Safety& safety() const noexcept { return safety_; }
+  [[nodiscard]] const CycleThread& cycle() const noexcept { return *cycle_; }
+  [[nodiscard]] const core::RealtimeReport& realtime_report() const noexcept { return cycle_->realtime_report(); }
+  [[nodiscard]] const PcapRecorder* recorder() const noexcept { return recorder_.get(); }
+  [[nodiscard]] std::string summary() const;
+
+ private:
+  Server(Controller& controller, const ServerOptions& options);
+  std::size_t on_packet(std::span<const std::byte> request, const net::Datagram& info,
+                        std::span<std::byte> reply) noexcept override;
+  void on_timeout(bool before_first) noexcept override;
+
+  std::size_t answer_init(std::span<const std::byte> in, std::span<std::byte> out) noexcept;
+  std::size_t answer_cyclic(std::span<const std::byte> in, const net::Datagram& info, std::span<std::byte> out) noexcept;
+  std::size_t answer_bad_cyclic(std::span<const std::byte> in, std::span<std::byte> out) noexcept;
+  void build_safe_reply(const protocol::Packet& request, protocol::Packet& reply) noexcept;
+  void enforce_mode_rules(const protocol::Packet& request, protocol::Packet& reply) noexcept;
+  std::size_t encode(const protocol::Packet& request, protocol::Packet& reply, std::span<std::byte> out) noexcept;
+
+  Controller& controller_;
+  ServerOptions options_;
+  std::unique_ptr<PcapRecorder> recorder_;
+  std::unique_ptr<CycleThread> cycle_;
+  Safety safety_;
+  ServerCounters counters_;
+  std::atomic<ServerState> state_{ServerState::waiting};
+
+  mutable std::mutex init_mutex_;  // init_copy_ only; the cycle thread takes it once per init packet
+  std::optional<protocol::InitPacket> init_copy_;
+
+  // Cycle thread only.
+  protocol::InitPacket init_{};
+  bool have_init_ = false;
+  protocol::AxisMap axes_{};
+  bool have_axes_ = false;
+  protocol::Packet request_{};
+  protocol::Packet reply_{};
+  protocol::Packet safe_{};
+  std::uint64_t cyclic_count_ = 0;
+  int late_in_row_ = 0;
+  std::array<float, protocol::kMaxAxes> last_target_{};
+  std::array<bool, protocol::kMaxAxes> have_target_{};
+  std::array<bool, protocol::kMaxAxes> exit_sent_{};
+};
+
+}  // namespace axon::c4g::host

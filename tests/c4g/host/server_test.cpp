@@ -1,0 +1,383 @@
+// The Server against a tiny scripted controller peer on loopback.
+#include "c4g/host/server.hpp"
+
+#include "c4g/protocol/mode.hpp"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <thread>
+#include <unistd.h>
+#include <fmt/format.h>
+#include <stdexcept>
+
+using namespace axon;
+using namespace axon::c4g;
+using namespace axon::c4g::host;
+using namespace std::chrono_literals;
+using protocol::code;
+using protocol::Mode;
+
+namespace {
+
+// Two open axes on arm 1 (logical 1 and 2), thresholds 0.5 / 0.25 turns, current limits 3 / 4 A.
+protocol::InitPacket make_init(std::int32_t number = 10) {
+  protocol::InitPacket p;
+  p.protocol_number = number;
+  p.open_axes = 2;
+  p.period_ms = 1;
+  p.open_axis_list[0][0] = 1;
+  p.open_axis_list[0][1] = 2;
+  p.following_error[0][0] = 0.5f;
+  p.following_error[0][1] = 0.25f;
+  p.current_limit[0][0] = 3.0f;
+  p.current_limit[0][1] = 4.0f;
+  p.transmission_ratio[0][0] = 100.0f;
+  p.transmission_ratio[0][1] = 100.0f;
+  return p;
+}
+
+protocol::Packet cyclic(std::int32_t num, std::int32_t mode, std::size_t axes = 2) {
+  protocol::Packet p;
+  p.num = num;
+  p.infpar = protocol::kDrivesOn;
+  p.count = axes;
+  for (std::size_t i = 0; i < axes; ++i) p.axes[i].mode = mode;
+  return p;
+}
+
+// The robot controller's side: sends packets, reads the answers.
+class Peer {
+ public:
+  explicit Peer(net::SocketAddress server) : server_(server), socket_(net::UdpSocket::open(net::SocketAddress{0x7f000001, 0}).value()) {}
+
+  void send_raw(std::span<const std::byte> bytes) { ASSERT_TRUE(socket_.send_to(bytes, server_)); }
+  void send(const protocol::Packet& p) {
+    std::array<std::byte, protocol::kMaxPacketSize> buf{};
+    ASSERT_TRUE(protocol::encode_packet(p, buf).ok());
+    send_raw({buf.data(), protocol::packet_size(p.count)});
+  }
+  void send(const protocol::InitPacket& p) {
+    std::array<std::byte, protocol::kInitPacketSize> buf{};
+    ASSERT_TRUE(protocol::encode_init(p, buf));
+    send_raw(buf);
+  }
+  // The next answer, decoded; count 0 when nothing came within the timeout.
+  protocol::Packet answer(std::chrono::milliseconds timeout = 2000ms) {
+    std::array<std::byte, 2048> buf{};
+    protocol::Packet p;
+    auto r = socket_.receive(buf, timeout);
+    if (!r) return p;
+    EXPECT_TRUE(protocol::decode_packet({buf.data(), r.value().size}, p).ok());
+    return p;
+  }
+  protocol::Packet ask(const protocol::Packet& p) {
+    send(p);
+    return answer();
+  }
+
+ private:
+  net::SocketAddress server_;
+  net::UdpSocket socket_;
+};
+
+struct ScriptedController : Controller {
+  std::atomic<int> inits{0};
+  std::atomic<int> cycles{0};
+  std::atomic<bool> throw_now{false};
+  std::atomic<int> last_request_num{-1};
+  std::function<void(const CycleContext&, ReplyBuilder&)> law;
+  void on_init(const protocol::InitPacket&, const protocol::AxisMap& axes) override {
+    EXPECT_EQ(axes.count(), 2u);
+    ++inits;
+  }
+  void on_cycle(const CycleContext& ctx, ReplyBuilder& reply) override {
+    ++cycles;
+    last_request_num = ctx.request.num;
+    if (throw_now) throw std::runtime_error("controller bug");
+    if (law) law(ctx, reply);
+  }
+};
+
+ServerOptions loopback_options() {
+  ServerOptions o;
+  o.listen = net::Endpoint{"127.0.0.1", 0};
+  o.controller_budget = 1s;  // lateness is tested on its own
+  return o;
+}
+
+struct Rig {
+  explicit Rig(ServerOptions o = loopback_options()) : server(Server::start(controller, o).value()), peer(server->local_address()) {}
+  void init() {
+    peer.send(make_init());
+    const auto a = peer.answer();
+    ASSERT_EQ(a.count, 2u);
+  }
+  ScriptedController controller;
+  std::unique_ptr<Server> server;
+  Peer peer;
+};
+
+}  // namespace
+
+TEST(Server, DefaultAddressIsTheManuals) {
+  ServerOptions o;
+  EXPECT_EQ(o.listen.host, "10.2.12.149");
+  EXPECT_EQ(o.listen.port, 1000);
+  EXPECT_EQ(o.numbering, protocol::ReplyNumbering::same);
+}
+
+TEST(Server, AnswersPacketsBeforeTheInitializationPacketWithTheirNumber) {
+  Rig rig;
+  EXPECT_EQ(rig.server->state(), ServerState::waiting);
+  for (std::int32_t num : {0, 1, 2}) {
+    const auto a = rig.peer.ask(cyclic(num, 0, 3));
+    EXPECT_EQ(a.num, num);
+    EXPECT_EQ(a.count, 3u);
+    for (const auto& ax : a.open_axes()) EXPECT_EQ(ax.mode, 0);
+  }
+  EXPECT_EQ(rig.server->state(), ServerState::syncing);
+  EXPECT_FALSE(rig.server->init());
+  EXPECT_EQ(rig.controller.cycles.load(), 3);  // the controller sees them too, with no init
+}
+
+TEST(Server, KeepsTheInitializationPacketAndAnswersIt) {
+  Rig rig;
+  rig.peer.send(make_init(10));
+  const auto a = rig.peer.answer();
+  EXPECT_EQ(a.num, 10);
+  EXPECT_EQ(a.count, 2u);
+  ASSERT_TRUE(rig.server->init());
+  EXPECT_EQ(*rig.server->init(), make_init(10));
+  EXPECT_EQ(rig.server->state(), ServerState::running);
+  EXPECT_EQ(rig.controller.inits.load(), 1);
+  EXPECT_FLOAT_EQ(rig.server->safety().following_error_thresholds()[1], 0.25f);
+  EXPECT_FLOAT_EQ(rig.server->safety().current_limits()[0], 3.0f);
+}
+
+TEST(Server, CyclicPacketsMustMatchTheInitializationAxisCount) {
+  Rig rig;
+  rig.init();
+  const auto a = rig.peer.ask(cyclic(11, 0, 3));  // three axes, init said two
+  EXPECT_EQ(a.num, 11);
+  for (const auto& ax : a.open_axes()) EXPECT_EQ(ax.mode, code(Mode::drive_off));
+  EXPECT_EQ(rig.server->counters().protocol_errors.load(), 1u);
+  EXPECT_EQ(rig.server->safety().reason(), FaultReason::bad_packet);
+}
+
+TEST(Server, NextNumberingIsAnOption) {
+  auto o = loopback_options();
+  o.numbering = protocol::ReplyNumbering::next;
+  Rig rig(o);
+  EXPECT_EQ(rig.peer.ask(cyclic(5, 0)).num, 6);
+  EXPECT_EQ(rig.peer.ask(cyclic(0x7FFF, 0)).num, 1);
+}
+
+TEST(Server, ControllerSeesTheTypedPacketAndItsReplyGoesOut) {
+  Rig rig;
+  rig.init();
+  rig.controller.law = [](const CycleContext& ctx, ReplyBuilder& r) {
+    ASSERT_NE(ctx.init, nullptr);
+    ASSERT_NE(ctx.axes, nullptr);
+    for (std::size_t i = 0; i < r.axis_count(); ++i) {
+      r.axis(i).d1 = ctx.request.axes[i].d3 + 0.01f;  // a small step from the actual position
+      r.axis(i).d2 = 0.01f;
+    }
+  };
+  auto req = cyclic(20, code(Mode::mode4));
+  req.axes[0].d3 = 1.0f;
+  req.axes[1].d3 = -2.0f;
+  const auto a = rig.peer.ask(req);
+  EXPECT_EQ(a.num, 20);
+  EXPECT_EQ(a.axes[0].mode, code(Mode::mode4));
+  EXPECT_FLOAT_EQ(a.axes[0].d1, 1.01f);
+  EXPECT_FLOAT_EQ(a.axes[1].d1, -1.99f);
+  EXPECT_EQ(rig.controller.last_request_num.load(), 20);
+}
+
+TEST(Server, ThrowingControllerGetsDriveOffUntilTheRobotHasObeyed) {
+  Rig rig;
+  rig.init();
+  rig.controller.throw_now = true;
+  auto a = rig.peer.ask(cyclic(30, code(Mode::mode7)));
+  EXPECT_EQ(a.num, 30);
+  for (const auto& ax : a.open_axes()) EXPECT_EQ(ax.mode, code(Mode::drive_off));
+  EXPECT_EQ(rig.server->safety().reason(), FaultReason::controller_exception);
+  EXPECT_EQ(rig.server->counters().controller_exceptions.load(), 1u);
+
+  // Latched: the controller is not called again, drive off is asked again.
+  a = rig.peer.ask(cyclic(31, code(Mode::mode7)));
+  for (const auto& ax : a.open_axes()) EXPECT_EQ(ax.mode, code(Mode::drive_off));
+  EXPECT_EQ(rig.controller.cycles.load(), 1);
+
+  // The robot reports drives off and mode 0: the server stops asking, still answers every packet.
+  auto settled = cyclic(32, 0);
+  settled.infpar = 0;
+  a = rig.peer.ask(settled);
+  EXPECT_EQ(a.num, 32);
+  for (const auto& ax : a.open_axes()) EXPECT_EQ(ax.mode, 0);
+  EXPECT_TRUE(rig.server->safety().faulted());
+
+  // After reset the controller runs again.
+  rig.controller.throw_now = false;
+  rig.server->safety().reset();
+  a = rig.peer.ask(cyclic(33, 0));
+  EXPECT_EQ(a.axes[0].mode, 0);
+  EXPECT_FALSE(rig.server->safety().faulted());
+  EXPECT_EQ(rig.controller.cycles.load(), 2);
+}
+
+TEST(Server, FollowingErrorAsksForStop508OnTheAxis) {
+  Rig rig;
+  rig.init();
+  auto req = cyclic(40, code(Mode::mode1));
+  req.axes[0].d1 = 1.0f;
+  req.axes[0].d3 = 1.4f;  // within 0.5
+  req.axes[1].d1 = 1.0f;
+  req.axes[1].d3 = 1.3f;  // over 0.25
+  const auto a = rig.peer.ask(req);
+  EXPECT_EQ(a.axes[0].mode, code(Mode::mode1));
+  EXPECT_EQ(a.axes[1].mode, code(Mode::following_error));
+  EXPECT_EQ(rig.server->safety().reason(), FaultReason::following_error);
+  EXPECT_EQ(rig.server->safety().fault_axis(), 1);
+}
+
+TEST(Server, CurrentsAreSaturatedToTheInitializationLimits) {
+  Rig rig;
+  rig.init();
+  rig.controller.law = [](const CycleContext&, ReplyBuilder& r) {
+    r.axis(0).d5 = 10.0f;
+    r.axis(1).d5 = -1.5f;
+  };
+  const auto a = rig.peer.ask(cyclic(50, code(Mode::mode2)));
+  EXPECT_FLOAT_EQ(a.axes[0].d5, 3.0f);
+  EXPECT_FLOAT_EQ(a.axes[1].d5, -1.5f);
+  EXPECT_EQ(a.axes[0].mode, code(Mode::mode2));
+  EXPECT_FALSE(rig.server->safety().faulted());
+  EXPECT_EQ(rig.server->safety().counters().currents_clamped.load(), 1u);
+}
+
+TEST(Server, StrokeEndsAndContinuityAreChecked) {
+  auto o = loopback_options();
+  o.safety.axes[0].min_position = -5;
+  o.safety.axes[0].max_position = 5;
+  o.safety.axes[1].max_step = 0.1f;
+  {
+    Rig rig(o);
+    rig.init();
+    rig.controller.law = [](const CycleContext&, ReplyBuilder& r) { r.axis(0).d1 = 6.0f; };
+    const auto a = rig.peer.ask(cyclic(60, code(Mode::mode4)));
+    for (const auto& ax : a.open_axes()) EXPECT_EQ(ax.mode, code(Mode::drive_off));
+    EXPECT_EQ(rig.server->safety().reason(), FaultReason::stroke_end);
+    EXPECT_EQ(rig.server->safety().fault_axis(), 0);
+  }
+  {
+    Rig rig(o);
+    rig.init();
+    std::atomic<float> target{0.0f};
+    rig.controller.law = [&](const CycleContext&, ReplyBuilder& r) { r.axis(1).d1 = target.load(); };
+    EXPECT_EQ(rig.peer.ask(cyclic(61, code(Mode::mode4))).axes[1].mode, code(Mode::mode4));
+    target = 0.05f;
+    EXPECT_EQ(rig.peer.ask(cyclic(62, code(Mode::mode4))).axes[1].mode, code(Mode::mode4));
+    target = 0.5f;  // a jump of 0.45 turns in one cycle
+    EXPECT_EQ(rig.peer.ask(cyclic(63, code(Mode::mode4))).axes[1].mode, code(Mode::drive_off));
+    EXPECT_EQ(rig.server->safety().reason(), FaultReason::discontinuity);
+  }
+}
+
+TEST(Server, MalformedPacketsAreCountedAndAnsweredWithDriveOffWhenPossible) {
+  Rig rig;
+  rig.init();
+  auto bad = cyclic(70, code(Mode::mode7));
+  std::array<std::byte, protocol::kMaxPacketSize> buf{};
+  ASSERT_TRUE(protocol::encode_packet(bad, buf).ok());
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(buf.data() + 12 + 4, &nan, 4);  // D1 of the first axis
+  rig.peer.send_raw({buf.data(), protocol::packet_size(2)});
+  const auto a = rig.peer.answer();
+  EXPECT_EQ(a.num, 70);
+  for (const auto& ax : a.open_axes()) EXPECT_EQ(ax.mode, code(Mode::drive_off));
+
+  const std::array<std::byte, 5> junk{};
+  rig.peer.send_raw(junk);
+  EXPECT_EQ(rig.peer.answer(50ms).count, 0u);  // nothing sensible to answer
+  EXPECT_EQ(rig.server->counters().protocol_errors.load(), 2u);
+  EXPECT_EQ(rig.server->counters().unanswered.load(), 1u);
+  // The server keeps serving.
+  EXPECT_EQ(rig.peer.ask(cyclic(71, 0)).num, 71);
+}
+
+TEST(Server, LateControllerTripsAfterConsecutiveOverruns) {
+  auto o = loopback_options();
+  o.controller_budget = 0ns;  // every call is late
+  o.max_late_cycles = 2;
+  Rig rig(o);
+  rig.init();
+  EXPECT_EQ(rig.peer.ask(cyclic(80, code(Mode::mode7))).axes[0].mode, code(Mode::mode7));
+  EXPECT_EQ(rig.peer.ask(cyclic(81, code(Mode::mode7))).axes[0].mode, code(Mode::drive_off));
+  EXPECT_EQ(rig.server->safety().reason(), FaultReason::controller_late);
+  EXPECT_EQ(rig.server->counters().controller_late.load(), 2u);
+}
+
+TEST(Server, ForbiddenModeChangesAreRefused) {
+  Rig rig;
+  rig.init();
+  rig.controller.law = [](const CycleContext&, ReplyBuilder& r) { r.set_mode(0, code(Mode::mode4)); };
+  // From mode 7, mode 4 is not reachable without passing mode 0.
+  EXPECT_EQ(rig.peer.ask(cyclic(90, code(Mode::mode7))).axes[0].mode, code(Mode::mode7));
+  EXPECT_EQ(rig.server->counters().refused_mode_changes.load(), 1u);
+  // From mode 0 it is.
+  EXPECT_EQ(rig.peer.ask(cyclic(91, 0)).axes[0].mode, code(Mode::mode4));
+  // Drive-off requests are always accepted, and exit-from-open goes out in INFPAR.
+  rig.controller.law = [](const CycleContext&, ReplyBuilder& r) {
+    r.set_mode(1, code(Mode::drive_off));
+    r.exit_from_open(1);
+  };
+  const auto a = rig.peer.ask(cyclic(92, code(Mode::mode7)));
+  EXPECT_EQ(a.axes[1].mode, code(Mode::drive_off));
+  EXPECT_TRUE(protocol::exit_from_open(a.infpar, 1));
+}
+
+TEST(Server, SafeReplyHoldsTheLastAbsoluteTarget) {
+  Rig rig;
+  rig.init();
+  rig.controller.law = [](const CycleContext&, ReplyBuilder& r) { r.axis(0).d1 = 2.5f; };
+  EXPECT_FLOAT_EQ(rig.peer.ask(cyclic(100, code(Mode::mode4))).axes[0].d1, 2.5f);
+  // A controller that leaves the reply as given sends the safe reply: the held target, not zero.
+  rig.controller.law = nullptr;
+  EXPECT_FLOAT_EQ(rig.peer.ask(cyclic(101, code(Mode::mode4))).axes[0].d1, 2.5f);
+  auto req = cyclic(102, code(Mode::mode4));
+  EXPECT_FLOAT_EQ(rig.peer.ask(req).axes[1].d1, 0.0f);  // axis 1 held its first (zero) target
+}
+
+TEST(Server, SilenceIsReportedAndTheServerResumes) {
+  auto o = loopback_options();
+  o.cycle.cycle_timeout = 10ms;
+  Rig rig(o);
+  rig.init();
+  while (rig.server->state() != ServerState::silent) std::this_thread::sleep_for(1ms);
+  EXPECT_EQ(rig.peer.ask(cyclic(5, 0)).num, 5);
+  EXPECT_EQ(rig.server->state(), ServerState::running);
+}
+
+TEST(Server, RecordsTheExchangeAndSummarizes) {
+  auto o = loopback_options();
+  o.pcap_path = (std::filesystem::temp_directory_path() / fmt::format("axon_server_{}.pcap", ::getpid())).string();
+  {
+    Rig rig(o);
+    rig.init();
+    for (int i = 0; i < 5; ++i) rig.peer.ask(cyclic(i, 0));
+    rig.server->stop();
+    ASSERT_NE(rig.server->recorder(), nullptr);
+    EXPECT_EQ(rig.server->recorder()->written(), 12u);  // init + 5 cyclic, both ways
+    const auto s = rig.server->summary();
+    EXPECT_NE(s.find("Packets 6 (init 1, cyclic 5)"), std::string::npos) << s;
+    EXPECT_NE(s.find("Worst cycle time"), std::string::npos) << s;
+    EXPECT_EQ(rig.server->state(), ServerState::stopped);
+  }
+  std::filesystem::remove(o.pcap_path);
+}
