@@ -49,7 +49,7 @@ std::string plan_to_json(const CollisionModel& model, const Plan& plan, const Pl
     robots.push_back(std::move(rj));
   }
   j["robots"] = std::move(robots);
-  return j.dump(1) + "\n";
+  return j.dump() + "\n";
 }
 
 Result<std::vector<RobotTrajectory>> load_plan_trajectories(const CollisionModel& model, const std::string& path,

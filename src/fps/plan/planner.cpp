@@ -110,6 +110,8 @@ void drop_still_points(std::vector<TimedAngle>& pts) {
   pts = std::move(out);
 }
 
+constexpr const char* kReverseStuck = "its target cannot be reached from the fold without a collision";
+
 std::size_t firmware_points(const std::vector<TimedAngle>& pts) { return pts.empty() ? 0 : pts.size() - 1; }
 
 }  // namespace
@@ -203,6 +205,15 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
         }
         if (still[victim]) continue;  // two robots that stay cannot touch: the current poses are clear
         if (target[victim] == park_pose(victim)) {
+          // Already folded: the other one gives way if it can.
+          const std::size_t other = victim == c.a ? c.b : c.a;
+          if (c.kind == Contact::Kind::robot && !still[other] && target[other] != park_pose(other)) {
+            plan.robots[other] = {RobotPlan::Status::parked, {},
+                                  fmt::format("target collides with robot {} (parked)", model.robot(victim).id()),
+                                  {model.robot(victim).id()}};
+            target[other] = park_pose(other);
+            break;
+          }
           plan.robots[victim] = {RobotPlan::Status::held, {}, "its folded pose collides with a robot that stays", blockers};
           still[victim] = true;
           target[victim] = request.current[victim];
@@ -270,8 +281,7 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
         target[i] = request.current[i];
         changed = true;
       } else if (!rb.reached[i]) {
-        plan.robots[i] = {RobotPlan::Status::parked, {}, "its target cannot be reached from the fold without a collision",
-                          ids_of(rb.blockers[i])};
+        plan.robots[i] = {RobotPlan::Status::parked, {}, kReverseStuck, ids_of(rb.blockers[i])};
         target[i] = park_pose(i);
         changed = true;
       }
@@ -283,13 +293,55 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
     settle_targets();
   }
 
-  // Join both halves.
+  // Third phase for robots parked because the reverse half got stuck: with everyone else at rest
+  // at the end, each tries forwards from its fold to its target. Robots that do not get there
+  // stay folded, and the others are re-planned without them (they were certified against it).
   const double ta = ra.duration_s, tb = rb.duration_s;
+  std::vector<bool> in_c(n, false);
+  for (std::size_t i = 0; i < n; ++i)
+    in_c[i] = plan.robots[i].status == RobotPlan::Status::parked && plan.robots[i].reason == kReverseStuck &&
+              model.robot(i).within_limits(request.target[i]);
+  StepperResult rc;
+  bool any_c = std::find(in_c.begin(), in_c.end(), true) != in_c.end();
+  for (int pass = 0; any_c && pass < 4; ++pass) {
+    std::vector<StepperRobot> fc(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Pose end{rb.paths[i].alpha.front().deg, rb.paths[i].beta.front().deg};  // B starts at the end pose
+      fc[i] = in_c[i] ? StepperRobot{end, request.target[i], false} : StepperRobot{end, end, true};
+    }
+    StepperOptions sc = so;
+    sc.seed = o.seed * 2 + 99 + static_cast<std::uint64_t>(pass);
+    const auto t0 = Clock::now();
+    rc = drive_to_goals(model, fc, sc);
+    search_s += seconds_since(t0);
+    plan.stats.escapes += rc.escapes;
+    bool dropped = false;
+    for (std::size_t i = 0; i < n; ++i)
+      if (in_c[i] && !rc.reached[i]) {
+        in_c[i] = false;
+        dropped = true;
+      }
+    any_c = std::find(in_c.begin(), in_c.end(), true) != in_c.end();
+    if (!dropped) break;
+    if (!any_c) rc = {};
+  }
+  if (!any_c) rc = {};
+
+  // Join the halves (and the third phase).
   plan.trajectories.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     RobotTrajectory& t = plan.trajectories[i];
     t.alpha = join(ra.paths[i].alpha, ta, rb.paths[i].alpha, tb);
     t.beta = join(ra.paths[i].beta, ta, rb.paths[i].beta, tb);
+    if (any_c && in_c[i]) {
+      for (auto [arm, c] : {std::pair{&t.alpha, &rc.paths[i].alpha}, std::pair{&t.beta, &rc.paths[i].beta}})
+        for (const auto& pt : *c) {
+          const double when = ta + tb + pt.t_s;
+          if (arm->back().t_s >= when - 1e-9) continue;
+          arm->push_back({when, pt.deg});
+        }
+      plan.robots[i] = {RobotPlan::Status::reached, {}, {}, {}};
+    }
     drop_still_points(t.alpha);
     drop_still_points(t.beta);
     plan.robots[i].end = {t.alpha.back().deg, t.beta.back().deg};
