@@ -87,16 +87,18 @@ void expect_sound(const CollisionModel& m, const Plan& p, const PlanRequest& req
 }
 
 TEST(Planner, TwoRobotsSwapSides) {
-  // Robot 1's arm starts in the gap between the two robots, robot 2's must end there.
+  // Robot 1's arm starts in the gap between the two robots (pointing up-right), robot 2's must
+  // end there (cw elbow, pointing up-left): robot 1 has to clear out before robot 2 comes in.
   const auto m = build({at(1, 0, 0), at(2, 22.4, 0)});
   PlanRequest req;
-  req.current = {{0, 30}, {10, 170}};
-  req.target = {{180, 170}, {180, 30}};
+  req.current = {{0, 60}, {0, 0}};
+  req.target = {{180, 0}, {180, 300}};
   ASSERT_GT(static_clearance(m, req.current), 0);
   ASSERT_GT(static_clearance(m, req.target), 0);
-  // Moved straight and together the arms would cross.
-  std::vector<RobotTrajectory> naive{RobotTrajectory::linear(req.current[0], req.target[0], 0, 15),
-                                     RobotTrajectory::linear(req.current[1], req.target[1], 0, 15)};
+  // In the wrong order (robot 2 first) the arms cross.
+  std::vector<RobotTrajectory> naive{
+      RobotTrajectory{{{0, 0}, {5, 0}, {20, 180}}, {{0, 60}, {5, 60}, {20, 0}}},
+      RobotTrajectory::linear(req.current[1], req.target[1], 0, 5)};
   TrajectoryChecker checker(m);
   CheckReport naive_report;
   ASSERT_TRUE(checker.check(naive, {}, naive_report));
@@ -104,10 +106,11 @@ TEST(Planner, TwoRobotsSwapSides) {
 
   auto r = plan_moves(m, req);
   ASSERT_TRUE(r) << r.error().message();
-  EXPECT_TRUE(r->ok()) << r->summary(m);
-  EXPECT_EQ(r->not_reached, 0u);
-  expect_sound(m, *r, req);
-  EXPECT_LE(r->stats.max_points, 8u);
+  const Plan& p = r.value();
+  EXPECT_TRUE(p.ok()) << p.summary(m);
+  EXPECT_EQ(p.not_reached, 0u);
+  expect_sound(m, p, req);
+  EXPECT_LE(p.stats.max_points, 8u);
 }
 
 TEST(Planner, RobotBoxedInByStillNeighboursReachesItsTarget) {
@@ -134,10 +137,11 @@ TEST(Planner, RobotBoxedInByStillNeighboursReachesItsTarget) {
   ASSERT_GT(static_clearance(m, req.target), 0);
   auto r = plan_moves(m, req);
   ASSERT_TRUE(r) << r.error().message();
-  EXPECT_EQ(r->robots[centre].status, RobotPlan::Status::reached) << r->summary(m);
+  const Plan& p = r.value();
+  EXPECT_EQ(p.robots[centre].status, RobotPlan::Status::reached) << p.summary(m);
   for (std::size_t i = 0; i < 7; ++i)
-    if (i != centre) EXPECT_EQ(r->robots[i].status, RobotPlan::Status::frozen);
-  expect_sound(m, *r, req);
+    if (i != centre) EXPECT_EQ(p.robots[i].status, RobotPlan::Status::frozen);
+  expect_sound(m, p, req);
 }
 
 TEST(Planner, BoxedInRobotWhoseTargetIsTakenIsReportedNotDropped) {
@@ -145,20 +149,21 @@ TEST(Planner, BoxedInRobotWhoseTargetIsTakenIsReportedNotDropped) {
   // reason and the blocker, and the plan for the others is still checked clear.
   const auto m = build({at(1, 0, 0), at(2, 22.4, 0), at(3, -22.4, 0)});
   PlanRequest req;
-  req.current = {{0, 20}, {10, 170}, {10, 170}};
-  req.target = {{0, 20}, {180, 10}, {0, 150}};
+  req.current = {{0, 90}, {90, 180}, {90, 180}};
+  req.target = {{0, 90}, {180, 10}, {0, 150}};
   req.frozen = {true, false, false};
   ASSERT_LT(static_clearance(m, req.target), 0);
   auto r = plan_moves(m, req);
   ASSERT_TRUE(r) << r.error().message();
-  EXPECT_EQ(r->robots[1].status, RobotPlan::Status::parked);
-  EXPECT_NE(r->robots[1].reason.find("collides with robot 1"), std::string::npos) << r->robots[1].reason;
-  EXPECT_EQ(r->robots[1].blockers, std::vector<std::int32_t>{1});
-  EXPECT_EQ(r->robots[2].status, RobotPlan::Status::reached);
-  EXPECT_EQ(r->not_reached, 1u);
-  EXPECT_FALSE(r->ok());
-  EXPECT_NE(r->summary(m).find("robot 2: parked"), std::string::npos);
-  expect_sound(m, *r, req);
+  const Plan& p = r.value();
+  EXPECT_EQ(p.robots[1].status, RobotPlan::Status::parked);
+  EXPECT_NE(p.robots[1].reason.find("collides with robot 1"), std::string::npos) << p.robots[1].reason;
+  EXPECT_EQ(p.robots[1].blockers, std::vector<std::int32_t>{1});
+  EXPECT_EQ(p.robots[2].status, RobotPlan::Status::reached);
+  EXPECT_EQ(p.not_reached, 1u);
+  EXPECT_FALSE(p.ok());
+  EXPECT_NE(p.summary(m).find("robot 2: parked"), std::string::npos);
+  expect_sound(m, p, req);
 }
 
 TEST(Planner, TargetNextToAFiducial) {
@@ -182,10 +187,11 @@ TEST(Planner, TargetNextToAFiducial) {
   req.target = {target};
   auto r = plan_moves(m, req);
   ASSERT_TRUE(r) << r.error().message();
-  EXPECT_TRUE(r->ok()) << r->summary(m);
-  expect_sound(m, *r, req);
-  EXPECT_GE(r->check.min_clearance_mm, 0.0);
-  EXPECT_LT(r->check.min_clearance_mm, 0.35);
+  const Plan& p = r.value();
+  EXPECT_TRUE(p.ok()) << p.summary(m);
+  expect_sound(m, p, req);
+  EXPECT_GE(p.check.min_clearance_mm, 0.0);
+  EXPECT_LT(p.check.min_clearance_mm, 0.35);
 }
 
 TEST(Planner, UnreachableTargetIntoAFiducialIsParkedAndReported) {
@@ -195,11 +201,12 @@ TEST(Planner, UnreachableTargetIntoAFiducialIsParkedAndReported) {
   req.target = {{0, 0}, {270, 30}};  // robot 1 stretched onto the fiducial
   auto r = plan_moves(m, req);
   ASSERT_TRUE(r) << r.error().message();
-  EXPECT_EQ(r->robots[0].status, RobotPlan::Status::parked);
-  EXPECT_NE(r->robots[0].reason.find("fiducial 7"), std::string::npos) << r->robots[0].reason;
-  EXPECT_EQ(r->robots[1].status, RobotPlan::Status::reached);
-  EXPECT_EQ(r->not_reached, 1u);
-  expect_sound(m, *r, req);
+  const Plan& p = r.value();
+  EXPECT_EQ(p.robots[0].status, RobotPlan::Status::parked);
+  EXPECT_NE(p.robots[0].reason.find("fiducial 7"), std::string::npos) << p.robots[0].reason;
+  EXPECT_EQ(p.robots[1].status, RobotPlan::Status::reached);
+  EXPECT_EQ(p.not_reached, 1u);
+  expect_sound(m, p, req);
 }
 
 TEST(Planner, CurrentPosesInContactAreAnError) {
@@ -236,18 +243,19 @@ TEST(Planner, SeededRandomPatchEveryRobotAccountedFor) {
     o.seed = seed;
     auto r = plan_moves(m, req, o);
     ASSERT_TRUE(r) << r.error().message();
-    expect_sound(m, *r, req, o);
+    const Plan& p = r.value();
+    expect_sound(m, p, req, o);
     // Most robots get there (the planner's success is measured on 500 robots by bench/fps_plan).
-    EXPECT_LE(r->not_reached, 4u) << r->summary(m);
-    EXPECT_GT(r->stats.duration_s, 0);
+    EXPECT_LE(p.not_reached, 4u) << p.summary(m);
+    EXPECT_GT(p.stats.duration_s, 0);
   }
 }
 
 TEST(Planner, SlowerSpeedGivesALongerMoveWithinThatSpeed) {
   const auto m = build({at(1, 0, 0), at(2, 22.4, 0)});
   PlanRequest req;
-  req.current = {{0, 30}, {10, 170}};
-  req.target = {{180, 170}, {180, 30}};
+  req.current = {{0, 60}, {90, 170}};
+  req.target = {{90, 180}, {180, 60}};
   PlannerOptions fast, slow;
   slow.speed = SpeedLimits::from_motor(1000, 1000);  // 6 deg/s
   EXPECT_DOUBLE_EQ(slow.speed.alpha_deg_s, 6.0);
@@ -255,8 +263,8 @@ TEST(Planner, SlowerSpeedGivesALongerMoveWithinThatSpeed) {
   auto b = plan_moves(m, req, slow);
   ASSERT_TRUE(a);
   ASSERT_TRUE(b);
-  expect_sound(m, *b, req, slow);
-  EXPECT_GT(b->stats.duration_s, 1.5 * a->stats.duration_s);
+  expect_sound(m, b.value(), req, slow);
+  EXPECT_GT(b.value().stats.duration_s, 1.5 * a.value().stats.duration_s);
 }
 
 TEST(PlannerSimplify, DropsPointsWithinToleranceAndNeverSpeedsUp) {
