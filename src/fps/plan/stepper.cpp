@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <numeric>
 
 namespace axon::fps::plan {
 
@@ -16,6 +17,8 @@ constexpr double kTiny = 1e-4;        // mm: the certificate keeps this much abo
 constexpr double kResolution = 0.01;  // mm: bound below which a sub-step counts as resolved
 constexpr int kMaxDepth = 8;          // halvings per step and pair
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kClrW = 1.0;   // escape score: clearance opened (mm, capped at 5)
+constexpr double kKeepW = 0.5;  // escape score: bonus for keeping the direction (fewer corners)
 
 Pose lerp(Pose a, Pose b, double f) noexcept {
   return {a.alpha_deg + f * (b.alpha_deg - a.alpha_deg), a.beta_deg + f * (b.beta_deg - a.beta_deg)};
@@ -92,6 +95,8 @@ class Stepper {
   std::vector<RobotState> st_;
   std::size_t escapes_ = 0;
   std::size_t checks_ = 0;
+  std::vector<std::uint32_t> rank_;      // priority: higher ranks do not make way for lower
+  std::vector<std::uint32_t> blockers_;  // scratch
 };
 
 bool Stepper::certify(std::size_t i, Pose i0, Pose i1, double c0, double c1, std::size_t j, Pose j0, Pose j1,
@@ -235,7 +240,7 @@ void Stepper::step_robot(std::size_t i) {
       const Segment s1 = m_.robot(i).collision_segment(q);
       const auto f = feasible(i, q, s1, travel(i, cands[k].mv), true, nullptr);
       if (!f.ok) continue;
-      const double score = std::min(f.min_clearance, 5.0) + noise(rng_) + (cands[k].mv == st.last ? 0.5 : 0.0);
+      const double score = kClrW * std::min(f.min_clearance, 5.0) + noise(rng_) + (cands[k].mv == st.last ? kKeepW : 0.0);
       if (score > best) {
         best = score;
         chosen = cands[k].mv;
@@ -259,9 +264,25 @@ void Stepper::step_robot(std::size_t i) {
     st.stuck = 0;
   } else if (++st.stuck >= o_.stuck_steps) {
     std::uniform_int_distribution<int> len(o_.escape_min_steps, std::max(o_.escape_min_steps, o_.escape_max_steps));
-    st.escape_left = len(rng_);
     st.stuck = 0;
-    ++escapes_;
+    // Blockers of lower priority make way; only when every blocker ranks higher does this robot
+    // step aside itself.
+    bool yielded = false;
+    if (nc > 0) {
+      blockers_.clear();
+      const Pose q0 = apply(p, cands[0].mv, g);
+      feasible(i, q0, m_.robot(i).collision_segment(q0), travel(i, cands[0].mv), false, &blockers_);
+      for (const std::uint32_t j : blockers_) {
+        if (robots_[j].frozen || rank_[j] >= rank_[i] || st_[j].escape_left > 0) continue;
+        st_[j].escape_left = len(rng_);
+        ++escapes_;
+        yielded = true;
+      }
+    }
+    if (!yielded) {
+      st.escape_left = len(rng_);
+      ++escapes_;
+    }
   }
 }
 
@@ -294,6 +315,9 @@ StepperResult Stepper::run() {
   std::vector<std::uint32_t> order;
   for (std::size_t i = 0; i < n; ++i)
     if (!robots_[i].frozen) order.push_back(static_cast<std::uint32_t>(i));
+  rank_.resize(n);
+  std::iota(rank_.begin(), rank_.end(), 0u);
+  std::shuffle(rank_.begin(), rank_.end(), rng_);
 
   const auto max_steps = static_cast<std::size_t>(std::ceil(o_.max_duration_s / o_.dt_s));
   std::size_t step = 0, last_motion = 0, quiet = 0;

@@ -18,9 +18,10 @@
 //
 // Choice of move: greedy, the move that lowers the weighted angle distance to the goal the most
 // (beta weighs more than alpha, so arms fold before they turn), preferring the previous move on
-// ties so that trajectories keep few corners. A robot that makes no progress for a while escapes:
-// for a random number of steps it takes the move that opens the most clearance (with a random
-// nudge), then goes back to greedy. Robots still away from their goal when the time limit is
+// ties so that trajectories keep few corners. A robot that makes no progress for a while is stuck:
+// the neighbours blocking its best move that rank lower (a random priority per run) are made to
+// escape; if none does, it escapes itself. Escaping robots, for a random number of steps, take the
+// move that opens the most clearance (with a random nudge), then go back to greedy. Robots still away from their goal when the time limit is
 // reached are reported as stuck, with the neighbours that blocked them.
 #pragma once
 
