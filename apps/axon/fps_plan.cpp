@@ -79,9 +79,9 @@ std::vector<plan::Pose> poses_from(const plan::CollisionModel& model, const std:
   plan::ValidationOptions vo;
   vo.policy = policy;
   const auto v = plan::validate_targets(model, targets, vo);
-  if (!v.ok() && policy == plan::TargetPolicy::reject)
+  if (!v.errors.empty() || (!v.ok() && policy == plan::TargetPolicy::reject))
     throw Exception(Error(plan::PlanErrc::bad_target_file, fmt::format("{} '{}':\n{}", what, spec, v.summary())));
-  if (!v.errors.empty() || !v.summary().empty()) spdlog::warn("{} '{}':\n{}", what, spec, v.summary());
+  if (!v.summary().empty()) spdlog::warn("{} '{}':\n{}", what, spec, v.summary());
   return v.poses();
 }
 
@@ -158,7 +158,7 @@ asio::awaitable<int> job_goto_all(const PlanArgs& a, host::Array& array) {
   plan::ValidationOptions vo;
   vo.policy = a.reject ? plan::TargetPolicy::reject : plan::TargetPolicy::park;
   const auto v = plan::validate_targets(model, targets, vo);
-  if (!v.ok() && vo.policy == plan::TargetPolicy::reject)
+  if (!v.errors.empty() || (!v.ok() && vo.policy == plan::TargetPolicy::reject))
     throw Exception(Error(plan::PlanErrc::bad_target_file, fmt::format("targets '{}':\n{}", a.targets, v.summary())));
   if (!v.summary().empty()) spdlog::warn("targets:\n{}", v.summary());
 
