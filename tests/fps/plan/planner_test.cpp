@@ -140,7 +140,9 @@ TEST(Planner, RobotBoxedInByStillNeighboursReachesItsTarget) {
   const Plan& p = r.value();
   EXPECT_EQ(p.robots[centre].status, RobotPlan::Status::reached) << p.summary(m);
   for (std::size_t i = 0; i < 7; ++i)
-    if (i != centre) EXPECT_EQ(p.robots[i].status, RobotPlan::Status::frozen);
+    if (i != centre) {
+      EXPECT_EQ(p.robots[i].status, RobotPlan::Status::frozen);
+    }
   expect_sound(m, p, req);
 }
 
