@@ -5,6 +5,7 @@
 #include "can/cannet_client.hpp"
 #include "can/open.hpp"
 #include "commands.hpp"
+#include "fps_array.hpp"
 #include "core/config.hpp"
 #include "fps/host/array.hpp"
 #include "fps/protocol/commands.hpp"
@@ -101,6 +102,9 @@ FpsOptions resolved(FpsOptions o) {
   if (o.timeout_s < 0) o.timeout_s = 1.0;
   return o;
 }
+
+// The group's options once add_fps_commands ran (for with_fps_array).
+FpsOptions* g_options = nullptr;
 
 // What a subcommand does once the robots are known. Returns the exit code.
 using Job = std::function<asio::awaitable<int>(host::Array&, const host::DiscoveryReport&)>;
@@ -520,6 +524,7 @@ asio::awaitable<int> job_raw(const FpsOptions& o, const RawArgs& a, host::Array&
 
 void add_fps_commands(CLI::App& app, GlobalOptions&) {
   static FpsOptions o;
+  g_options = &o;
   auto* fps = app.add_subcommand("fps", "fiber positioners: discover, status, moves, trajectories, calibration, firmware");
   fps->require_subcommand(1);
   fps->fallthrough();  // bus options and --json may also follow the subcommand
@@ -617,6 +622,10 @@ void add_fps_commands(CLI::App& app, GlobalOptions&) {
   rw->callback([] {
     exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_raw(o, raw, a, r); });
   });
+}
+
+int with_fps_array(const FpsArrayJob& job) {
+  return with_array(*g_options, [&job](host::Array& a, const host::DiscoveryReport&) { return job(a); });
 }
 
 }  // namespace axon::app

@@ -1,0 +1,425 @@
+#include "fps/plan/planner.hpp"
+
+#include "fps/plan/stepper.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+#include <thread>
+
+namespace axon::fps::plan {
+
+std::string_view to_string(RobotPlan::Status s) noexcept {
+  switch (s) {
+    case RobotPlan::Status::reached: return "reached";
+    case RobotPlan::Status::frozen: return "frozen";
+    case RobotPlan::Status::parked: return "parked";
+    case RobotPlan::Status::held: return "held";
+  }
+  return "?";
+}
+
+std::string Plan::summary(const CollisionModel& model) const {
+  std::string out;
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    const RobotPlan& r = robots[i];
+    if (r.status != RobotPlan::Status::parked && r.status != RobotPlan::Status::held) continue;
+    out += fmt::format("robot {}: {}: {}", model.robot(i).id(), to_string(r.status), r.reason);
+    if (!r.blockers.empty()) {
+      out += " (blocked by";
+      for (auto id : r.blockers) out += fmt::format(" {}", id);
+      out += ")";
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+std::vector<TimedAngle> simplify_arm(std::span<const TimedAngle> points, double tolerance_deg) {
+  if (points.size() <= 2 || tolerance_deg <= 0) return {points.begin(), points.end()};
+  std::vector<bool> keep(points.size(), false);
+  keep.front() = keep.back() = true;
+  std::vector<std::pair<std::size_t, std::size_t>> todo{{0, points.size() - 1}};
+  while (!todo.empty()) {
+    const auto [a, b] = todo.back();
+    todo.pop_back();
+    if (b <= a + 1) continue;
+    double worst = -1;
+    std::size_t at = a;
+    const TimedAngle& pa = points[a];
+    const TimedAngle& pb = points[b];
+    for (std::size_t k = a + 1; k < b; ++k) {
+      const double f = (points[k].t_s - pa.t_s) / (pb.t_s - pa.t_s);
+      const double d = std::abs(pa.deg + f * (pb.deg - pa.deg) - points[k].deg);
+      if (d > worst) {
+        worst = d;
+        at = k;
+      }
+    }
+    if (worst > tolerance_deg) {
+      keep[at] = true;
+      todo.push_back({a, at});
+      todo.push_back({at, b});
+    }
+  }
+  std::vector<TimedAngle> out;
+  for (std::size_t k = 0; k < points.size(); ++k)
+    if (keep[k]) out.push_back(points[k]);
+  return out;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+bool finite(Pose p) { return std::isfinite(p.alpha_deg) && std::isfinite(p.beta_deg); }
+
+// The A half (forward) and the reversed B half, joined at the fold: B's points mirrored in time
+// and shifted after A's duration.
+std::vector<TimedAngle> join(const std::vector<TimedAngle>& a, double ta, const std::vector<TimedAngle>& b, double tb) {
+  std::vector<TimedAngle> out = a;
+  for (auto it = b.rbegin(); it != b.rend(); ++it) {
+    const double t = ta + (tb - it->t_s);
+    if (out.back().t_s >= t - 1e-9) {
+      // Same instant (an arm that stopped exactly at the fold time): the angles agree.
+      continue;
+    }
+    // An arm that holds still across the join needs no point where it does not change.
+    if (out.size() >= 2 && out.back().deg == it->deg && out[out.size() - 2].deg == it->deg) {
+      out.back().t_s = t;
+      continue;
+    }
+    out.push_back({t, it->deg});
+  }
+  return out;
+}
+
+// Drops points in the middle of a run of equal angles (a still arm needs only both ends).
+void drop_still_points(std::vector<TimedAngle>& pts) {
+  std::vector<TimedAngle> out;
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    if (k > 0 && k + 1 < pts.size() && pts[k - 1].deg == pts[k].deg && pts[k + 1].deg == pts[k].deg) continue;
+    out.push_back(pts[k]);
+  }
+  // A trailing point that repeats the angle before it adds nothing (the arm holds its last angle).
+  while (out.size() >= 2 && out.back().deg == out[out.size() - 2].deg) out.pop_back();
+  pts = std::move(out);
+}
+
+constexpr const char* kReverseStuck = "its target cannot be reached from the fold without a collision";
+
+std::size_t firmware_points(const std::vector<TimedAngle>& pts) { return pts.empty() ? 0 : pts.size() - 1; }
+
+}  // namespace
+
+Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request, const PlannerOptions& o) {
+  const auto t_start = Clock::now();
+  const std::size_t n = model.size();
+  if (request.current.size() != n || request.target.size() != n || (!request.frozen.empty() && request.frozen.size() != n))
+    return make_error(PlanErrc::bad_trajectory,
+                      fmt::format("plan request: {} current poses, {} targets, {} frozen flags for {} robots",
+                                  request.current.size(), request.target.size(), request.frozen.size(), n));
+  for (std::size_t i = 0; i < n; ++i)
+    if (!finite(request.current[i]) || !finite(request.target[i]))
+      return make_error(PlanErrc::bad_trajectory, fmt::format("plan request: robot {}: angle not finite", model.robot(i).id()));
+  if (!(o.speed.alpha_deg_s > 0) || !(o.speed.beta_deg_s > 0) || !(o.step_deg > 0))
+    return make_error(PlanErrc::bad_trajectory, "plan request: speeds and step must be positive");
+
+  // The current configuration must be clear: no move out of a contact can be certified.
+  std::vector<Segment> segs(n);
+  std::vector<Contact> contacts;
+  model.segments(request.current, segs);
+  model.find_contacts(segs, contacts);
+  if (!contacts.empty()) {
+    std::string what;
+    for (const auto& c : contacts) {
+      if (what.size() > 300) {
+        what += ", ...";
+        break;
+      }
+      if (!what.empty()) what += ", ";
+      what += c.kind == Contact::Kind::robot
+                  ? fmt::format("robots {} and {} ({:.3f} mm)", model.robot(c.a).id(), model.robot(c.b).id(), c.clearance_mm)
+                  : fmt::format("robot {} and {} ({:.3f} mm)", model.robot(c.a).id(), model.obstacles()[c.b].name,
+                                c.clearance_mm);
+    }
+    return make_error(contacts.front().kind == Contact::Kind::robot ? PlanErrc::robot_collision : PlanErrc::obstacle_collision,
+                      fmt::format("current poses already in contact: {}", what));
+  }
+
+  Plan plan;
+  plan.robots.resize(n);
+  std::vector<Pose> target = request.target;
+  std::vector<bool> still(n, false);  // frozen or held: stays at the current pose throughout
+  for (std::size_t i = 0; i < n; ++i) {
+    plan.robots[i].status = RobotPlan::Status::reached;
+    if (!request.frozen.empty() && request.frozen[i]) {
+      plan.robots[i].status = RobotPlan::Status::frozen;
+      still[i] = true;
+      target[i] = request.current[i];
+    }
+  }
+
+  const double dt = o.step_deg / std::max(o.speed.alpha_deg_s, o.speed.beta_deg_s);
+  auto fold_beta = [&](std::size_t i) {
+    const AngleLimits& l = model.robot(i).limits();
+    return std::clamp(o.fold_beta_deg, l.beta_min_deg, l.beta_max_deg);
+  };
+  auto park_pose = [&](std::size_t i) { return Pose{request.current[i].alpha_deg, fold_beta(i)}; };
+  auto ids_of = [&](const std::vector<std::uint32_t>& v) {
+    std::vector<std::int32_t> out;
+    for (auto j : v) out.push_back(model.robot(j).id());
+    return out;
+  };
+
+  // Targets outside the limits or in contact with each other, with obstacles or with robots that
+  // stay: the later robot (or the one that moves) is parked; a parked robot whose fold still
+  // touches a robot that stays is held.
+  for (std::size_t i = 0; i < n; ++i) {
+    if (still[i]) continue;
+    if (!model.robot(i).within_limits(target[i])) {
+      plan.robots[i] = {RobotPlan::Status::parked, {}, "target outside the angle limits", {}};
+      target[i] = park_pose(i);
+    }
+  }
+  auto settle_targets = [&]() {
+    for (std::size_t guard = 0; guard < 4 * n + 4; ++guard) {
+      model.segments(target, segs);
+      model.find_contacts(segs, contacts);
+      if (contacts.empty()) return;
+      for (const auto& c : contacts) {
+        std::size_t victim = c.a;
+        std::string why;
+        std::vector<std::int32_t> blockers;
+        if (c.kind == Contact::Kind::robot) {
+          victim = still[c.b] ? c.a : c.b;
+          const std::size_t other = victim == c.a ? c.b : c.a;
+          why = fmt::format("target collides with robot {} ({:.3f} mm)", model.robot(other).id(), c.clearance_mm);
+          blockers.push_back(model.robot(other).id());
+        } else {
+          why = fmt::format("target collides with {} ({:.3f} mm)", model.obstacles()[c.b].name, c.clearance_mm);
+        }
+        if (still[victim]) continue;  // two robots that stay cannot touch: the current poses are clear
+        if (target[victim] == park_pose(victim)) {
+          // Already folded: the other one gives way if it can.
+          const std::size_t other = victim == c.a ? c.b : c.a;
+          if (c.kind == Contact::Kind::robot && !still[other] && target[other] != park_pose(other)) {
+            plan.robots[other] = {RobotPlan::Status::parked, {},
+                                  fmt::format("target collides with robot {} (parked)", model.robot(victim).id()),
+                                  {model.robot(victim).id()}};
+            target[other] = park_pose(other);
+            break;
+          }
+          plan.robots[victim] = {RobotPlan::Status::held, {}, "its folded pose collides with a robot that stays", blockers};
+          still[victim] = true;
+          target[victim] = request.current[victim];
+        } else {
+          plan.robots[victim] = {RobotPlan::Status::parked, {}, why, blockers};
+          target[victim] = park_pose(victim);
+        }
+        break;  // re-evaluate after each change
+      }
+    }
+  };
+  settle_targets();
+
+  StepperOptions so;
+  so.dt_s = dt;
+  so.alpha_step_deg = o.speed.alpha_deg_s * dt;
+  so.beta_step_deg = o.speed.beta_deg_s * dt;
+  so.margin_mm = o.margin_mm;
+  so.max_duration_s = o.max_half_s;
+
+  StepperResult ra, rb;
+  std::vector<StepperRobot> fa(n), fb(n);
+  double search_s = 0;
+  const int max_rounds = std::max(1, o.retries + 1) + 4;
+  for (int round = 0;; ++round) {
+    // The fold's alpha: alpha turns towards the target during B (as far as B's beta work allows)
+    // and the rest during A.
+    double tb = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (!still[i]) tb = std::max(tb, std::abs(target[i].beta_deg - fold_beta(i)) / o.speed.beta_deg_s);
+    const double alpha_budget = tb * o.speed.alpha_deg_s;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (still[i]) {
+        fa[i] = fb[i] = {request.current[i], request.current[i], true};
+        continue;
+      }
+      const double at = target[i].alpha_deg, ac = request.current[i].alpha_deg;
+      const Pose fold{at + std::clamp(ac - at, -alpha_budget, alpha_budget), fold_beta(i)};
+      fa[i] = {request.current[i], fold, false};
+      fb[i] = {target[i], fold, false};
+    }
+    StepperOptions sa = so, sb = so;
+    sa.seed = o.seed * 2 + 1 + static_cast<std::uint64_t>(round) * 7919;
+    sb.seed = o.seed * 2 + 2 + static_cast<std::uint64_t>(round) * 7919;
+    const auto t0 = Clock::now();
+    if (o.parallel) {
+      std::thread worker([&] { ra = drive_to_goals(model, fa, sa); });
+      rb = drive_to_goals(model, fb, sb);
+      worker.join();
+    } else {
+      ra = drive_to_goals(model, fa, sa);
+      rb = drive_to_goals(model, fb, sb);
+    }
+    search_s += seconds_since(t0);
+    plan.stats.rounds = static_cast<std::size_t>(round) + 1;
+    plan.stats.escapes += ra.escapes + rb.escapes;
+
+    bool changed = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (still[i]) continue;
+      if (!ra.reached[i]) {
+        plan.robots[i] = {RobotPlan::Status::held, {}, "cannot fold from its current pose without a collision",
+                          ids_of(ra.blockers[i])};
+        still[i] = true;
+        target[i] = request.current[i];
+        changed = true;
+      } else if (!rb.reached[i]) {
+        plan.robots[i] = {RobotPlan::Status::parked, {}, kReverseStuck, ids_of(rb.blockers[i])};
+        target[i] = park_pose(i);
+        changed = true;
+      }
+    }
+    if (!changed) break;
+    if (round + 1 >= max_rounds)
+      return make_error(PlanErrc::robot_collision,
+                        fmt::format("planner did not settle after {} rounds: robots keep blocking each other", max_rounds));
+    settle_targets();
+  }
+
+  // Third phase for robots parked because the reverse half got stuck: with everyone else at rest
+  // at the end, each tries forwards from its fold to its target. Robots that do not get there
+  // stay folded, and the others are re-planned without them (they were certified against it).
+  const double ta = ra.duration_s, tb = rb.duration_s;
+  std::vector<bool> in_c(n, false);
+  for (std::size_t i = 0; i < n; ++i)
+    in_c[i] = plan.robots[i].status == RobotPlan::Status::parked && plan.robots[i].reason == kReverseStuck &&
+              model.robot(i).within_limits(request.target[i]);
+  StepperResult rc;
+  bool any_c = std::find(in_c.begin(), in_c.end(), true) != in_c.end();
+  for (int pass = 0; any_c && pass < 4; ++pass) {
+    std::vector<StepperRobot> fc(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Pose end{rb.paths[i].alpha.front().deg, rb.paths[i].beta.front().deg};  // B starts at the end pose
+      fc[i] = in_c[i] ? StepperRobot{end, request.target[i], false} : StepperRobot{end, end, true};
+    }
+    StepperOptions sc = so;
+    sc.seed = o.seed * 2 + 99 + static_cast<std::uint64_t>(pass);
+    const auto t0 = Clock::now();
+    rc = drive_to_goals(model, fc, sc);
+    search_s += seconds_since(t0);
+    plan.stats.escapes += rc.escapes;
+    bool dropped = false;
+    for (std::size_t i = 0; i < n; ++i)
+      if (in_c[i] && !rc.reached[i]) {
+        in_c[i] = false;
+        dropped = true;
+      }
+    any_c = std::find(in_c.begin(), in_c.end(), true) != in_c.end();
+    if (!dropped) break;
+    if (!any_c) rc = {};
+  }
+  if (!any_c) rc = {};
+
+  // Join the halves (and the third phase).
+  plan.trajectories.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    RobotTrajectory& t = plan.trajectories[i];
+    t.alpha = join(ra.paths[i].alpha, ta, rb.paths[i].alpha, tb);
+    t.beta = join(ra.paths[i].beta, ta, rb.paths[i].beta, tb);
+    if (any_c && in_c[i]) {
+      for (auto [arm, c] : {std::pair{&t.alpha, &rc.paths[i].alpha}, std::pair{&t.beta, &rc.paths[i].beta}})
+        for (const auto& pt : *c) {
+          const double when = ta + tb + pt.t_s;
+          if (arm->back().t_s >= when - 1e-9) continue;
+          arm->push_back({when, pt.deg});
+        }
+      plan.robots[i] = {RobotPlan::Status::reached, {}, {}, {}};
+    }
+    drop_still_points(t.alpha);
+    drop_still_points(t.beta);
+    plan.robots[i].end = {t.alpha.back().deg, t.beta.back().deg};
+    if (plan.robots[i].status == RobotPlan::Status::parked || plan.robots[i].status == RobotPlan::Status::held) ++plan.not_reached;
+  }
+  plan.stats.search_s = search_s;
+
+  // Simplify where it pays, then verify; robots in a pair the checker flags get their exact
+  // (certified) trajectories back, until the checker is satisfied.
+  const std::vector<RobotTrajectory> exact = plan.trajectories;
+  std::vector<bool> simplified(n, false);
+  for (std::size_t i = 0; i < n; ++i) {
+    RobotTrajectory& t = plan.trajectories[i];
+    const bool over = firmware_points(t.alpha) > o.max_points || firmware_points(t.beta) > o.max_points;
+    if (o.simplify_deg <= 0 && !over) continue;
+    double tol = std::max(o.simplify_deg, 1e-3);
+    for (;;) {
+      auto a = simplify_arm(exact[i].alpha, tol), b = simplify_arm(exact[i].beta, tol);
+      if ((firmware_points(a) <= o.max_points && firmware_points(b) <= o.max_points) || tol > 10) {
+        if (a.size() < t.alpha.size() || b.size() < t.beta.size()) {
+          t.alpha = std::move(a);
+          t.beta = std::move(b);
+          simplified[i] = true;
+        }
+        break;
+      }
+      tol *= 2;
+    }
+  }
+
+  TrajectoryChecker checker(model);
+  const auto t_check = Clock::now();
+  if (o.verify) {
+    for (int pass = 0; pass < 6; ++pass) {
+      AXON_TRY(checker.check(plan.trajectories, o.check, plan.check));
+      if (plan.check.ok()) break;
+      bool reverted = false;
+      auto revert = [&](std::size_t i) {
+        if (!simplified[i]) return;
+        plan.trajectories[i] = exact[i];
+        simplified[i] = false;
+        reverted = true;
+      };
+      const auto rp = model.robot_pairs();
+      for (std::size_t k = 0; k < rp.size(); ++k)
+        if (plan.check.robot_pairs[k].collided) {
+          revert(rp[k].a);
+          revert(rp[k].b);
+        }
+      const auto op = model.obstacle_pairs();
+      for (std::size_t k = 0; k < op.size(); ++k)
+        if (plan.check.obstacle_pairs[k].collided) revert(op[k].robot);
+      if (!reverted) break;
+    }
+    plan.verified = plan.check.ok();
+  }
+  plan.stats.check_s = seconds_since(t_check);
+
+  std::vector<std::size_t> counts;
+  for (std::size_t i = 0; i < n; ++i) {
+    const RobotTrajectory& t = plan.trajectories[i];
+    plan.stats.simplified += simplified[i] ? 1 : 0;
+    for (const auto* arm : {&t.alpha, &t.beta}) {
+      const std::size_t c = firmware_points(*arm);
+      if (c == 0) continue;
+      counts.push_back(c);
+      plan.stats.max_points = std::max(plan.stats.max_points, c);
+    }
+    plan.stats.max_alpha_speed = std::max(plan.stats.max_alpha_speed, max_speed(t.alpha));
+    plan.stats.max_beta_speed = std::max(plan.stats.max_beta_speed, max_speed(t.beta));
+    plan.stats.duration_s = std::max({plan.stats.duration_s, t.alpha.back().t_s, t.beta.back().t_s});
+  }
+  if (!counts.empty()) {
+    std::nth_element(counts.begin(), counts.begin() + static_cast<std::ptrdiff_t>(counts.size() / 2), counts.end());
+    plan.stats.median_points = counts[counts.size() / 2];
+  }
+  plan.stats.plan_s = seconds_since(t_start);
+  return plan;
+}
+
+}  // namespace axon::fps::plan

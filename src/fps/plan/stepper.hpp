@@ -1,0 +1,73 @@
+// The planner's motion engine: drives every robot from a start pose towards a goal pose in
+// lock-step time steps, each step certified collision-free over its whole interval.
+//
+// Every step lasts dt; each arm moves by -step, 0, +step or the rest of the way to its goal (a
+// partial step), so each arm's speed is piecewise constant and at most the speed limit. Robots
+// take their step one after the other within a time step (in a random order drawn from the seed),
+// and each checks its move against every neighbour's move of the same step (neighbours that have
+// not moved yet stand still for this check; they check against this robot when their turn comes),
+// so every pair is checked once, with both robots moving, by whichever moves later. Standing
+// still is therefore always allowed, and the configuration stays clear.
+//
+// Certificate for one pair over one step: a point of a robot's collision segment moves at most
+// |d alpha| * reach + |d beta| * collision length (radians, mm), so the pair's clearance changes
+// by at most S (the sum of both robots' bounds) over the step. With clearances c0 and c1 at the
+// ends, the clearance anywhere in between is at least (c0 + c1 - S) / 2. Where that is negative,
+// the step is halved and both halves are certified the same way, down to a few micrometres. A
+// step the certificate rejects is not taken.
+//
+// Choice of move: greedy, the move that lowers the weighted angle distance to the goal the most
+// (beta weighs more than alpha, so arms fold before they turn), preferring the previous move on
+// ties so that trajectories keep few corners. A robot that makes no progress for a while is stuck:
+// the neighbours blocking its best move that rank lower (a random priority per run) are made to
+// escape; if none does, it escapes itself. Escaping robots, for a random number of steps, take the
+// move that opens the most clearance (with a random nudge), then go back to greedy. Robots still away from their goal when the time limit is
+// reached are reported as stuck, with the neighbours that blocked them.
+#pragma once
+
+#include "fps/plan/collision.hpp"
+#include "fps/plan/trajectory.hpp"
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace axon::fps::plan {
+
+struct StepperRobot {
+  Pose start;
+  Pose goal;
+  bool frozen = false;  // never moves (held, disabled): an obstacle for the others
+};
+
+struct StepperOptions {
+  double dt_s = 1.0 / 12.0;      // one step
+  double alpha_step_deg = 1.0;   // per step at full speed
+  double beta_step_deg = 1.0;
+  double margin_mm = 0.05;       // clearance every step's end keeps (or its start value if less)
+  double max_duration_s = 90.0;  // give up after this much simulated time
+  std::uint64_t seed = 1;
+  double alpha_weight = 1.0;     // cost = weight * |angle to go|, per arm
+  double beta_weight = 2.0;
+  int stuck_steps = 6;           // steps without progress before a robot escapes
+  int escape_min_steps = 3;
+  int escape_max_steps = 15;
+};
+
+struct StepperResult {
+  std::vector<RobotTrajectory> paths;   // per robot, times from 0, few points (lossless)
+  std::vector<Pose> end;                // where each robot ended
+  std::vector<bool> reached;            // at its goal
+  std::vector<std::vector<std::uint32_t>> blockers;  // for robots that did not reach: who blocked
+  double duration_s = 0;                // until the last robot stopped
+  std::size_t steps = 0;
+  std::size_t escapes = 0;              // escape episodes started
+  std::size_t pair_checks = 0;          // exact pair certificates evaluated
+};
+
+// Robots in model order. A pair that starts in contact cannot be certified, so both robots of it
+// stay where they are: callers pass a clear start.
+StepperResult drive_to_goals(const CollisionModel& model, std::span<const StepperRobot> robots,
+                             const StepperOptions& options);
+
+}  // namespace axon::fps::plan

@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Path planning on the command line: `fps plan` on the default 500-robot layout writes a verified
+# plan.json, `fps plot` draws it; `fps goto-all` plans from the simulated benchtop robots' positions,
+# runs the move and reports every robot completed at its target.
+source "$(dirname "$0")/lib.sh"
+DATA="$(cd "$(dirname "$0")/../../data/layouts" && pwd)"
+
+"$AXON" fps plan --layout "$DATA/default.yaml" --to random --seed 5 -o "$TMP/plan.json" --svg "$TMP/plan.svg" \
+  --allow-partial 2>"$TMP/plan.err" || fail "plan exited with $? ($(cat "$TMP/plan.err"))"
+grep -q 'verified by the checker' "$TMP/plan.err" || fail "plan: not verified: $(cat "$TMP/plan.err")"
+/usr/bin/python3 - "$TMP/plan.json" <<'PY' || fail "plan.json is not what was expected"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["format"] == "axon-fps-plan" and j["verified"] is True, j.get("verified")
+assert len(j["robots"]) == 500
+for r in j["robots"]:
+    for arm in ("alpha", "beta"):
+        pts = r[arm]
+        assert pts[0][1] == 0 and len(pts) - 1 <= 1023
+        for (a0, t0), (a1, t1) in zip(pts, pts[1:]):
+            assert t1 > t0 and abs(a1 - a0) / (t1 - t0) <= 12 + 1e-6, (r["id"], arm)
+    if r["status"] in ("parked", "held"):
+        assert r["reason"], r
+PY
+grep -q '<svg' "$TMP/plan.svg" || fail "plan --svg wrote no SVG"
+"$AXON" fps plot --layout "$DATA/default.yaml" --plan "$TMP/plan.json" --at 5 -o "$TMP/at5.svg" 2>"$TMP/plot.err" \
+  || fail "plot of the plan at 5 s exited with $? ($(cat "$TMP/plot.err"))"
+grep -q 'at 5.00 s' "$TMP/at5.svg" || fail "plot: title"
+
+# A target file with a typo'd robot is an error, not a silent drop.
+printf 'targets:\n  - {robot: 99, alpha: 10, beta: 170}\n' >"$TMP/bad.yaml"
+if "$AXON" fps plan --layout "$DATA/benchtop.yaml" --to "$TMP/bad.yaml" 2>"$TMP/bad.err"; then fail "unknown robot accepted"; fi
+grep -q '99' "$TMP/bad.err" || fail "unknown robot not named: $(cat "$TMP/bad.err")"
+
+# goto-all on the simulated benchtop (robots start folded at alpha 0, beta 180).
+cat >"$TMP/targets.yaml" <<'YAML'
+targets:
+  - {robot: 1, alpha: 30, beta: 150}
+  - {robot: 2, alpha: 90, beta: 140}
+  - {robot: 3, alpha: 200, beta: 160}
+  - {robot: 4, alpha: 10, beta: 170}
+  - {robot: 5, alpha: 300, beta: 150}
+  - {robot: 6, alpha: 45, beta: 175}
+YAML
+start_sim_fps --robots 1-6 --gateway 127.0.0.1:0
+"$AXON" fps --gateway "127.0.0.1:$SIM_CANNET_PORT" goto-all --layout "$DATA/benchtop.yaml" --targets "$TMP/targets.yaml" \
+  --save-plan "$TMP/bench_plan.json" >"$TMP/goto.out" 2>"$TMP/goto.err" \
+  || fail "goto-all exited with $?: $(cat "$TMP/goto.out" "$TMP/goto.err")"
+grep -qi 'completed' "$TMP/goto.out" || fail "goto-all: $(cat "$TMP/goto.out")"
+"$AXON" fps --gateway "127.0.0.1:$SIM_CANNET_PORT" --json position 2>/dev/null >"$TMP/pos.json" || fail "position"
+/usr/bin/python3 - "$TMP/pos.json" <<'PY' || fail "robots are not at their targets: $(cat "$TMP/pos.json")"
+import json, sys
+want = {1: (30, 150), 2: (90, 140), 3: (200, 160), 4: (10, 170), 5: (300, 150), 6: (45, 175)}
+j = json.load(open(sys.argv[1]))
+got = {int(k): (v["alpha"], v["beta"]) for k, v in j.items()}
+for i, (a, b) in want.items():
+    assert abs(got[i][0] - a) < 0.2 and abs(got[i][1] - b) < 0.2, (i, got[i])
+PY
+echo "ok"
