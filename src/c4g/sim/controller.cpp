@@ -661,11 +661,12 @@ void Controller::step_physics() {
     double reported = dsa_ref;
     double vel = ax.traj_vel;
     double acc = ax.traj_acc;
+    bool echo_test = false;
     switch (base) {
-      case 10:  // 0': the controller uses what the PC echoed
-        dsa_ref = reported = pc.d1;
+      case 10:  // 0': the controller keeps sending its own trajectory; the DSA gets what the PC echoed
+        echo_test = true;
+        dsa_ref = pc.d1;
         vel = pc.d2 / period_;
-        acc = (vel - ax.ref_vel) / period_;
         break;
       case 1:  // the PC generates and closes the loops; the DSA holds until the switch is complete
         dsa_ref = ax.hold_pos;
@@ -720,7 +721,7 @@ void Controller::step_physics() {
     ax.prev_ref_pos = dsa_ref;
     ax.dsa_ref = dsa_ref;
     ax.ref_pos = reported;
-    ax.ref_vel = vel;
+    ax.ref_vel = echo_test ? ax.traj_vel : vel;
   }
 }
 
@@ -810,6 +811,12 @@ bool Controller::start_step(const Step& s) {
           return false;
         }
         const std::size_t first = map_.arm_first(arm), n = map_.arm_count(arm);
+        if (s.mode == P::code(P::Mode::mode2_standby) && a.open && a.open_mode == P::code(P::Mode::mode2)) {
+          // Mode 2 is the one the robot program ends itself (state machine: the program sets 2' after
+          // its move, then waits while control ramps back to the drive): the exit sequence 12 -> 0.
+          start_exit(arm);
+          continue;
+        }
         for (std::size_t i = first; i < first + n; ++i) {
           const std::int32_t cur = axes_[i].mode;
           if (cur != 0 && cur != 10 && cur != s.mode) {
@@ -900,6 +907,10 @@ bool Controller::step_complete(const Step& s) {
         if (arms_[arm].powered || arms_[arm].drive_off_left > 0) return false;
       return true;
     case StepKind::go_open:
+      if (s.mode == P::code(P::Mode::mode2_standby))  // leaving mode 2 blocks until mode 0, like its delays
+        for (std::size_t arm : step_arms(s))
+          if (arms_[arm].open) return false;
+      return true;
     case StepKind::cmd: return true;
     case StepKind::wait_for_pc:
       for (std::size_t arm : step_arms(s))
