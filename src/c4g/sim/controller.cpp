@@ -182,10 +182,17 @@ void Controller::encode_cyclic(std::int32_t force_mode) {
     p.cmd = P::with_arm_byte(p.cmd, arm, arms_[arm].cmd);
   }
   p.count = map_.count();
+  // A program's special code (502, 504, 506) is issued from mode 0: the packets first show mode 0 at
+  // least once, so the PC sees the open mode end before the special (a state no packet shows does
+  // not exist for the PC). 503 follows the silence of 502 directly.
+  bool shown_mode0 = true;
+  for (std::size_t i = 0; i < p.count; ++i) shown_mode0 = shown_mode0 && axes_[i].sent_mode == 0;
+  const std::int32_t special = shown_mode0 || force_mode == P::code(P::Mode::freezing_passive_out) ? force_mode : 0;
+  special_in_packet_ = special;
   for (std::size_t i = 0; i < p.count; ++i) {
     const AxisSim& ax = axes_[i];
     P::Axis& a = p.axes[i];
-    a.mode = phase_ == Phase::sync ? 0 : (force_mode != 0 ? force_mode : ax.mode);
+    a.mode = phase_ == Phase::sync ? 0 : (special != 0 ? special : ax.mode);
     axes_[i].sent_mode = a.mode;
     a.d1 = static_cast<float>(ax.ref_pos);
     a.d2 = static_cast<float>(ax.ref_vel * period_);
@@ -247,7 +254,7 @@ void Controller::judge_datagram(std::span<const std::byte> d) {
 void Controller::end_cycle() {
   std::array<std::int32_t, P::kMaxAxes> before{};
   for (std::size_t i = 0; i < map_.count(); ++i) before[i] = axes_[i].mode;
-  const std::int32_t sent_special = sent_cyclic_ ? pending_special_ : 0;
+  const std::int32_t sent_special = sent_cyclic_ ? special_in_packet_ : 0;
   if (awaiting_) {
     recent_[recent_next_] = expected_;
     recent_next_ = (recent_next_ + 1) % recent_.size();
