@@ -130,7 +130,8 @@ TEST(ServerAgainstSim, Mode8VelocityContributionShiftsTheAxisThenExitFromOpenEnd
   EXPECT_TRUE(run.c->scenario_done()) << run.log();
   EXPECT_FALSE(run.c->communication_error());
   EXPECT_EQ(run.c->stats().refused_requests, 0u);
-  EXPECT_EQ(modes, (std::vector<std::int32_t>{0, 501, 0, 8, 0, 504})) << run.log();
+  // The drive-on procedure ends straight into the mode the program set (manual, driving on).
+  EXPECT_EQ(modes, (std::vector<std::int32_t>{0, 501, 8, 0, 504})) << run.log();
   const double kp = S::six_axis_robot().axes[0][1].kp;
   EXPECT_GT(max_lead, 0.5 / kp);
   EXPECT_LT(max_lead, 2.0 / kp);
@@ -244,10 +245,11 @@ TEST(ServerAgainstSim, ActiveFreezing500ToleratesAStalledPcUntilExitFromOpen) {
         stalled = true;
         std::this_thread::sleep_for(std::chrono::milliseconds(80));
       }
-      if (frozen > 20) {
-        r.exit_from_open(1);
-        done = true;
-      }
+      if (frozen > 20) r.exit_from_open(1);  // until the controller shows mode 0 again
+      return;
+    }
+    if (frozen > 0) {
+      done = true;
       return;
     }
     if (drives && all_modes(ctx.request, 0) && ++on_cycles >= 10)
@@ -264,7 +266,7 @@ TEST(ServerAgainstSim, ActiveFreezing500ToleratesAStalledPcUntilExitFromOpen) {
   EXPECT_TRUE(run.has(S::event::kFreezing, "active freezing (500)")) << run.log();
   EXPECT_TRUE(run.has(S::event::kFreezing, "ended by the PC's exit-from-open")) << run.log();
   EXPECT_GE(run.c->stats().frozen_cycles, 20u);
-  EXPECT_EQ(run.c->stats().misses, 0u);
+  EXPECT_LT(run.c->stats().max_consecutive_misses, 10u);
   EXPECT_TRUE(done);
 }
 
@@ -299,7 +301,7 @@ TEST(ServerAgainstSim, ForbiddenModeRequestsAreRefusedByTheServerAndNeverReachTh
   EXPECT_EQ(run.c->stats().refused_requests, 0u) << run.log();
   EXPECT_FALSE(run.has(S::event::kRequestRefused));
   // The PC's exit came while the controller's move still ran: 7' until it ends, then 7'', then 0.
-  EXPECT_EQ(modes, (std::vector<std::int32_t>{0, 501, 0, 7, 17, 170, 0, 504})) << run.log();
+  EXPECT_EQ(modes, (std::vector<std::int32_t>{0, 501, 7, 17, 170, 0, 504})) << run.log();
 }
 
 // ---- silence on either side --------------------------------------------------------------------------
