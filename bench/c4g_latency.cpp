@@ -1,16 +1,24 @@
-// c4g latency at 1 kHz with six axes: the Server running the `pid` application in mode 1 (the
-// heaviest built-in law: transforms, six PI loops, safety checks) against a minimal C UDP echo
-// server, both driven in the same run by one paced controller-side client that alternates between
-// them every tick (so both see the same machine load).
+// c4g latency at 1 kHz with six axes, measured by the controller simulator: two simulated
+// controllers (src/c4g/sim, the paced client loop `axon sim c4g` runs) side by side in one process,
+// one against the c4g Server running the `pid` application in mode 1 (the heaviest built-in law:
+// transforms, six PI loops, safety checks), the other against a minimal C UDP echo server, so both
+// see the same machine load.
 //
 // Figures: server processing time (packet received -> reply sent, the server's own TimingStats)
-// and the echo server's (recvfrom returned -> sendto returned), p50/p99/p99.9/max; the client's
-// round trip to each; missed deadlines (above 500 us, the manual's T_CYCLE1) for both. Ratios are
-// server / echo. `--seconds N` (default 5; 60 for the full run).
+// and the echo server's (recvfrom returned -> sendto returned), p50/p99/p99.9/max; the simulators'
+// round trips (send -> accepted reply, waited for up to 20 ms so the tail is measured); processing
+// times and round trips over 500 us (the manual's T_CYCLE1) and round trips over the 1 ms period, for
+// both.
+// Ratios are server / echo. `--seconds N` (default 5; 60 for the full run).
 // Last line: `BENCH c4g_latency ... ratio=` (round-trip p50 ratio).
 #include "c4g/apps/pid.hpp"
 #include "c4g/host/server.hpp"
 #include "c4g/protocol/init_packet.hpp"
+#include "c4g/sim/client_runner.hpp"
+#include "c4g/sim/controller.hpp"
+#include "c4g/sim/robots.hpp"
+#include "c4g/sim/scenario.hpp"
+#include "c4g/sim/udp_client.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -20,11 +28,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <array>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -35,7 +45,6 @@ using namespace axon::c4g;
 namespace {
 
 constexpr std::size_t kAxes = 6;
-constexpr std::int64_t kPeriodNs = 1'000'000;
 constexpr std::int64_t kDeadlineNs = 500'000;
 
 std::int64_t mono_ns() {
@@ -100,33 +109,35 @@ struct EchoServer {
   }
 };
 
-// The controller side: one socket, one request in flight at a time.
-struct Client {
-  net::UdpSocket socket = net::UdpSocket::open(net::SocketAddress{0x7f000001, 0}).value();
-  std::array<std::byte, 2048> rx{};
-  // Sends and waits for the answer; the round trip in ns, or -1 when none came within 20 ms.
-  std::int64_t exchange(std::span<const std::byte> tx, const net::SocketAddress& to) {
-    const std::int64_t t0 = mono_ns();
-    if (!socket.send_to(tx, to)) return -1;
-    auto r = socket.receive(rx, std::chrono::milliseconds(20));
-    if (!r) return -1;
-    return mono_ns() - t0;
+// One simulated controller (six-axis robot at 1 ms) playing `yaml` against `port` for `seconds`.
+struct SimSide {
+  std::optional<sim::Controller> controller;
+  sim::RunReport report;
+  std::string error;
+
+  void run(std::uint16_t port, const char* yaml, double seconds) {
+    auto scenario = sim::Scenario::parse(yaml);
+    sim::ControllerOptions co;
+    co.period_ms = 1;
+    // A benchmark reports stalls instead of ending on them: the manual's communication error (10
+    // misses in a row) is off, and replies are waited for up to 20 ms so that the round-trip tail is
+    // measured rather than cut at the period.
+    co.max_misses = 1 << 30;
+    auto c = sim::Controller::create(sim::six_axis_robot(), scenario.value(), co);
+    auto udp = sim::UdpClient::open(net::Endpoint{"127.0.0.1", port});
+    if (!c || !udp) {
+      error = "cannot start the simulator";
+      return;
+    }
+    controller.emplace(std::move(c).value());
+    sim::RunOptions ro;
+    ro.duration_s = seconds;
+    ro.reply_deadline = std::chrono::milliseconds(20);
+    report = sim::run_client(*controller, udp.value(), ro);
+    if (controller->communication_error()) error = "communication error";
+    else if (controller->scenario_failed()) error = controller->scenario_error();
   }
 };
-
-protocol::InitPacket bench_init() {
-  protocol::InitPacket p;
-  p.protocol_number = 1;
-  p.open_axes = kAxes;
-  p.period_ms = 1;
-  p.open_axis_list[0] = {1, 2, 3, 4, 5, 6, 0, 0, 0, 0};
-  p.calibration[0] = {0.14f, 0.17f, 0.22f, 0.41f, 0.04f, 0.36f, 0, 0, 0, 0};
-  p.current_limit[0] = {24.5f, 24.5f, 24.5f, 9.5f, 9.5f, 9.5f, 0, 0, 0, 0};
-  p.transmission_ratio[0] = {-181.6f, 159.3f, 162.5f, 72.6f, 78.75f, -50.0f, 0, 0, 0, 0};
-  p.influence[0] = {0, 0, 0, -0.02f, 0.0204f, 0.02f, 0, 0, 0, 0};
-  p.following_error[0] = {7.5f, 7.5f, 7.5f, 7.5f, 7.5f, 0, 0, 0, 0, 0};
-  return p;
-}
 
 }  // namespace
 
@@ -134,90 +145,75 @@ int main(int argc, char** argv) {
   double seconds = 5;
   for (int i = 1; i + 1 < argc; ++i)
     if (std::string(argv[i]) == "--seconds") seconds = std::atof(argv[i + 1]);
-  const auto rounds = static_cast<std::size_t>(seconds * 1e9 / static_cast<double>(kPeriodNs));
 
   EchoServer echo;
-  const net::SocketAddress echo_addr{0x7f000001, echo.port};
 
-  apps::PidApp app(apps::PidOptions{});
+  apps::PidOptions pid;  // a 0.5 deg / 1 Hz sine on every joint, so the loops have work to do
+  pid.amplitude_rad = {0.5 * 3.14159265358979 / 180.0};
+  pid.frequency_hz = {1.0};
+  apps::PidApp app(pid);
   host::ServerOptions o;
   o.listen = net::Endpoint{"127.0.0.1", 0};
   o.safety.check_following_error = true;
   o.max_late_cycles = 0;  // a loaded machine must not end the run
   auto server = host::Server::start(app, o).value();
-  const auto server_addr = server->local_address();
 
-  Client client;
-  std::array<std::byte, protocol::kInitPacketSize> init_bytes{};
-  if (!protocol::encode_init(bench_init(), init_bytes)) return 1;
-  if (client.exchange(init_bytes, server_addr) < 0) {
-    std::fprintf(stderr, "c4g_latency: no answer to the initialization packet\n");
-    return 1;
-  }
-
-  protocol::Packet p;
-  p.count = kAxes;
-  p.infpar = protocol::kDrivesOn;
-  for (std::size_t i = 0; i < kAxes; ++i) {
-    p.axes[i].mode = 1;  // the PC closes the loops: the pid app holds the position
-    p.axes[i].d1 = p.axes[i].d3 = 0.5f * static_cast<float>(i);
-    p.axes[i].ext1 = 0.1f;
-  }
-  std::array<std::byte, protocol::kMaxPacketSize> tx{};
-  Stats rtt_server, rtt_echo;
-  rtt_server.v.reserve(rounds);
-  rtt_echo.v.reserve(rounds);
-  std::size_t lost_server = 0, lost_echo = 0;
-  std::int64_t next = mono_ns() + kPeriodNs;
-  for (std::size_t k = 0; k < rounds; ++k) {
-    const timespec wake{static_cast<time_t>(next / 1'000'000'000), static_cast<long>(next % 1'000'000'000)};
-    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &wake, nullptr);
-    next += kPeriodNs;
-    p.num = static_cast<std::int32_t>(k & 0x7FFF);
-    // Small motion so the loops have work to do.
-    for (std::size_t i = 0; i < kAxes; ++i) p.axes[i].d3 = 0.5f * static_cast<float>(i) + 1e-4f * static_cast<float>(k % 100);
-    (void)protocol::encode_packet(p, tx);
-    const std::span<const std::byte> bytes(tx.data(), protocol::packet_size(kAxes));
-    for (int side = 0; side < 2; ++side) {
-      const bool to_server = (side == 0) == (k % 2 == 0);
-      const std::int64_t r = client.exchange(bytes, to_server ? server_addr : echo_addr);
-      if (r < 0) ++(to_server ? lost_server : lost_echo);
-      else (to_server ? rtt_server : rtt_echo).v.push_back(r);
-    }
-  }
+  // The server side holds the robot in mode 1 (the PC closes the loops); the echo side stays in
+  // mode 0, where an echoed packet is a valid answer the controller ignores.
+  SimSide to_server, to_echo;
+  std::thread t([&] {
+    to_server.run(server->local_address().port, "steps:\n  - drive_on\n  - go_open: {type: A, mode: 1}\n  - run\n", seconds);
+  });
+  to_echo.run(echo.port, "steps:\n  - drive_on\n  - run\n", seconds);
+  t.join();
   server->stop();
   echo.finish();
+  for (const SimSide* s : {&to_server, &to_echo})
+    if (!s->error.empty() || !s->controller) {
+      std::fprintf(stderr, "c4g_latency: simulator against the %s: %s\n", s == &to_server ? "server" : "echo",
+                   s->error.empty() ? "did not start" : s->error.c_str());
+      return 1;
+    }
 
-  rtt_server.sort();
-  rtt_echo.sort();
   echo.processing.sort();
   const auto& h = server->cycle().timing().cycle_times();
   const double sp50 = static_cast<double>(h.percentile(50)) * 1e-3, sp99 = static_cast<double>(h.percentile(99)) * 1e-3,
                sp999 = static_cast<double>(h.percentile(99.9)) * 1e-3, spmax = static_cast<double>(h.max()) * 1e-3;
   const auto& ep = echo.processing;
+  const auto& rs = to_server.report.rtt;
+  const auto& re = to_echo.report.rtt;
+  auto us = [](const sim::RttHistogram& r, double p) { return static_cast<double>(r.percentile(p)) * 1e-3; };
+  auto ull = [](std::uint64_t v) { return static_cast<unsigned long long>(v); };
   auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
 
   std::printf("%s", server->summary().c_str());
-  std::printf("c4g_latency: %.0f s at 1 kHz, %zu axes, server app pid (mode 1), deadline %lld us\n", seconds, kAxes,
-              static_cast<long long>(kDeadlineNs / 1000));
+  std::printf("%s", app.summary().c_str());
+  std::printf("c4g_latency: %.0f s at 1 kHz, %zu axes, server app pid (mode 1, 0.5 deg sine), deadline %lld us, round trips measured "
+              "by the controller simulator\n",
+              seconds, kAxes, static_cast<long long>(kDeadlineNs / 1000));
   std::printf("processing us   server p50 %.1f p99 %.1f p99.9 %.1f max %.1f | echo p50 %.1f p99 %.1f p99.9 %.1f max %.1f\n",
               sp50, sp99, sp999, spmax, ep.us(50), ep.us(99), ep.us(99.9), ep.max_us());
-  std::printf("round trip us   server p50 %.1f p99 %.1f p99.9 %.1f max %.1f | echo p50 %.1f p99 %.1f p99.9 %.1f max %.1f\n",
-              rtt_server.us(50), rtt_server.us(99), rtt_server.us(99.9), rtt_server.max_us(), rtt_echo.us(50),
-              rtt_echo.us(99), rtt_echo.us(99.9), rtt_echo.max_us());
-  std::printf("missed (> 500 us): server processing %llu, echo processing %zu; round trips server %zu echo %zu; lost server %zu echo %zu\n",
-              static_cast<unsigned long long>(server->cycle().timing().missed_deadlines()), ep.over(kDeadlineNs),
-              rtt_server.over(kDeadlineNs), rtt_echo.over(kDeadlineNs), lost_server, lost_echo);
+  std::printf("round trip us   server p50 %.1f p99 %.1f p99.9 %.1f max %.1f (n %llu) | echo p50 %.1f p99 %.1f p99.9 %.1f "
+              "max %.1f (n %llu)\n",
+              us(rs, 0.5), us(rs, 0.99), us(rs, 0.999), static_cast<double>(rs.max()) * 1e-3, ull(rs.count()), us(re, 0.5),
+              us(re, 0.99), us(re, 0.999), static_cast<double>(re.max()) * 1e-3, ull(re.count()));
+  std::printf("over 500 us: server processing %llu, echo processing %zu; round trips server %llu echo %llu; round trips "
+              "over 1 ms server %llu echo %llu; schedule overruns %llu / %llu; pid max following error %.5f turns\n",
+              ull(server->cycle().timing().missed_deadlines()), ep.over(kDeadlineNs), ull(rs.count_at_or_above(kDeadlineNs)),
+              ull(re.count_at_or_above(kDeadlineNs)), ull(rs.count_at_or_above(1'000'000)), ull(re.count_at_or_above(1'000'000)), ull(to_server.report.overruns),
+              ull(to_echo.report.overruns), app.max_following_error());
   std::printf(
-      "BENCH c4g_latency seconds=%.0f axes=%zu rounds=%zu server_proc_p50_us=%.1f server_proc_p99_us=%.1f "
-      "server_proc_p999_us=%.1f server_proc_max_us=%.1f echo_proc_p50_us=%.1f echo_proc_p99_us=%.1f "
-      "echo_proc_p999_us=%.1f echo_proc_max_us=%.1f rtt_server_p50_us=%.1f rtt_echo_p50_us=%.1f rtt_server_p99_us=%.1f "
-      "rtt_echo_p99_us=%.1f rtt_server_p999_us=%.1f rtt_echo_p999_us=%.1f missed_server=%zu missed_echo=%zu "
-      "proc_ratio_p50=%.2f proc_ratio_p99=%.2f rtt_ratio_p99=%.2f rtt_ratio_p999=%.2f ratio=%.2f\n",
-      seconds, kAxes, rounds, sp50, sp99, sp999, spmax, ep.us(50), ep.us(99), ep.us(99.9), ep.max_us(), rtt_server.us(50),
-      rtt_echo.us(50), rtt_server.us(99), rtt_echo.us(99), rtt_server.us(99.9), rtt_echo.us(99.9),
-      rtt_server.over(kDeadlineNs), rtt_echo.over(kDeadlineNs), ratio(sp50, ep.us(50)), ratio(sp99, ep.us(99)),
-      ratio(rtt_server.us(99), rtt_echo.us(99)), ratio(rtt_server.us(99.9), rtt_echo.us(99.9)),
-      ratio(rtt_server.us(50), rtt_echo.us(50)));
+      "BENCH c4g_latency seconds=%.0f axes=%zu rounds_server=%llu rounds_echo=%llu server_proc_p50_us=%.1f "
+      "server_proc_p99_us=%.1f server_proc_p999_us=%.1f server_proc_max_us=%.1f echo_proc_p50_us=%.1f "
+      "echo_proc_p99_us=%.1f echo_proc_p999_us=%.1f echo_proc_max_us=%.1f rtt_server_p50_us=%.1f rtt_echo_p50_us=%.1f "
+      "rtt_server_p99_us=%.1f rtt_echo_p99_us=%.1f rtt_server_p999_us=%.1f rtt_echo_p999_us=%.1f missed_server=%llu "
+      "missed_echo=%llu over_period_server=%llu over_period_echo=%llu proc_ratio_p50=%.2f proc_ratio_p99=%.2f "
+      "rtt_ratio_p99=%.2f rtt_ratio_p999=%.2f ratio=%.2f\n",
+      seconds, kAxes, ull(rs.count()), ull(re.count()), sp50, sp99, sp999, spmax, ep.us(50), ep.us(99), ep.us(99.9),
+      ep.max_us(), us(rs, 0.5), us(re, 0.5), us(rs, 0.99), us(re, 0.99), us(rs, 0.999), us(re, 0.999),
+      ull(rs.count_at_or_above(kDeadlineNs)), ull(re.count_at_or_above(kDeadlineNs)), ull(rs.count_at_or_above(1'000'000)),
+      ull(re.count_at_or_above(1'000'000)),
+      ratio(sp50, ep.us(50)), ratio(sp99, ep.us(99)), ratio(us(rs, 0.99), us(re, 0.99)),
+      ratio(us(rs, 0.999), us(re, 0.999)), ratio(us(rs, 0.5), us(re, 0.5)));
   return 0;
 }

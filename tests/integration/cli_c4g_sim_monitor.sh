@@ -20,6 +20,8 @@ grep -q "Worst cycle time" "$TMP/serve.out" || fail "no timing report"
 "$AXON" c4g init-info --from-pcap "$TMP/run.pcap" >"$TMP/info.out" || fail "init-info"
 grep -q "open axis 6 = arm 1 axis 6" "$TMP/info.out" || fail "init-info content"
 if command -v tcpdump >/dev/null; then
-  tcpdump -nn -r "$TMP/run.pcap" 2>/dev/null | grep -q "UDP, length 1200" || fail "tcpdump does not show the initialization packet"
+  # Not piped into grep -q: grep quitting early would SIGPIPE tcpdump and fail the pipeline (pipefail).
+  tcpdump -nn -r "$TMP/run.pcap" >"$TMP/tcpdump.txt" 2>/dev/null || fail "tcpdump cannot read the capture"
+  grep -q "UDP, length 1200" "$TMP/tcpdump.txt" || fail "tcpdump does not show the initialization packet"
 fi
 echo ok

@@ -182,10 +182,17 @@ void Controller::encode_cyclic(std::int32_t force_mode) {
     p.cmd = P::with_arm_byte(p.cmd, arm, arms_[arm].cmd);
   }
   p.count = map_.count();
+  // A program's special code (502, 504, 506) is issued from mode 0: the packets first show mode 0 at
+  // least once, so the PC sees the open mode end before the special (a state no packet shows does
+  // not exist for the PC). 503 follows the silence of 502 directly.
+  bool shown_mode0 = true;
+  for (std::size_t i = 0; i < p.count; ++i) shown_mode0 = shown_mode0 && axes_[i].sent_mode == 0;
+  const std::int32_t special = shown_mode0 || force_mode == P::code(P::Mode::freezing_passive_out) ? force_mode : 0;
+  special_in_packet_ = special;
   for (std::size_t i = 0; i < p.count; ++i) {
     const AxisSim& ax = axes_[i];
     P::Axis& a = p.axes[i];
-    a.mode = phase_ == Phase::sync ? 0 : (force_mode != 0 ? force_mode : ax.mode);
+    a.mode = phase_ == Phase::sync ? 0 : (special != 0 ? special : ax.mode);
     axes_[i].sent_mode = a.mode;
     a.d1 = static_cast<float>(ax.ref_pos);
     a.d2 = static_cast<float>(ax.ref_vel * period_);
@@ -247,7 +254,7 @@ void Controller::judge_datagram(std::span<const std::byte> d) {
 void Controller::end_cycle() {
   std::array<std::int32_t, P::kMaxAxes> before{};
   for (std::size_t i = 0; i < map_.count(); ++i) before[i] = axes_[i].mode;
-  const std::int32_t sent_special = sent_cyclic_ ? pending_special_ : 0;
+  const std::int32_t sent_special = sent_cyclic_ ? special_in_packet_ : 0;
   if (awaiting_) {
     recent_[recent_next_] = expected_;
     recent_next_ = (recent_next_ + 1) % recent_.size();
@@ -661,11 +668,12 @@ void Controller::step_physics() {
     double reported = dsa_ref;
     double vel = ax.traj_vel;
     double acc = ax.traj_acc;
+    bool echo_test = false;
     switch (base) {
-      case 10:  // 0': the controller uses what the PC echoed
-        dsa_ref = reported = pc.d1;
+      case 10:  // 0': the controller keeps sending its own trajectory; the DSA gets what the PC echoed
+        echo_test = true;
+        dsa_ref = pc.d1;
         vel = pc.d2 / period_;
-        acc = (vel - ax.ref_vel) / period_;
         break;
       case 1:  // the PC generates and closes the loops; the DSA holds until the switch is complete
         dsa_ref = ax.hold_pos;
@@ -720,7 +728,7 @@ void Controller::step_physics() {
     ax.prev_ref_pos = dsa_ref;
     ax.dsa_ref = dsa_ref;
     ax.ref_pos = reported;
-    ax.ref_vel = vel;
+    ax.ref_vel = echo_test ? ax.traj_vel : vel;
   }
 }
 
@@ -810,6 +818,12 @@ bool Controller::start_step(const Step& s) {
           return false;
         }
         const std::size_t first = map_.arm_first(arm), n = map_.arm_count(arm);
+        if (s.mode == P::code(P::Mode::mode2_standby) && a.open && a.open_mode == P::code(P::Mode::mode2)) {
+          // Mode 2 is the one the robot program ends itself (state machine: the program sets 2' after
+          // its move, then waits while control ramps back to the drive): the exit sequence 12 -> 0.
+          start_exit(arm);
+          continue;
+        }
         for (std::size_t i = first; i < first + n; ++i) {
           const std::int32_t cur = axes_[i].mode;
           if (cur != 0 && cur != 10 && cur != s.mode) {
@@ -900,6 +914,10 @@ bool Controller::step_complete(const Step& s) {
         if (arms_[arm].powered || arms_[arm].drive_off_left > 0) return false;
       return true;
     case StepKind::go_open:
+      if (s.mode == P::code(P::Mode::mode2_standby))  // leaving mode 2 blocks until mode 0, like its delays
+        for (std::size_t arm : step_arms(s))
+          if (arms_[arm].open) return false;
+      return true;
     case StepKind::cmd: return true;
     case StepKind::wait_for_pc:
       for (std::size_t arm : step_arms(s))

@@ -220,6 +220,7 @@ class Controller {
   // Program-issued special codes waiting for their packet: 502 -> freeze, 503 -> back to 0,
   // 504 -> end, 506 -> initialization packet.
   std::int32_t pending_special_ = 0;
+  std::int32_t special_in_packet_ = 0;  // the special code the last cyclic packet carried (0: none)
   std::uint64_t passive_left_ = 0;
   bool passive_out_pending_ = false;
 

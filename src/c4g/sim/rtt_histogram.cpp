@@ -29,4 +29,11 @@ std::int64_t RttHistogram::percentile(double p) const noexcept {
   return max_;
 }
 
+std::uint64_t RttHistogram::count_at_or_above(std::int64_t ns) const noexcept {
+  const auto first = std::min<std::size_t>(static_cast<std::size_t>(std::max<std::int64_t>(ns, 0) / kBinNs), kBins);
+  std::uint64_t n = 0;
+  for (std::size_t i = first; i < bins_.size(); ++i) n += bins_[i];
+  return n;
+}
+
 }  // namespace axon::c4g::sim

@@ -15,6 +15,8 @@ class RttHistogram {
   // The smallest value v [ns] with at least p (0..1) of the samples <= v (bin resolution: 1 us).
   [[nodiscard]] std::int64_t percentile(double p) const noexcept;
   [[nodiscard]] std::int64_t max() const noexcept { return max_; }
+  // Samples at or above ns (bin resolution: 1 us; ns is rounded down to its bin).
+  [[nodiscard]] std::uint64_t count_at_or_above(std::int64_t ns) const noexcept;
   [[nodiscard]] std::int64_t min() const noexcept { return count_ ? min_ : 0; }
   [[nodiscard]] double mean() const noexcept { return count_ ? static_cast<double>(sum_) / static_cast<double>(count_) : 0.0; }
 

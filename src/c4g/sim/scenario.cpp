@@ -42,6 +42,7 @@ Result<double> positive_seconds(const core::ConfigNode& n) {
 bool openable(std::int32_t m) {
   switch (m) {
     case 0: case 10: case 1: case 2: case 4: case 5: case 7: case 8: case 9: return true;
+    case 12: return true;  // 2': the program ends mode 2 itself
     default: return m > 100 && m < 200;
   }
 }
@@ -96,7 +97,7 @@ Result<Step> parse_step(const core::ConfigNode& item) {
     if (!openable(*m))
       return mnode.error(CoreErrc::config_bad_value,
                          fmt::format("mode {} ({}) cannot be opened by a program in the simulator (modes: 0, 0', 1, 2, 4, 5, "
-                                     "7, 8, 9, 1xx; the special modes have their own steps or come from the PC)",
+                                     "7, 8, 9, 1xx, and 2' to leave mode 2; the special modes have their own steps or come from the PC)",
                                      mtext, protocol::mode_name(*m)));
     s.mode = *m;
     AXON_TRY(a, arms_of(*args));

@@ -4,6 +4,8 @@
 //   steps:
 //     - drive_on                         # DRIVE ON (mode 501 meanwhile); optional {arms: [1]}
 //     - go_open: {type: A, mode: 4, arms: [1]}   # GO OPEN TYPE A|B in the mode ("4", "0'", "mode7", 9)
+//                                        #   mode 2' (12) in mode 2: the program leaves mode 2 (blocks
+//                                        #   until the arm is back in mode 0)
 //     - wait_for_pc                      # WAIT FOR PC: until the PC's exit-from-open sequence ends
 //                                        #   optional {arms: [1], timeout: 10}
 //     - move: {arm: 1, deg: [10, 0, 0, 0, 0, 0], duration: 2}    # joint targets [deg] at the link

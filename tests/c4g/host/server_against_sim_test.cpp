@@ -1,0 +1,459 @@
+// The Server against the controller simulator over real UDP on loopback, in one process: the sim's
+// own client loop (run_client) on the test thread, the Server on its cycle thread, with small test
+// controllers for what the built-in applications do not cover (modes 8 and 9, the special modes
+// requested by the PC, refused mode changes, malformed and reordered datagrams through a proxy).
+// The command-line pairs (separate processes) are in tests/integration/cli_c4g_sim_*.sh.
+#include "c4g/host/server.hpp"
+#include "c4g/protocol/mode.hpp"
+#include "c4g/sim/client_runner.hpp"
+#include "c4g/sim/controller.hpp"
+#include "c4g/sim/robots.hpp"
+#include "c4g/sim/scenario.hpp"
+#include "c4g/sim/udp_client.hpp"
+
+#include <gtest/gtest.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <optional>
+#include <thread>
+#include <vector>
+
+namespace axon::c4g::test {
+namespace {
+
+namespace P = protocol;
+namespace H = host;
+namespace S = sim;
+
+// A Controller made of a function, counting what the server tells it.
+class TestController : public H::Controller {
+ public:
+  std::function<void(const H::CycleContext&, H::ReplyBuilder&)> cycle;
+  std::atomic<int> inits{0};
+  std::atomic<int> silences{0};
+  void on_init(const P::InitPacket&, const P::AxisMap&) override { ++inits; }
+  void on_cycle(const H::CycleContext& ctx, H::ReplyBuilder& reply) override {
+    if (cycle) cycle(ctx, reply);
+  }
+  void on_silence() noexcept override { ++silences; }
+};
+
+std::unique_ptr<H::Server> start_server(H::Controller& c, H::ServerOptions o = {}) {
+  o.listen = net::Endpoint{"127.0.0.1", 0};
+  o.max_late_cycles = 0;  // a loaded test machine must not trip the lateness check
+  auto s = H::Server::start(c, o);
+  if (!s) ADD_FAILURE() << s.error().detail;
+  return std::move(s).value();
+}
+
+struct SimRun {
+  std::optional<S::Controller> c;
+  S::RunReport report;
+  std::vector<S::Event> events;
+  [[nodiscard]] bool has(std::string_view name, std::string_view text = {}) const {
+    return std::any_of(events.begin(), events.end(), [&](const S::Event& e) {
+      return e.name == name && e.text.find(text) != std::string::npos;
+    });
+  }
+  [[nodiscard]] std::string log() const {
+    std::string out;
+    for (const auto& e : events) out += e.name + ": " + e.text + "\n";
+    return out;
+  }
+};
+
+// Runs the six-axis simulator against `port` until its scenario ends or max_s passes.
+SimRun run_sim(std::uint16_t port, std::string_view yaml, double max_s = 20) {
+  SimRun r;
+  auto scenario = S::Scenario::parse(yaml);
+  EXPECT_TRUE(scenario) << scenario.error().detail;
+  auto c = S::Controller::create(S::six_axis_robot(), scenario.value());
+  EXPECT_TRUE(c) << c.error().detail;
+  r.c.emplace(std::move(c).value());
+  auto udp = S::UdpClient::open(net::Endpoint{"127.0.0.1", port});
+  EXPECT_TRUE(udp);
+  S::RunOptions ro;
+  ro.duration_s = max_s;
+  ro.reply_deadline = std::chrono::milliseconds(20);  // generous: scheduling noise is not the subject
+  ro.on_event = [&](const S::Event& e) { r.events.push_back(e); };
+  r.report = S::run_client(*r.c, udp.value(), ro);
+  return r;
+}
+
+bool all_modes(const P::Packet& p, std::int32_t m) {
+  for (std::size_t i = 0; i < p.count; ++i)
+    if (p.axes[i].mode != m) return false;
+  return p.count > 0;
+}
+
+// ---- modes 8 and 9 (no built-in application) ------------------------------------------------------
+
+TEST(ServerAgainstSim, Mode8VelocityContributionShiftsTheAxisThenExitFromOpenEndsIt) {
+  // A constant velocity contribution at the velocity loop's input: the drive's position loop settles
+  // where kp * (reference - position) cancels it, i.e. the axis runs ahead by contribution / kp.
+  TestController pc;
+  int cycles8 = 0;
+  double max_lead = 0;
+  std::vector<std::int32_t> modes;
+  pc.cycle = [&](const H::CycleContext& ctx, H::ReplyBuilder& r) {
+    const auto m = ctx.request.axes[0].mode;
+    if (modes.empty() || modes.back() != m) modes.push_back(m);
+    if (m != 8) return;
+    ++cycles8;
+    const auto& ax = ctx.request.axes[1];  // axis 2 does not move in this program
+    max_lead = std::max(max_lead, static_cast<double>(ax.d3 - ax.d1));
+    if (cycles8 < 300) {
+      for (std::size_t i = 0; i < r.axis_count(); ++i) r.axis(i).d4 = 0.002f;  // 1 turn/s at 2 ms
+    } else {
+      r.exit_from_open(1);
+    }
+  };
+  auto server = start_server(pc);
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - go_open: {type: B, mode: 8, arms: [1]}
+  - move: {arm: 1, deg: [2, 0, 0, 0, 0, 0], duration: 0.2}
+  - wait_for_pc: {timeout: 5}
+  - exit_open)");
+  server->stop();
+  EXPECT_TRUE(run.c->scenario_done()) << run.log();
+  EXPECT_FALSE(run.c->communication_error());
+  EXPECT_EQ(run.c->stats().refused_requests, 0u);
+  // The drive-on procedure ends straight into the mode the program set (manual, driving on).
+  EXPECT_EQ(modes, (std::vector<std::int32_t>{0, 501, 8, 0, 504})) << run.log();
+  const double kp = S::six_axis_robot().axes[0][1].kp;
+  EXPECT_GT(max_lead, 0.5 / kp);
+  EXPECT_LT(max_lead, 2.0 / kp);
+  EXPECT_EQ(server->safety().reason(), H::FaultReason::none);
+}
+
+TEST(ServerAgainstSim, Mode9CurrentContributionIsSaturatedByTheServerBeforeTheController) {
+  TestController pc;
+  int cycles9 = 0;
+  pc.cycle = [&](const H::CycleContext& ctx, H::ReplyBuilder& r) {
+    if (ctx.request.axes[0].mode != 9) return;
+    ++cycles9;
+    if (cycles9 <= 5) r.axis(0).d5 = 80.0f;  // far over axis 1's 24.5 A
+    if (cycles9 > 50) r.exit_from_open(1);
+  };
+  auto server = start_server(pc);
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - go_open: {type: B, mode: 9, arms: [1]}
+  - wait_for_pc: {timeout: 5}
+  - exit_open)");
+  server->stop();
+  EXPECT_TRUE(run.c->scenario_done()) << run.log();
+  EXPECT_FALSE(run.has(S::event::kFollowErrorController)) << run.log();
+  EXPECT_GE(server->safety().counters().currents_clamped.load(), 5u);
+  EXPECT_EQ(server->safety().reason(), H::FaultReason::none);  // clamping is the remedy, not a fault
+  EXPECT_GT(cycles9, 50);
+}
+
+// ---- special modes ---------------------------------------------------------------------------------
+
+TEST(ServerAgainstSim, FollowingErrorInMode1Sends508AndTheControllerDrivesOff) {
+  // Mode 1 is not checked by the controller (manual: PC-side check only): a PC target that runs
+  // away with no current behind it must be caught by the server's Safety layer.
+  TestController pc;
+  float start = 0;
+  int k = 0;
+  pc.cycle = [&](const H::CycleContext& ctx, H::ReplyBuilder& r) {
+    if (ctx.request.axes[0].mode != 1) return;
+    if (k == 0) start = ctx.request.axes[0].d3;
+    ++k;
+    r.axis(0).d1 = start + 0.05f * static_cast<float>(k);
+    r.axis(0).d5 = 0;
+  };
+  auto server = start_server(pc);
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - go_open: {type: A, mode: 1, arms: [1]}
+  - wait_for_pc: {timeout: 5}
+  - run)", 2.0);
+  EXPECT_TRUE(run.has(S::event::kFollowErrorFromPc, "arm 1 axis 1 Following error out of range")) << run.log();
+  EXPECT_FALSE(run.has(S::event::kFollowErrorController)) << run.log();
+  EXPECT_FALSE(run.c->drives_on(1));
+  EXPECT_EQ(server->safety().reason(), H::FaultReason::following_error);
+  EXPECT_EQ(server->safety().fault_axis(), 0);
+  EXPECT_GT(server->safety().counters().following_error_replies.load(), 0u);
+  EXPECT_FALSE(run.c->communication_error());
+}
+
+TEST(ServerAgainstSim, ThrowingControllerGetsDriveOff505) {
+  TestController pc;
+  int cycles4 = 0;
+  pc.cycle = [&](const H::CycleContext& ctx, H::ReplyBuilder&) {
+    if (ctx.request.axes[0].mode == 4 && ++cycles4 == 20) throw std::runtime_error("bug in the PC's law");
+  };
+  auto server = start_server(pc);
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - go_open: {type: A, mode: 4, arms: [1]}
+  - wait_for_pc: {timeout: 5}
+  - run)", 1.5);
+  EXPECT_TRUE(run.has(S::event::kDriveOffFromPc)) << run.log();
+  EXPECT_FALSE(run.c->drives_on(1));
+  EXPECT_EQ(run.c->axis_mode(0), 0);  // 505 shown for the drive-off time, then mode 0
+  EXPECT_EQ(server->counters().controller_exceptions.load(), 1u);
+  EXPECT_EQ(server->safety().reason(), H::FaultReason::controller_exception);
+  EXPECT_FALSE(run.c->communication_error());
+}
+
+TEST(ServerAgainstSim, Restart506SendsTheInitializationPacketAgainWithoutSync) {
+  TestController pc;
+  auto server = start_server(pc);
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - delay: 0.1
+  - restart
+  - delay: 0.1
+  - exit_open)");
+  EXPECT_TRUE(run.c->scenario_done()) << run.log();
+  EXPECT_EQ(run.c->stats().sync_sent, 3u);
+  EXPECT_EQ(run.c->stats().init_sent, 2u);
+  EXPECT_EQ(run.c->stats().init_answers, 2u);
+  EXPECT_EQ(server->counters().init_packets.load(), 2u);
+  EXPECT_EQ(pc.inits.load(), 2);
+  EXPECT_EQ(run.c->stats().misses, 0u);
+}
+
+TEST(ServerAgainstSim, ActiveFreezing500ToleratesAStalledPcUntilExitFromOpen) {
+  // The PC freezes from mode 0, then blocks for 40 controller periods (non-real-time work): without
+  // the freeze that is a communication error (10 misses); with it the controller waits for the
+  // PC's exit-from-open and goes on.
+  TestController pc;
+  int on_cycles = 0, frozen = 0;
+  bool stalled = false, done = false;
+  pc.cycle = [&](const H::CycleContext& ctx, H::ReplyBuilder& r) {
+    const bool drives = P::drives_on(ctx.request.infpar, 1);
+    if (done) return;
+    if (all_modes(ctx.request, 500)) {
+      ++frozen;
+      if (!stalled) {
+        stalled = true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(80));
+      }
+      if (frozen > 20) r.exit_from_open(1);  // until the controller shows mode 0 again
+      return;
+    }
+    if (frozen > 0) {
+      done = true;
+      return;
+    }
+    if (drives && all_modes(ctx.request, 0) && ++on_cycles >= 10)
+      for (std::size_t i = 0; i < r.axis_count(); ++i) r.set_mode(i, 500);
+  };
+  auto server = start_server(pc);
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - delay: 1.0
+  - exit_open)");
+  server->stop();
+  EXPECT_TRUE(run.c->scenario_done()) << run.log();
+  EXPECT_FALSE(run.c->communication_error()) << run.log();
+  EXPECT_TRUE(run.has(S::event::kFreezing, "active freezing (500)")) << run.log();
+  EXPECT_TRUE(run.has(S::event::kFreezing, "ended by the PC's exit-from-open")) << run.log();
+  EXPECT_GE(run.c->stats().frozen_cycles, 20u);
+  EXPECT_LT(run.c->stats().max_consecutive_misses, 10u);
+  EXPECT_TRUE(done);
+}
+
+// ---- mode-change rules ------------------------------------------------------------------------------
+
+TEST(ServerAgainstSim, ForbiddenModeRequestsAreRefusedByTheServerAndNeverReachTheController) {
+  // Requests during drive on (501) and a change from mode 7 to 4 without exit-from-open break the
+  // state machine's rules: the server answers the current mode instead and counts the refusal.
+  TestController pc;
+  int cycles7 = 0;
+  std::vector<std::int32_t> modes;
+  pc.cycle = [&](const H::CycleContext& ctx, H::ReplyBuilder& r) {
+    const auto m = ctx.request.axes[0].mode;
+    if (modes.empty() || modes.back() != m) modes.push_back(m);
+    if (m == 501) r.set_mode(0, 4);
+    if (m == 7) {
+      ++cycles7;
+      if (cycles7 < 30) r.set_mode(0, 4);
+      else r.exit_from_open(1);
+    }
+  };
+  auto server = start_server(pc);
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - go_open: {type: B, mode: 7, arms: [1]}
+  - move: {arm: 1, deg: [1, 0, 0, 0, 0, 0], duration: 0.2}
+  - wait_for_pc: {timeout: 5}
+  - exit_open)");
+  server->stop();
+  EXPECT_TRUE(run.c->scenario_done()) << run.log();
+  EXPECT_GE(server->counters().refused_mode_changes.load(), 29u);
+  EXPECT_EQ(run.c->stats().refused_requests, 0u) << run.log();
+  EXPECT_FALSE(run.has(S::event::kRequestRefused));
+  // The PC's exit came while the controller's move still ran: 7' until it ends, then 7'', then 0.
+  EXPECT_EQ(modes, (std::vector<std::int32_t>{0, 501, 7, 17, 170, 0, 504})) << run.log();
+}
+
+// ---- silence on either side --------------------------------------------------------------------------
+
+TEST(ServerAgainstSim, ServerThatStopsAnsweringRaisesTheCommunicationErrorAfterTen) {
+  TestController pc;
+  std::atomic<int> cycles{0};
+  pc.cycle = [&](const H::CycleContext&, H::ReplyBuilder&) { ++cycles; };
+  auto server = start_server(pc);
+  std::thread killer([&] {
+    while (cycles.load() < 200) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    server->stop();
+  });
+  const auto run = run_sim(server->local_address().port, "steps:\n  - drive_on\n  - run\n", 10.0);
+  killer.join();
+  EXPECT_TRUE(run.c->communication_error()) << run.log();
+  EXPECT_EQ(run.c->stats().max_consecutive_misses, 10u);
+  EXPECT_TRUE(run.has(S::event::kCommunicationError, "C4GOpen: communication error"));
+  EXPECT_FALSE(run.c->drives_on(1));
+}
+
+TEST(ServerAgainstSim, ControllerThatFallsSilentIsReportedAndANewOneIsServed) {
+  TestController pc;
+  H::ServerOptions o;
+  o.cycle.cycle_timeout = std::chrono::milliseconds(150);
+  auto server = start_server(pc, o);
+  const auto first = run_sim(server->local_address().port, "steps:\n  - drive_on\n  - run\n", 0.6);
+  EXPECT_FALSE(first.c->communication_error());
+  for (int i = 0; i < 200 && server->state() != H::ServerState::silent; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_EQ(server->state(), H::ServerState::silent);
+  EXPECT_GE(pc.silences.load(), 1);
+  const auto second = run_sim(server->local_address().port, "steps:\n  - drive_on\n  - exit_open\n");
+  EXPECT_TRUE(second.c->scenario_done()) << second.log();
+  EXPECT_EQ(pc.inits.load(), 2);
+}
+
+// ---- malformed and reordered datagrams --------------------------------------------------------------
+
+// A UDP relay between the simulator and the server that tampers with chosen datagrams.
+class TamperingProxy {
+ public:
+  explicit TamperingProxy(std::uint16_t server_port) {
+    to_sim_ = bind_loopback();
+    to_server_ = bind_loopback();
+    server_.sin_family = AF_INET;
+    server_.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    server_.sin_port = htons(server_port);
+    thread_ = std::thread([this] { loop(); });
+  }
+  ~TamperingProxy() {
+    stop_ = true;
+    thread_.join();
+    ::close(to_sim_);
+    ::close(to_server_);
+  }
+  [[nodiscard]] std::uint16_t port() const {
+    sockaddr_in a{};
+    socklen_t len = sizeof a;
+    ::getsockname(to_sim_, reinterpret_cast<sockaddr*>(&a), &len);
+    return ntohs(a.sin_port);
+  }
+
+ private:
+  static int bind_loopback() {
+    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    EXPECT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+    return fd;
+  }
+  void to_sim(const std::vector<char>& d) {
+    ::sendto(to_sim_, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&sim_), sizeof sim_);
+  }
+  void to_server(const std::vector<char>& d) {
+    ::sendto(to_server_, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&server_), sizeof server_);
+  }
+  void loop() {
+    std::vector<char> buf(2048);
+    std::vector<char> held, previous_request;
+    int requests = 0, replies = 0;
+    while (!stop_) {
+      pollfd p[2] = {{to_sim_, POLLIN, 0}, {to_server_, POLLIN, 0}};
+      if (::poll(p, 2, 20) <= 0) continue;
+      if (p[0].revents & POLLIN) {
+        socklen_t len = sizeof sim_;
+        const auto n = ::recvfrom(to_sim_, buf.data(), buf.size(), 0, reinterpret_cast<sockaddr*>(&sim_), &len);
+        if (n > 0) {
+          std::vector<char> d(buf.begin(), buf.begin() + n);
+          ++requests;
+          to_server(d);
+          if (requests == 120) to_server(std::vector<char>(50, '\x55'));  // no known size
+          if (requests == 170 && !previous_request.empty()) to_server(previous_request);  // an old number again
+          previous_request = d;
+        }
+      }
+      if (p[1].revents & POLLIN) {
+        const auto n = ::recvfrom(to_server_, buf.data(), buf.size(), 0, nullptr, nullptr);
+        if (n > 0) {
+          std::vector<char> d(buf.begin(), buf.begin() + n);
+          ++replies;
+          if (replies == 100) {
+            held = d;  // delivered after the next reply: reordered
+            continue;
+          }
+          if (replies == 150) {
+            const std::uint32_t nan_bits = 0x7fc00000u;
+            std::memcpy(d.data() + 16, &nan_bits, 4);  // axis 1 D1
+          }
+          if (replies == 250) to_sim(std::vector<char>(7, '\x01'));
+          to_sim(d);
+          if (replies == 200) to_sim(d);  // duplicated
+          if (!held.empty()) {
+            to_sim(held);
+            held.clear();
+          }
+        }
+      }
+    }
+  }
+
+  int to_sim_ = -1, to_server_ = -1;
+  sockaddr_in server_{}, sim_{};
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+TEST(ServerAgainstSim, MalformedReorderedAndDuplicatedDatagramsAreCountedNotFatal) {
+  TestController pc;
+  auto server = start_server(pc);
+  TamperingProxy proxy(server->local_address().port);
+  const auto run = run_sim(proxy.port(), R"(steps:
+  - drive_on
+  - delay: 0.6
+  - exit_open)");
+  const auto& s = run.c->stats();
+  EXPECT_TRUE(run.c->scenario_done()) << run.log();
+  EXPECT_FALSE(run.c->communication_error());
+  EXPECT_EQ(s.malformed, 1u);   // the NaN
+  EXPECT_EQ(s.wrong_size, 1u);  // the 7 bytes
+  // The held reply, the answer to the replayed request and the duplicate (read at the next tick,
+  // when its number is an earlier packet's).
+  EXPECT_GE(s.late_replies + s.duplicate_replies, 3u);
+  EXPECT_GE(s.misses, 2u);        // the held and the corrupted reply's packets
+  EXPECT_LT(s.max_consecutive_misses, 10u);
+  // The server: the 50-byte datagram is a protocol error left unanswered; the replayed request is
+  // answered under its own number; nothing latches a fault.
+  EXPECT_EQ(server->counters().protocol_errors.load(), 1u);
+  EXPECT_EQ(server->counters().unanswered.load(), 1u);
+  EXPECT_EQ(server->safety().reason(), H::FaultReason::none);
+}
+
+}  // namespace
+}  // namespace axon::c4g::test
