@@ -18,6 +18,8 @@ void add_fps_commands(CLI::App& app, GlobalOptions& global);
 void add_fps_layout_commands(CLI::App& app, GlobalOptions& global);
 void add_fps_plc_commands(CLI::App& app, GlobalOptions& global);
 void add_sim_plc_command(CLI::App& app, GlobalOptions& global);
+// `fps plane` (after add_fps_commands).
+void add_fps_plane_commands(CLI::App& app, GlobalOptions& global);
 
 // Exit code chosen by the subcommand that ran.
 int& exit_code();

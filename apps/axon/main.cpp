@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   add_fps_layout_commands(app, global);
   add_fps_plc_commands(app, global);
   add_sim_plc_command(app, global);
+  add_fps_plane_commands(app, global);
   add_demo_command(app, global);
   try {
     app.parse(argc, argv);

@@ -3,7 +3,11 @@
 #include "core/error.hpp"
 #include "fps/sim/simulator_config.hpp"
 
-#include <boost/asio/post.hpp>
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/detached.hpp>
+#include <boost/asio/redirect_error.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/use_awaitable.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -29,7 +33,7 @@ Result<std::set<std::uint16_t>> read_ids(const core::ConfigNode& node, std::stri
 }  // namespace
 
 Result<Scenario> Scenario::from_config(const core::ConfigNode& node) {
-  AXON_TRY(node.reject_unknown({"datum_lost", "uncalibrated", "collided", "bootloader", "absent", "extra"}));
+  AXON_TRY(node.reject_unknown({"datum_lost", "uncalibrated", "collided", "bootloader", "absent", "collide_on_move", "extra"}));
   Scenario s;
   AXON_TRY(a, read_ids(node, "datum_lost"));
   s.datum_lost = std::move(a);
@@ -41,6 +45,8 @@ Result<Scenario> Scenario::from_config(const core::ConfigNode& node) {
   s.bootloader = std::move(d);
   AXON_TRY(e, read_ids(node, "absent"));
   s.absent = std::move(e);
+  AXON_TRY(f, read_ids(node, "collide_on_move"));
+  s.collide_on_move = std::move(f);
   if (node.has("extra")) {
     AXON_TRY(list, node.child("extra"));
     AXON_TRY(items, list.items());
@@ -135,6 +141,27 @@ struct FocalPlaneSimulator::Impl {
     return ok();
   }
 
+  // Scripted collisions: each listed robot reports one the first time it is seen moving.
+  static asio::awaitable<void> watch_collisions(Impl* self, std::shared_ptr<bool> alive, std::set<std::uint16_t> ids) {
+    asio::steady_timer timer(self->executor);
+    while (!ids.empty()) {
+      timer.expires_after(std::chrono::milliseconds(5));
+      boost::system::error_code ec;
+      co_await timer.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+      if (!*alive) co_return;
+      for (auto it = ids.begin(); it != ids.end();) {
+        auto* m = self->simulator->find(*it);
+        if (m != nullptr && m->moving()) {
+          spdlog::info("sim: scripted collision of robot {}", *it);
+          (void)self->simulator->force_collision(*it, Arm::beta);
+          it = ids.erase(it);
+        } else {
+          ++it;
+        }
+      }
+    }
+  }
+
   void set_sync(bool high) {
     const bool rising = high && !sync_high;
     sync_high = high;
@@ -163,7 +190,7 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
   Impl& s = *impl;
   const auto& o = s.options;
   const auto& sc = o.scenario;
-  for (const auto* set : {&sc.datum_lost, &sc.uncalibrated, &sc.collided, &sc.bootloader, &sc.absent}) {
+  for (const auto* set : {&sc.datum_lost, &sc.uncalibrated, &sc.collided, &sc.bootloader, &sc.absent, &sc.collide_on_move}) {
     for (auto id : *set) {
       if (plane.find(id) == nullptr && !sc.extra.contains(id))
         return Error(CoreErrc::invalid_argument, fmt::format("scenario: robot {} is not in layout '{}'", id, plane.name()));
@@ -235,6 +262,9 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
     if (s.simulator->find(id) != nullptr) AXON_TRY(s.simulator->force_collision(id, Arm::beta));
   }
 
+  if (!sc.collide_on_move.empty())
+    asio::co_spawn(executor, Impl::watch_collisions(&s, s.alive, sc.collide_on_move), asio::detached);
+
   // Gateways: one emulator each, its channels are the layout's buses on it.
   for (const auto& gw : plane.gateways()) {
     GatewayInfo g;
@@ -264,7 +294,7 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
     Impl* self = &s;
     std::weak_ptr<bool> alive = s.alive;
     s.plc->on_relay_change([self, alive](const plc::RelayEvent& e) {
-      if (alive.lock()) self->on_relay(e);
+      if (auto a = alive.lock(); a && *a) self->on_relay(e);
     });
   }
   return std::unique_ptr<FocalPlaneSimulator>(new FocalPlaneSimulator(std::move(impl)));
@@ -273,6 +303,7 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
 void FocalPlaneSimulator::stop() {
   if (!impl_ || impl_->stopped) return;
   impl_->stopped = true;
+  *impl_->alive = false;
   impl_->alive.reset();
   if (impl_->plc) impl_->plc->stop();
   for (auto& e : impl_->emulators)

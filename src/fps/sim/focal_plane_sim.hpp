@@ -52,11 +52,12 @@ struct Scenario {
   std::set<std::uint16_t> collided;      // a collision flag set at start (beta arm)
   std::set<std::uint16_t> bootloader;    // powered with the sync line low: in the bootloader
   std::set<std::uint16_t> absent;        // not simulated at all (a dead robot: discovery misses it)
+  std::set<std::uint16_t> collide_on_move;  // report a collision (beta) the first time they move
   // Robots the layout does not have, on a bus of the layout (discovery finds them "unexpected").
   std::map<std::uint16_t, BusRef> extra;
 
   // YAML: {datum_lost: [ids], uncalibrated: [...], collided: [...], bootloader: [...],
-  //        absent: [...], extra: [{id: 900, gateway: 1, bus: 2}]}. Ids as lists or "1-5,9" strings.
+  //        absent: [...], collide_on_move: [...], extra: [{id: 900, gateway: 1, bus: 2}]}.
   static Result<Scenario> from_config(const core::ConfigNode& node);
 };
 
