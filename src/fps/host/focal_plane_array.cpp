@@ -1,5 +1,7 @@
 #include "fps/host/focal_plane_array.hpp"
 
+#include "can/bus_spec.hpp"
+
 #include "fps/host/concurrent.hpp"
 #include "fps/layout/layout_sweep.hpp"
 
