@@ -32,7 +32,7 @@ namespace {
 constexpr double kTimeScale = 10.0;  // simulated seconds per real second
 
 using Clock = std::chrono::steady_clock;
-double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+using namespace std::chrono_literals;
 double seconds(core::Duration d) { return std::chrono::duration<double>(d).count(); }
 
 // Exact wire bits carried so far by each bus of the simulated plane.

@@ -259,7 +259,9 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
   AXON_TRY(sim, make_simulator(executor, config, s.registry));
   s.simulator = std::move(sim);
   for (auto id : sc.collided) {
-    if (s.simulator->find(id) != nullptr) AXON_TRY(s.simulator->force_collision(id, Arm::beta));
+    if (s.simulator->find(id) != nullptr) {
+      AXON_TRY(s.simulator->force_collision(id, Arm::beta));
+    }
   }
 
   if (!sc.collide_on_move.empty())
@@ -282,7 +284,9 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
     s.gateways.push_back(std::move(g));
   }
   s.emulators.resize(s.gateways.size());
-  for (std::size_t i = 0; i < s.gateways.size(); ++i) AXON_TRY(s.start_gateway(i));
+  for (std::size_t i = 0; i < s.gateways.size(); ++i) {
+    AXON_TRY(s.start_gateway(i));
+  }
 
   // The PLC, whose relays act here (hooks posted to our executor).
   if (o.plc) {
