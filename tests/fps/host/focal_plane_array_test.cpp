@@ -1,11 +1,12 @@
 // The whole focal plane at once: a small layout (2 sextants, 2 gateways, 4 buses, 12 robots)
 // simulated by FocalPlaneSimulator behind CAN@net gateway emulators and the PLC emulator, driven by
 // a FocalPlaneArray over real TCP on loopback (same process, separate sockets).
-#include "rig.hpp"
+#include "sim_rig.hpp"
 
 #include "fps/host/focal_plane_array.hpp"
 #include "fps/sim/focal_plane_sim.hpp"
 
+#include <boost/asio/detached.hpp>
 #include <gtest/gtest.h>
 
 #include <algorithm>
