@@ -158,6 +158,7 @@ TEST(VirtualBusWire, FramesQueuedDuringATransmissionCompeteForTheNext) {
   asio::io_context io;
   WireModel wire;
   wire.pace_realtime = true;
+  wire.bitrate = 10'000;  // about 5 ms per frame: b surely queues while 0x500 is on the wire
   auto medium = VirtualBus::create(io.get_executor(), "vcan0", wire);
   auto a = medium->attach(), b = medium->attach(), rx = medium->attach();
   asio::co_spawn(io, [&]() -> asio::awaitable<void> {
