@@ -2,12 +2,14 @@
 // CAN@net gateway emulators, plus the PLC emulator) driven over loopback TCP by the host: layout
 // check, discovery, status sweep, a fold and a coordinated move both started by the PLC's sync
 // line, final positions verified, each phase timed against the wire time of its busiest bus.
+// The simulated plane runs on a thread of its own (sim_thread.hpp), the host on the caller's.
 #include "demo_fps.hpp"
 
 #include "fps/host/focal_plane_array.hpp"
 #include "fps/sim/focal_plane_sim.hpp"
 #include "layout_name.hpp"
 #include "run.hpp"
+#include "sim_thread.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
@@ -15,6 +17,7 @@
 #include <spdlog/spdlog.h>
 
 #include <sys/resource.h>
+#include <time.h>
 
 #include <algorithm>
 #include <chrono>
@@ -34,6 +37,13 @@ constexpr double kTimeScale = 10.0;  // simulated seconds per real second
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 double seconds(core::Duration d) { return std::chrono::duration<double>(d).count(); }
+
+// CPU time of the calling thread (s).
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) / 1e9;
+}
 
 // Exact wire bits carried so far by each bus of the simulated plane.
 std::map<fps::BusRef, std::uint64_t> wire_bits(const fps::sim::FocalPlaneSimulator& sim, const fps::FocalPlane& plane) {
@@ -74,16 +84,29 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   fps::sim::FocalPlaneSimOptions so;
   so.simulator.time_scale = kTimeScale;
   so.seed = 7;
-  auto sim = need(fps::sim::FocalPlaneSimulator::start(ex, plane, so));
+  SimThread sim_thread;
+  auto sim = sim_thread.call([&] { return need(fps::sim::FocalPlaneSimulator::start(sim_thread.executor(), plane, so)); });
+  struct StopSim {
+    SimThread& t;
+    fps::sim::FocalPlaneSimulator& s;
+    ~StopSim() {
+      t.call([this] { s.stop(); });
+      t.stop();
+    }
+  } stop_sim{sim_thread, *sim};
+  auto wire_now = [&] { return sim_thread.call([&] { return wire_now(); }); };
+  const auto sextants = sim_thread.call([&] { return sim->sextants(); });
+  const auto gateways = sim_thread.call([&] { return sim->gateways(); });
+  const auto plc_endpoint = sim_thread.call([&] { return sim->plc()->endpoint(); });
   fmt::print("1. simulated focal plane '{}': {} robots in {} sextants on {} buses (1 Mbit/s, exact frame bits,\n"
              "   real-time pacing) behind {} CAN@net gateway emulators; PLC emulator at {}; time x{};\n"
              "   robots start at random alpha with beta folded (seed {})\n",
-             plane.name(), sim->simulator().size(), sim->sextants().size(), plane.buses().size(), sim->gateways().size(),
-             sim->plc()->endpoint().to_string(), kTimeScale, so.seed);
+             plane.name(), sim_thread.call([&] { return sim->simulator().size(); }), sextants.size(), plane.buses().size(), gateways.size(),
+             plc_endpoint.to_string(), kTimeScale, so.seed);
 
   host::FocalPlaneArrayOptions ao;
-  for (const auto& g : sim->gateways()) ao.addresses[g.id] = g.endpoint;
-  ao.plc = sim->plc()->endpoint();
+  for (const auto& g : gateways) ao.addresses[g.id] = g.endpoint;
+  ao.plc = plc_endpoint;
   ao.array.positioner.poll_interval = 100ms;
   auto connected = co_await host::FocalPlaneArray::connect(ex, plane, ao);
   auto fpa = need(std::move(connected));
@@ -98,20 +121,20 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
              fpa->bus_count(), seconds(ao.check_window), check.matched.size(), check.missing.size(),
              check.unexpected.size(), check.wrong_bus.size(), seconds(Clock::now() - t0));
   if (!check.ok()) throw Exception(Error(CoreErrc::invalid_argument, "layout check failed:\n" + check.to_text()));
-  auto bits0 = wire_bits(*sim, plane);
+  auto bits0 = wire_now();
   t0 = Clock::now();
   auto disc = co_await fpa->discover();
   const auto found = need(std::move(disc));
-  phases.push_back({"discovery", seconds(Clock::now() - t0), floor_s(bits0, wire_bits(*sim, plane))});
+  phases.push_back({"discovery", seconds(Clock::now() - t0), floor_s(bits0, wire_now())});
   fmt::print("   discovery (GET_ID until every robot of the bus answered, then firmware and status of each): "
              "{} robots, {} problems ({:.2f} s)\n",
              found.table.rows.size(), found.problems.size(), phases.back().seconds);
 
   // 3. Status sweep (firmware, status, position of every robot).
-  bits0 = wire_bits(*sim, plane);
+  bits0 = wire_now();
   t0 = Clock::now();
   const auto table = co_await array.status_table(true);
-  phases.push_back({"status sweep", seconds(Clock::now() - t0), floor_s(bits0, wire_bits(*sim, plane))});
+  phases.push_back({"status sweep", seconds(Clock::now() - t0), floor_s(bits0, wire_now())});
   std::size_t ready = 0;
   for (const auto& row : table.rows) ready += row.error.empty() && row.position ? 1 : 0;
   fmt::print("3. status sweep: {} of {} robots answered with status and position ({:.2f} s)\n", ready, table.rows.size(),
@@ -139,7 +162,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   bool moving = false, finished = false, progress_done = false;
   host::TrajectoryOptions to;
   to.on_phase = [&](std::string_view phase) {
-    marks[std::string(phase)] = wire_bits(*sim, plane);
+    marks[std::string(phase)] = wire_now();
     marks_t[std::string(phase)] = Clock::now();
     if (phase == "started") moving = true;
     if (phase == "finished") finished = true;
@@ -149,7 +172,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
     while (!moving && !finished) co_await core::sleep_for(20ms);
     const auto start = Clock::now();
     std::vector<std::uint16_t> sample;
-    for (const auto& [s, ids] : sim->sextants())
+    for (const auto& [s, ids] : sextants)
       if (!ids.empty()) sample.push_back(ids.front());
     while (!finished) {
       std::string where;
@@ -167,7 +190,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
     progress_done = true;
   };
   asio::co_spawn(ex, progress(), asio::detached);
-  bits0 = wire_bits(*sim, plane);
+  bits0 = wire_now();
   auto r2 = co_await fpa->run_trajectories(std::move(moves), to, true);
   const auto run = need(std::move(r2));
   finished = true;
@@ -190,14 +213,19 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
     if (rr.reached) {
       worst_host = std::max({worst_host, std::abs(rr.reached->alpha - target.alpha), std::abs(rr.reached->beta - target.beta)});
     }
-    if (const auto* m = sim->simulator().find(rr.id)) {
-      const double e = std::max(std::abs(m->physical_deg(fps::sim::Arm::alpha) - target.alpha),
-                                std::abs(m->physical_deg(fps::sim::Arm::beta) - target.beta));
-      worst_sim = std::max(worst_sim, e);
-      at_target += e < 0.1 ? 1 : 0;
-    }
   }
-  const auto& st = sim->simulator().stats();
+  // The simulator's own arms, read on its thread.
+  sim_thread.call([&] {
+    for (const auto& rr : run.robots) {
+      if (const auto* m = sim->simulator().find(rr.id)) {
+        const double e = std::max(std::abs(m->physical_deg(fps::sim::Arm::alpha) - target.alpha),
+                                  std::abs(m->physical_deg(fps::sim::Arm::beta) - target.beta));
+        worst_sim = std::max(worst_sim, e);
+        at_target += e < 0.1 ? 1 : 0;
+      }
+    }
+  });
+  const auto st = sim_thread.call([&] { return sim->simulator().stats(); });
   fmt::print("6. verified: {} of {} robots at their target; worst error {:.4f} deg (host reading), {:.4f} deg "
              "(simulated arms); {} collisions\n",
              at_target, run.robots.size(), worst_host, worst_sim, st.neighbour_collisions + st.obstacle_collisions);
@@ -216,13 +244,13 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   const auto totals = array.client_totals();
-  fmt::print("   host and simulator in this process: {:.1f} s CPU, peak memory {} MB; {} requests, {} timeouts, "
+  const double host_cpu = thread_cpu_s();
+  const double sim_cpu = sim_thread.call([] { return thread_cpu_s(); });
+  const auto overflows = sim_thread.call([&] { return sim->simulator().receive_overflows(); });
+  fmt::print("   CPU: host thread {:.1f} s, simulator thread {:.1f} s; peak memory {} MB; {} requests, {} timeouts, "
              "{} receive overflows\n",
-             static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-                 static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec) / 1e6,
-             u.ru_maxrss / 1024, totals.sent, totals.timeouts, sim->simulator().receive_overflows());
+             host_cpu, sim_cpu, u.ru_maxrss / 1024, totals.sent, totals.timeouts, overflows);
   co_await fpa->close();
-  sim->stop();
   fmt::print("   the same from a shell: `axon sim fps --layout default` (docs/fps-simulator.md), then `axon fps ...`\n");
   if (!run.completed) throw Exception(Error(CoreErrc::invalid_argument, run.summary()));
 }

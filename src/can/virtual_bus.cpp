@@ -75,6 +75,7 @@ struct VirtualBus::Impl {
     core::Duration delay{0};
     std::uint32_t bits = 0;  // wire bits of one copy (0 when nothing is accounted)
     core::TimePoint start{};  // pacing: when it went on the wire (the schedule's time, see hold_wire)
+    std::uint32_t rx_bits = 0;  // wire bits of what receivers see (differs when corrupted)
   };
   struct Delayed {
     core::TimePoint due;
@@ -187,6 +188,7 @@ struct VirtualBus::Impl {
       if (d.corrupted) ++stats.fault_corrupted;
       on_wire.frame = d.frame;
     }
+    on_wire.rx_bits = on_wire.frame == frame ? bits : frame_bits(on_wire.frame).total;
     // The wire carries what the sender sent; corruption is the receivers' view of it.
     on_wire.bits = accounting() ? bits : 0;
     on_wire.start = std::max(queued, wire_free);
@@ -211,7 +213,7 @@ struct VirtualBus::Impl {
       if (on_wire.delay > core::Duration::zero()) {
         schedule_delayed(core::SteadyClock::instance().now() + on_wire.delay, f, on_wire.sender);
       } else {
-        deliver_all(f, on_wire.sender);
+        deliver_all(f, on_wire.sender, on_wire.rx_bits);
       }
     }
     if (--on_wire.copies == 0) return false;
@@ -219,8 +221,7 @@ struct VirtualBus::Impl {
     return true;
   }
 
-  void deliver_all(const Frame& f, std::uint64_t sender) {
-    const std::uint32_t bits = frame_bits(f).total;
+  void deliver_all(const Frame& f, std::uint64_t sender, std::uint32_t bits) {
     for (auto* n : nodes)
       if (n->id() != sender) n->hand_in(f, bits);
   }
@@ -291,7 +292,7 @@ struct VirtualBus::Impl {
       Delayed d = delayed.back();
       delayed.pop_back();
       d.frame.set_timestamp(core::SteadyClock::instance().wall());
-      deliver_all(d.frame, d.sender);
+      deliver_all(d.frame, d.sender, frame_bits(d.frame).total);
     }
     if (!delayed.empty()) arm_delay(delayed.front().due);
   }
