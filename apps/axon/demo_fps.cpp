@@ -32,6 +32,18 @@ namespace protocol = fps::protocol;
 
 namespace {
 
+// The report's summary plus the detail of the first robots that did not complete.
+std::string failure_text(const host::TrajectoryReport& rep) {
+  std::string out = rep.summary();
+  int shown = 0;
+  for (const auto& r : rep.robots) {
+    if (r.state == host::RobotState::completed || r.state == host::RobotState::withdrawn) continue;
+    if (shown++ == 10) break;
+    out += fmt::format("\n  robot {}: {}: {}", r.id, host::to_string(r.state), r.detail);
+  }
+  return out;
+}
+
 constexpr double kTimeScale = 10.0;  // simulated seconds per real second
 
 using Clock = std::chrono::steady_clock;
@@ -94,7 +106,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
       t.stop();
     }
   } stop_sim{sim_thread, *sim};
-  auto wire_now = [&] { return sim_thread.call([&] { return wire_now(); }); };
+  auto wire_now = [&] { return sim_thread.call([&] { return wire_bits(*sim, plane); }); };
   const auto sextants = sim_thread.call([&] { return sim->sextants(); });
   const auto gateways = sim_thread.call([&] { return sim->gateways(); });
   const auto plc_endpoint = sim_thread.call([&] { return sim->plc()->endpoint(); });
@@ -151,7 +163,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   auto r1 = co_await fpa->run_trajectories(std::move(fold), {}, true);
   const auto folded = need(std::move(r1));
   fmt::print("4. fold (20 points per arm, 16 s simulated, started by the PLC's sync line): {}\n", folded.outcome);
-  if (!folded.completed) throw Exception(Error(CoreErrc::invalid_argument, folded.summary()));
+  if (!folded.completed) throw Exception(Error(CoreErrc::invalid_argument, failure_text(folded)));
 
   const host::ArmAngles target{120, 100};
   const double move_s = 10.0;
@@ -252,7 +264,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
              host_cpu, sim_cpu, u.ru_maxrss / 1024, totals.sent, totals.timeouts, overflows);
   co_await fpa->close();
   fmt::print("   the same from a shell: `axon sim fps --layout default` (docs/fps-simulator.md), then `axon fps ...`\n");
-  if (!run.completed) throw Exception(Error(CoreErrc::invalid_argument, run.summary()));
+  if (!run.completed) throw Exception(Error(CoreErrc::invalid_argument, failure_text(run)));
 }
 
 }  // namespace axon::app

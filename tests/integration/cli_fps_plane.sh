@@ -53,7 +53,7 @@ set -e
 [ $rc = 1 ] || fail "layout check should fail (rc $rc)"
 grep -q '^missing *robot 5 ' "$TMP/check.out" || fail "robot 5 not reported missing"
 grep -q '^unexpected *robot 900 ' "$TMP/check.out" || fail "robot 900 not reported unexpected"
-grep -q '10 matched' "$TMP/check.out" || fail "10 robots should match"
+grep -q '11 matched' "$TMP/check.out" || fail "11 robots should match (12 in the layout, robot 5 absent)"
 
 # 2. A move started by the sync line reaches every bus (robot 5 is absent: left out).
 "$AXON" fps plane --layout "$TMP/a.yaml" --plc "$PLC" move --alpha 20 --beta 170 --duration 4 --sync \
@@ -68,8 +68,10 @@ grep -q 'sync line rising edge: ' "$TMP/a.err" || fail "the simulator saw no syn
 # 3. Sextant 2 powered off, then on through the PLC, while the host keeps working.
 "$AXON" fps plc --host "$PLC" power 2 off >/dev/null || fail "power off"
 "$AXON" fps plane --layout "$TMP/a.yaml" status >"$TMP/off.out" 2>"$TMP/off.err" || true
-grep -Eq '^  no answer: 6$' "$TMP/off.out" || fail "sextant 2 should be silent"
-grep -Eq '^  ready: 5$' "$TMP/off.out" || fail "sextant 1 should stay ready"
+# Silent: the 6 robots of sextant 2 and the absent robot 5; ready: the other 5 of sextant 1 and
+# the extra robot 900 (not in a sextant: no relay switches it).
+grep -Eq '^  no answer: 7$' "$TMP/off.out" || fail "sextant 2 should be silent"
+grep -Eq '^  ready: 6$' "$TMP/off.out" || fail "sextant 1 should stay ready"
 "$AXON" fps plc --host "$PLC" power 2 on >/dev/null || fail "power on"
 "$AXON" fps plane --layout "$TMP/a.yaml" status >"$TMP/on.out" 2>"$TMP/on.err" || true
 grep -Eq '^  bootloader: 6$' "$TMP/on.out" || fail "sextant 2 should be in the bootloader (sync line low)"
