@@ -1,15 +1,28 @@
-// `axon demo`, fps section: 20 simulated fiber positioners on one virtual bus, 20x faster than real
-// time, found, inspected, moved and run through a trajectory by the host driver.
+// `axon demo`, fps section: the default focal plane (500 simulated robots on 24 buses behind 6
+// CAN@net gateway emulators, plus the PLC emulator) driven over loopback TCP by the host: layout
+// check, discovery, status sweep, a fold and a coordinated move both started by the PLC's sync
+// line, final positions verified, each phase timed against the wire time of its busiest bus.
+// The simulated plane runs on a thread of its own (sim_thread.hpp), the host on the caller's.
 #include "demo_fps.hpp"
 
-#include "can/virtual_bus.hpp"
-#include "fps/host/array.hpp"
-#include "fps/sim/simulator_config.hpp"
+#include "fps/host/focal_plane_array.hpp"
+#include "fps/sim/focal_plane_sim.hpp"
+#include "layout_name.hpp"
 #include "run.hpp"
+#include "sim_thread.hpp"
 
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/detached.hpp>
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
+#include <sys/resource.h>
+#include <time.h>
+
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <map>
 
 namespace axon::app {
@@ -17,71 +30,241 @@ namespace axon::app {
 namespace host = fps::host;
 namespace protocol = fps::protocol;
 
-asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
-  fmt::print("\naxon demo: fiber positioners (fps)\n\n");
-  can::VirtualBusRegistry registry(ex);
-  need(registry.add("fps0"));
-  const std::vector<std::string> channels{"fps0"};
-  auto config = need(fps::sim::SimulatorConfig::grid(20, channels));
-  config.options.time_scale = 20;
-  auto simulator = need(fps::sim::make_simulator(ex, config, registry));
-  fmt::print("1. simulator: 20 robots (ids 1-20) on a hexagonal grid, virtual bus fps0, time x20;\n"
-             "   calibrated, datums initialised, arms folded (alpha 0, beta 180)\n");
+namespace {
 
-  auto bus = need(registry.open("fps0"));
-  host::Array array(std::vector<can::Bus*>{bus.get()});
-  const auto t0 = std::chrono::steady_clock::now();
-  auto since = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-
-  auto r1 = co_await array.discover();
-  const auto report = need(std::move(r1));
-  const auto& table = report.table;
-  std::map<std::string, int> states;
-  for (const auto& row : table.rows) ++states[row.state()];
-  std::string state_text;
-  for (const auto& [s, n] : states) state_text += fmt::format("{}{} {}", state_text.empty() ? "" : ", ", n, s);
-  fmt::print("2. discover (GET_ID broadcast, then firmware and status of each): {} robots, {} ({:.2f} s)\n",
-             table.rows.size(), state_text, since());
-  if (!table.rows.empty() && table.rows.front().firmware && table.rows.front().status)
-    fmt::print("   robot {}: firmware {}, {} status flags set, e.g. DATUM_ALPHA_INITIALIZED: {}\n", table.rows.front().id,
-               table.rows.front().firmware->to_string(), table.rows.front().status->names().size(),
-               table.rows.front().status->has(protocol::StatusBit::datum_alpha_initialized) ? "yes" : "no");
-  std::map<std::uint16_t, host::ArmAngles> targets{{1, {90, 170}}, {2, {180, 160}}, {3, {270, 175}}, {4, {45, 150}}};
-  const auto t_move = since();
-  auto r2 = co_await array.goto_absolute(targets);
-  const auto moves = need(std::move(r2));
-  fmt::print("3. goto, robots 1-4 at once (12 deg/s simulated, precise approach), {:.2f} s:\n", since() - t_move);
-  for (const auto& [id, res] : moves) {
-    if (res) fmt::print("   robot {}: at alpha {:7.3f} beta {:7.3f}\n", id, res.value().reached.alpha, res.value().reached.beta);
-    else fmt::print("   robot {}: {}\n", id, res.error().message());
+// The report's summary plus the detail of the first robots that did not complete.
+std::string failure_text(const host::TrajectoryReport& rep) {
+  std::string out = rep.summary();
+  int shown = 0;
+  for (const auto& r : rep.robots) {
+    if (r.state == host::RobotState::completed || r.state == host::RobotState::withdrawn) continue;
+    if (shown++ == 10) break;
+    out += fmt::format("\n  robot {}: {}: {}", r.id, host::to_string(r.state), r.detail);
   }
+  return out;
+}
 
-  const std::vector<protocol::ArmPoint> a5{{20, 1.0}, {40, 2.0}, {30, 3.0}}, b5{{170, 1.5}, {178, 3.0}};
-  const std::vector<protocol::ArmPoint> a6{{-3, 1.0}, {60, 4.0}}, b6{};
-  std::map<std::uint16_t, protocol::Trajectory> trajectories;
-  trajectories.emplace(5, need(protocol::Trajectory::from_physical(a5, b5)));
-  trajectories.emplace(6, need(protocol::Trajectory::from_physical(a6, b6)));
-  const auto t_traj = since();
-  auto r3 = co_await array.run_trajectories(trajectories);
-  const auto run = need(std::move(r3));
-  fmt::print("4. trajectories for robots 5 and 6 (upload with every reply checked, start by broadcast), {:.2f} s:\n",
-             since() - t_traj);
-  for (const auto& rr : run.robots)
-    fmt::print("   robot {}: {}{}\n", rr.id, host::to_string(rr.state),
-               rr.reached ? fmt::format(", ended at alpha {:.3f} beta {:.3f}", rr.reached->alpha, rr.reached->beta) : "");
-  fmt::print("   {}\n", run.outcome);
+constexpr double kTimeScale = 10.0;  // simulated seconds per real second
 
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+double seconds(core::Duration d) { return std::chrono::duration<double>(d).count(); }
+
+// CPU time of the calling thread (s).
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) / 1e9;
+}
+
+// Exact wire bits carried so far by each bus of the simulated plane.
+std::map<fps::BusRef, std::uint64_t> wire_bits(const fps::sim::FocalPlaneSimulator& sim, const fps::FocalPlane& plane) {
+  std::map<fps::BusRef, std::uint64_t> out;
+  for (const auto& b : plane.buses()) out[b] = sim.medium(b)->stats().bits;
+  return out;
+}
+
+// Wire time (s, 1 Mbit/s) of the busiest bus between two snapshots.
+double floor_s(const std::map<fps::BusRef, std::uint64_t>& before, const std::map<fps::BusRef, std::uint64_t>& after) {
+  std::uint64_t most = 0;
+  for (const auto& [b, bits] : after) most = std::max(most, bits - before.at(b));
+  return static_cast<double>(most) / 1e6;
+}
+
+// A straight move of both arms from `from` to `to` in `points` points per arm over `duration_s`.
+protocol::Trajectory straight(host::ArmAngles from, host::ArmAngles to, int points, double duration_s) {
+  std::vector<protocol::ArmPoint> a, b;
+  for (int i = 1; i <= points; ++i) {
+    const double f = static_cast<double>(i) / points;
+    a.push_back({from.alpha + (to.alpha - from.alpha) * f, duration_s * f});
+    b.push_back({from.beta + (to.beta - from.beta) * f, duration_s * f});
+  }
+  return need(protocol::Trajectory::from_physical(a, b));
+}
+
+struct Phase {
+  std::string name;
+  double seconds = 0;
+  double floor = 0;  // wire time of the busiest bus; 0: not a bus-bound phase
+};
+
+}  // namespace
+
+asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
+  fmt::print("\naxon demo: a focal plane of fiber positioners (fps)\n\n");
+  const auto plane = need(resolve_layout("default"));
+  fps::sim::FocalPlaneSimOptions so;
+  so.simulator.time_scale = kTimeScale;
+  so.seed = 7;
+  SimThread sim_thread;
+  auto sim = sim_thread.call([&] { return need(fps::sim::FocalPlaneSimulator::start(sim_thread.executor(), plane, so)); });
+  struct StopSim {
+    SimThread& t;
+    fps::sim::FocalPlaneSimulator& s;
+    ~StopSim() {
+      t.call([this] { s.stop(); });
+      t.stop();
+    }
+  } stop_sim{sim_thread, *sim};
+  auto wire_now = [&] { return sim_thread.call([&] { return wire_bits(*sim, plane); }); };
+  const auto sextants = sim_thread.call([&] { return sim->sextants(); });
+  const auto gateways = sim_thread.call([&] { return sim->gateways(); });
+  const auto plc_endpoint = sim_thread.call([&] { return sim->plc()->endpoint(); });
+  fmt::print("1. simulated focal plane '{}': {} robots in {} sextants on {} buses (1 Mbit/s, exact frame bits,\n"
+             "   real-time pacing) behind {} CAN@net gateway emulators; PLC emulator at {}; time x{};\n"
+             "   robots start at random alpha with beta folded (seed {})\n",
+             plane.name(), sim_thread.call([&] { return sim->simulator().size(); }), sextants.size(), plane.buses().size(), gateways.size(),
+             plc_endpoint.to_string(), kTimeScale, so.seed);
+
+  host::FocalPlaneArrayOptions ao;
+  for (const auto& g : gateways) ao.addresses[g.id] = g.endpoint;
+  ao.plc = plc_endpoint;
+  ao.array.positioner.poll_interval = 100ms;
+  auto connected = co_await host::FocalPlaneArray::connect(ex, plane, ao);
+  auto fpa = need(std::move(connected));
+  auto& array = fpa->array();
+  std::vector<Phase> phases;
+
+  // 2. Layout check and discovery.
+  auto t0 = Clock::now();
+  const auto check = co_await fpa->check_layout();
+  fmt::print("2. layout check (GET_ID broadcast on all {} buses at once, {:.1f} s window): {} matched, {} missing, "
+             "{} unexpected, {} on the wrong bus ({:.2f} s)\n",
+             fpa->bus_count(), seconds(ao.check_window), check.matched.size(), check.missing.size(),
+             check.unexpected.size(), check.wrong_bus.size(), seconds(Clock::now() - t0));
+  if (!check.ok()) throw Exception(Error(CoreErrc::invalid_argument, "layout check failed:\n" + check.to_text()));
+  auto bits0 = wire_now();
+  t0 = Clock::now();
+  auto disc = co_await fpa->discover();
+  const auto found = need(std::move(disc));
+  phases.push_back({"discovery", seconds(Clock::now() - t0), floor_s(bits0, wire_now())});
+  fmt::print("   discovery (GET_ID until every robot of the bus answered, then firmware and status of each): "
+             "{} robots, {} problems ({:.2f} s)\n",
+             found.table.rows.size(), found.problems.size(), phases.back().seconds);
+
+  // 3. Status sweep (firmware, status, position of every robot).
+  bits0 = wire_now();
+  t0 = Clock::now();
+  const auto table = co_await array.status_table(true);
+  phases.push_back({"status sweep", seconds(Clock::now() - t0), floor_s(bits0, wire_now())});
+  std::size_t ready = 0;
+  for (const auto& row : table.rows) ready += row.error.empty() && row.position ? 1 : 0;
+  fmt::print("3. status sweep: {} of {} robots answered with status and position ({:.2f} s)\n", ready, table.rows.size(),
+             phases.back().seconds);
+
+  // 4. Fold every robot to alpha 0 (beta stays folded: the arms never leave their cells), then
+  //    the coordinated move: every robot the same trajectory at the same instant, so neighbours
+  //    stay translated copies of each other and never come closer than the pitch allows.
+  std::map<std::uint16_t, protocol::Trajectory> fold;
+  for (const auto& row : table.rows) {
+    if (!row.position) continue;
+    fold.emplace(row.id, straight(*row.position, {0, 180}, 20, 16.0));
+  }
+  auto r1 = co_await fpa->run_trajectories(std::move(fold), {}, true);
+  const auto folded = need(std::move(r1));
+  fmt::print("4. fold (20 points per arm, 16 s simulated, started by the PLC's sync line): {}\n", folded.outcome);
+  if (!folded.completed) throw Exception(Error(CoreErrc::invalid_argument, failure_text(folded)));
+
+  const host::ArmAngles target{120, 100};
+  const double move_s = 10.0;
+  std::map<std::uint16_t, protocol::Trajectory> moves;
+  for (auto id : array.ids()) moves.emplace(id, straight({0, 180}, target, 20, move_s));
+  std::map<std::string, std::map<fps::BusRef, std::uint64_t>> marks;
+  std::map<std::string, Clock::time_point> marks_t;
+  bool moving = false, finished = false, progress_done = false;
+  host::TrajectoryOptions to;
+  to.on_phase = [&](std::string_view phase) {
+    marks[std::string(phase)] = wire_now();
+    marks_t[std::string(phase)] = Clock::now();
+    if (phase == "started") moving = true;
+    if (phase == "finished") finished = true;
+  };
+  // Progress line while the robots move: the host's view of one robot per sextant.
+  auto progress = [&]() -> asio::awaitable<void> {
+    while (!moving && !finished) co_await core::sleep_for(20ms);
+    const auto start = Clock::now();
+    std::vector<std::uint16_t> sample;
+    for (const auto& [s, ids] : sextants)
+      if (!ids.empty()) sample.push_back(ids.front());
+    while (!finished) {
+      std::string where;
+      for (auto id : sample) {
+        auto p = co_await array.find(id)->read_position();
+        if (p) where += fmt::format(" {}:{:.0f}/{:.0f}", id, p.value().alpha, p.value().beta);
+      }
+      const double el = seconds(Clock::now() - start), total = move_s / kTimeScale;
+      std::printf("\r   moving %4.1f of %.1f s (%3.0f%%), alpha/beta of one robot per sextant:%s   ", el, total,
+                  std::min(100.0, 100.0 * el / total), where.c_str());
+      std::fflush(stdout);
+      co_await core::sleep_for(250ms);
+    }
+    std::printf("\n");
+    progress_done = true;
+  };
+  asio::co_spawn(ex, progress(), asio::detached);
+  bits0 = wire_now();
+  auto r2 = co_await fpa->run_trajectories(std::move(moves), to, true);
+  const auto run = need(std::move(r2));
+  finished = true;
+  while (!progress_done) co_await core::sleep_for(20ms);  // let the progress line end
+  fmt::print("5. coordinated move of all {} robots to alpha {} beta {} (20 points per arm, {} s simulated),\n"
+             "   started by the sync line: {}\n",
+             run.robots.size(), target.alpha, target.beta, move_s, run.outcome);
+  if (marks.contains("checked") && marks.contains("uploaded")) {
+    phases.push_back({"upload", seconds(run.timings.upload), floor_s(marks["checked"], marks["uploaded"])});
+  }
+  if (marks.contains("uploaded") && marks.contains("started")) {
+    phases.push_back({"sync start", seconds(run.timings.start), 0});
+  }
+  phases.push_back({"move", seconds(run.timings.move), 0});
+
+  // 6. Verify: the host's final reading of every robot and the simulator's own arms.
+  double worst_host = 0, worst_sim = 0;
+  std::size_t at_target = 0;
+  for (const auto& rr : run.robots) {
+    if (rr.reached) {
+      worst_host = std::max({worst_host, std::abs(rr.reached->alpha - target.alpha), std::abs(rr.reached->beta - target.beta)});
+    }
+  }
+  // The simulator's own arms, read on its thread.
+  sim_thread.call([&] {
+    for (const auto& rr : run.robots) {
+      if (const auto* m = sim->simulator().find(rr.id)) {
+        const double e = std::max(std::abs(m->physical_deg(fps::sim::Arm::alpha) - target.alpha),
+                                  std::abs(m->physical_deg(fps::sim::Arm::beta) - target.beta));
+        worst_sim = std::max(worst_sim, e);
+        at_target += e < 0.1 ? 1 : 0;
+      }
+    }
+  });
+  const auto st = sim_thread.call([&] { return sim->simulator().stats(); });
+  fmt::print("6. verified: {} of {} robots at their target; worst error {:.4f} deg (host reading), {:.4f} deg "
+             "(simulated arms); {} collisions\n",
+             at_target, run.robots.size(), worst_host, worst_sim, st.neighbour_collisions + st.obstacle_collisions);
+
+  fmt::print("7. timings (floor: wire time of the busiest bus for the frames the phase put on it, 1 Mbit/s):\n");
+  for (const auto& p : phases) {
+    if (p.floor > 0) {
+      fmt::print("   {:<12} {:7.3f} s   floor {:7.4f} s   ratio {:5.2f}\n", p.name, p.seconds, p.floor, p.seconds / p.floor);
+    } else if (p.name == "move") {
+      fmt::print("   {:<12} {:7.3f} s   trajectory {:.3f} s (real time)   ratio {:5.2f}\n", p.name, p.seconds,
+                 move_s / kTimeScale, p.seconds / (move_s / kTimeScale));
+    } else {
+      fmt::print("   {:<12} {:7.3f} s\n", p.name, p.seconds);
+    }
+  }
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
   const auto totals = array.client_totals();
-  const auto& s = simulator->stats();
-  fmt::print("5. host: {} requests, {} replies, {} timeouts; simulator: {} frames processed, {} receive overflows, "
-             "{} collisions\n",
-             totals.sent, totals.replies, totals.timeouts, s.frames_processed, simulator->receive_overflows(),
-             s.neighbour_collisions + s.obstacle_collisions);
-  co_await array.close();
-  bus->close();
-  simulator->stop();
-  fmt::print("   the same commands from a shell: `axon sim fps --gateway 127.0.0.1:19228 --time-scale 20` and\n"
-             "   `axon fps --gateway 127.0.0.1:19228 status` (docs/fps-cli.md)\n");
+  const double host_cpu = thread_cpu_s();
+  const double sim_cpu = sim_thread.call([] { return thread_cpu_s(); });
+  const auto overflows = sim_thread.call([&] { return sim->simulator().receive_overflows(); });
+  fmt::print("   CPU: host thread {:.1f} s, simulator thread {:.1f} s; peak memory {} MB; {} requests, {} timeouts, "
+             "{} receive overflows\n",
+             host_cpu, sim_cpu, u.ru_maxrss / 1024, totals.sent, totals.timeouts, overflows);
+  co_await fpa->close();
+  fmt::print("   the same from a shell: `axon sim fps --layout default` (docs/fps-simulator.md), then `axon fps ...`\n");
+  if (!run.completed) throw Exception(Error(CoreErrc::invalid_argument, failure_text(run)));
 }
 
 }  // namespace axon::app

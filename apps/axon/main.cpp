@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   add_fps_plan_commands(app, global);
   add_sim_plc_command(app, global);
   add_blmc_commands(app, global);
+  add_fps_plane_commands(app, global);
   add_demo_command(app, global);
   try {
     app.parse(argc, argv);

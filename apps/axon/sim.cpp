@@ -12,8 +12,10 @@
 #include "can/virtual_bus.hpp"
 #include "commands.hpp"
 #include "core/config.hpp"
+#include "fps/sim/focal_plane_sim.hpp"
 #include "fps/sim/simulator_config.hpp"
 #include "id_list.hpp"
+#include "layout_name.hpp"
 #include "net/endpoint.hpp"
 #include "run.hpp"
 
@@ -26,6 +28,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 
 namespace axon::app {
@@ -41,6 +44,15 @@ struct SimFpsOptions {
   unsigned buses = 1;
   double time_scale = 1.0;
   double duration_s = 0;
+  // --layout mode
+  std::string layout;
+  std::string scenario;
+  std::string plc = "127.0.0.1:0";
+  std::string bind = "127.0.0.1";
+  std::uint16_t base_port = 0;
+  std::uint64_t seed = 1;
+  bool folded = false;
+  std::string write_layout;
 };
 
 // The simulator configuration the options describe: a file, or a hexagonal grid of the listed ids
@@ -61,7 +73,79 @@ sim::SimulatorConfig build_config(const SimFpsOptions& o) {
   return config;
 }
 
+// The layout with each gateway's address replaced by where its emulator listens.
+fps::FocalPlane with_addresses(const fps::FocalPlane& plane, const std::vector<sim::GatewayInfo>& gateways) {
+  auto spec = plane.spec();
+  for (auto& g : spec.gateways) {
+    for (const auto& info : gateways)
+      if (info.id == g.id) g.address = info.endpoint.to_string();
+  }
+  return need(fps::FocalPlane::build(std::move(spec)));
+}
+
+// `axon sim fps --layout ...`: every robot of a layout behind one CAN@net emulator per gateway,
+// plus the PLC emulator whose relays act on them.
+int run_sim_layout(const SimFpsOptions& o) {
+  if (o.time_scale <= 0) throw Exception(Error(CoreErrc::invalid_argument, "--time-scale must be positive"));
+  const auto plane = need(resolve_layout(o.layout));
+  sim::FocalPlaneSimOptions fo;
+  fo.simulator.time_scale = o.time_scale;
+  fo.seed = o.seed;
+  fo.random_start = !o.folded;
+  fo.bind_address = o.bind;
+  if (o.base_port != 0) {
+    std::uint16_t port = o.base_port;
+    for (const auto& g : plane.gateways()) fo.gateway_ports[g.id] = port++;
+  }
+  if (!o.scenario.empty()) fo.scenario = need(sim::Scenario::from_config(need(core::ConfigNode::load_file(o.scenario))));
+  fo.plc = !o.plc.empty() && o.plc != "off";
+  if (fo.plc) {
+    const auto ep = need(net::parse_endpoint(o.plc, 502));
+    fo.plc_options.bind_address = ep.host;
+    fo.plc_options.port = ep.port;
+  }
+  return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
+    auto fp = need(sim::FocalPlaneSimulator::start(io.get_executor(), plane, fo));
+    // Ready lines: one per gateway, then the PLC (tests parse them).
+    for (const auto& g : fp->gateways()) {
+      std::string chans;
+      for (const auto& [ch, name] : g.channels) chans += fmt::format("{}{}", chans.empty() ? "" : ",", ch);
+      std::printf("listening gateway %u %s channels %s robots %zu sextant %d\n", unsigned{g.id},
+                  g.endpoint.to_string().c_str(), chans.c_str(), g.robots, g.sextant);
+    }
+    if (auto* p = fp->plc()) std::printf("listening plc %s\n", p->endpoint().to_string().c_str());
+    if (!o.write_layout.empty()) {
+      std::ofstream out(o.write_layout);
+      out << fps::to_yaml(with_addresses(plane, fp->gateways()));
+      out.close();
+      if (!out) throw Exception(Error(CoreErrc::io, fmt::format("cannot write '{}'", o.write_layout)));
+      std::printf("wrote layout %s\n", o.write_layout.c_str());
+    }
+    std::printf("ready\n");
+    std::fflush(stdout);
+    spdlog::info("sim: layout '{}': {} positioners on {} buses behind {} gateways, time scale {} (Ctrl-C to stop)",
+                 plane.name(), fp->simulator().size(), plane.buses().size(), fp->gateways().size(), o.time_scale);
+
+    asio::steady_timer until(io, o.duration_s > 0 ? std::chrono::steady_clock::now() +
+                                                         std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.duration_s))
+                                                   : core::TimePoint::max());
+    set_on_signal([&] { until.cancel(); });
+    boost::system::error_code ec;
+    co_await until.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+    const auto& s = fp->simulator().stats();
+    const auto& c = fp->counters();
+    spdlog::info("sim: {} frames processed, {} sent ({} unsolicited), {} receive overflows, {} collisions "
+                 "({} neighbour, {} obstacle), {} sync edges, {} sextant and {} gateway power changes",
+                 s.frames_processed, s.frames_sent, s.unsolicited, fp->simulator().receive_overflows(),
+                 s.neighbour_collisions + s.obstacle_collisions, s.neighbour_collisions, s.obstacle_collisions,
+                 c.sync_edges, c.sextant_power_changes, c.gateway_power_changes);
+    fp->stop();
+    co_return 0;
+  });
+}
+
 int run_sim_fps(const SimFpsOptions& o) {
+  if (!o.layout.empty()) return run_sim_layout(o);
   if (o.gateway.empty() && o.socketcand.empty())
     throw Exception(Error(CoreErrc::invalid_argument, "give --gateway HOST:PORT and/or --socketcand HOST:PORT"));
   if (o.time_scale <= 0) throw Exception(Error(CoreErrc::invalid_argument, "--time-scale must be positive"));
@@ -222,7 +306,17 @@ void add_sim_commands(CLI::App& app, GlobalOptions&) {
       ->check(CLI::Range(1u, 24u));
   f->add_option("--time-scale", fps.time_scale, "simulated seconds per real second (default 1)");
   f->add_option("--duration", fps.duration_s, "stop after this many seconds (default: until Ctrl-C)");
+  f->add_option("--layout", fps.layout, "every robot of a layout (default, benchtop or FILE) behind one CAN@net "
+                                     "emulator per gateway, with the PLC emulator");
+  f->add_option("--scenario", fps.scenario, "with --layout: robots datum lost, uncalibrated, collided, ... (YAML)");
+  f->add_option("--seed", fps.seed, "with --layout: seed of the random start positions (default 1)");
+  f->add_flag("--folded", fps.folded, "with --layout: every robot at alpha 0, beta 180 (default: random alpha, beta folded)");
+  f->add_option("--plc", fps.plc, "with --layout: PLC emulator on HOST:PORT (default 127.0.0.1:0; `off`: none)");
+  f->add_option("--bind", fps.bind, "with --layout: address of the gateway emulators (default 127.0.0.1)");
+  f->add_option("--base-port", fps.base_port, "with --layout: gateway N listens on base + N - 1 (default: any free port)");
+  f->add_option("--write-layout", fps.write_layout, "with --layout: write the layout with the emulators' addresses to FILE");
   f->get_option("--config")->excludes("--robots")->excludes("--buses");
+  f->get_option("--layout")->excludes("--robots")->excludes("--buses")->excludes("--config")->excludes("--gateway")->excludes("--socketcand");
   f->callback([] { exit_code() = run_sim_fps(fps); });
 
   static SimBlmcOptions blmc;

@@ -24,7 +24,8 @@ class VirtualNode final : public Bus {
  public:
   struct Queued {
     Frame frame;
-    std::uint64_t seq;  // medium-wide order of queueing: breaks ties between equal keys
+    std::uint64_t seq;        // medium-wide order of queueing: breaks ties between equal keys
+    core::TimePoint queued;   // when the node handed it over (pacing: it cannot start earlier)
   };
 
   VirtualNode(std::shared_ptr<VirtualBus> medium, VirtualBus::Impl& impl, std::uint64_t id, std::string name,
@@ -73,6 +74,8 @@ struct VirtualBus::Impl {
     bool drop = false;
     core::Duration delay{0};
     std::uint32_t bits = 0;  // wire bits of one copy (0 when nothing is accounted)
+    core::TimePoint start{};  // pacing: when it went on the wire (the schedule's time, see hold_wire)
+    std::uint32_t rx_bits = 0;  // wire bits of what receivers see (differs when corrupted)
   };
   struct Delayed {
     core::TimePoint due;
@@ -95,9 +98,7 @@ struct VirtualBus::Impl {
 
   OnWire on_wire;
   asio::steady_timer wire_timer;
-  core::TimePoint burst_start{};  // pacing: when the medium last became busy after being idle
-  std::uint64_t burst_bits = 0;   // bits sent since then
-  core::TimePoint wire_free{};    // when the last paced frame ends
+  core::TimePoint wire_free{};    // pacing: when the last frame ends (or ended) on the schedule
 
   std::vector<Delayed> delayed;  // min-heap on (due, seq)
   asio::steady_timer delay_timer;
@@ -116,7 +117,7 @@ struct VirtualBus::Impl {
 
   void run() {
     if (pacing()) {
-      start_next(false);
+      start_next();
       return;
     }
     while (begin()) {
@@ -127,14 +128,24 @@ struct VirtualBus::Impl {
   }
 
   // Arbitration: among the heads of all queues, the lowest key wins; equal keys go in queueing
-  // order. Returns null when every queue is empty.
+  // order. When pacing, only frames queued by the time the wire is free compete (the schedule may
+  // run behind the clock, see hold_wire); if none was, the earliest queued go first. Returns null
+  // when every queue is empty.
   VirtualNode* arbitrate() noexcept {
     VirtualNode* best = nullptr;
     std::uint32_t best_key = 0;
     std::uint64_t best_seq = 0;
     unsigned contenders = 0;
+    core::TimePoint eligible = core::TimePoint::max();
+    if (pacing()) {
+      core::TimePoint first = core::TimePoint::max();
+      for (auto* n : nodes)
+        if (!n->queue().empty()) first = std::min(first, n->queue().front().queued);
+      eligible = std::max(first, wire_free);
+    }
     for (auto* n : nodes) {
       if (n->queue().empty()) continue;
+      if (n->queue().front().queued > eligible) continue;
       ++contenders;
       const auto& head = n->queue().front();
       const std::uint32_t key = arbitration_key(head.frame);
@@ -153,6 +164,7 @@ struct VirtualBus::Impl {
     VirtualNode* winner = arbitrate();
     if (!winner) return false;
     const Frame frame = winner->queue().front().frame;
+    const core::TimePoint queued = winner->queue().front().queued;
     winner->queue().pop_front();
     const std::uint32_t bits = frame_bits(frame).total;
     winner->take(frame, bits);
@@ -176,8 +188,10 @@ struct VirtualBus::Impl {
       if (d.corrupted) ++stats.fault_corrupted;
       on_wire.frame = d.frame;
     }
+    on_wire.rx_bits = on_wire.frame == frame ? bits : frame_bits(on_wire.frame).total;
     // The wire carries what the sender sent; corruption is the receivers' view of it.
     on_wire.bits = accounting() ? bits : 0;
+    on_wire.start = std::max(queued, wire_free);
     account();
     return true;
   }
@@ -199,7 +213,7 @@ struct VirtualBus::Impl {
       if (on_wire.delay > core::Duration::zero()) {
         schedule_delayed(core::SteadyClock::instance().now() + on_wire.delay, f, on_wire.sender);
       } else {
-        deliver_all(f, on_wire.sender);
+        deliver_all(f, on_wire.sender, on_wire.rx_bits);
       }
     }
     if (--on_wire.copies == 0) return false;
@@ -207,47 +221,48 @@ struct VirtualBus::Impl {
     return true;
   }
 
-  void deliver_all(const Frame& f, std::uint64_t sender) {
-    const std::uint32_t bits = frame_bits(f).total;
+  void deliver_all(const Frame& f, std::uint64_t sender, std::uint32_t bits) {
     for (auto* n : nodes)
       if (n->id() != sender) n->hand_in(f, bits);
   }
 
-  // Paced mode: arbitrate, then hold the medium for the winner's bit time. `back_to_back`: the
-  // previous frame has just ended, so this one starts where that one ended (not when the timer
-  // handler happened to run), and wake-up latency does not pile up over a burst.
-  void start_next(bool back_to_back) {
+  // Paced mode: arbitrate, then hold the medium for the winner's bit time.
+  void start_next() {
     if (!begin()) {
       active = false;
       return;
     }
-    hold_wire(back_to_back);
+    hold_wire();
   }
 
-  // How far the medium may lag behind the wire schedule and still catch up by sending the next
-  // frames sooner; a longer stall (a descheduled process) restarts the schedule instead of
-  // flushing a burst no real bus could carry.
-  static constexpr core::Duration kMaxCatchUp = std::chrono::milliseconds(2);
-
-  void hold_wire(bool back_to_back) {
-    const auto now = core::SteadyClock::instance().now();
-    if (!back_to_back || now - wire_free > kMaxCatchUp) {
-      burst_start = now;
-      burst_bits = 0;
-    }
-    burst_bits += on_wire.bits;
-    // Measured from the start of the burst so that rounding never adds up either.
-    wire_free = burst_start + bits_to_time(burst_bits, wire.bitrate);
+  // The schedule: a frame starts when the wire is free and not before it was queued, and ends its
+  // bit time later; it is delivered when the timer for that end fires. Times come from the
+  // schedule, not from when handlers happened to run: a process that wakes up late (a loaded
+  // machine, a descheduled thread) delivers what the wire would have carried meanwhile, and no
+  // more, since no frame starts before it was queued or before the previous one ended. So wake-up
+  // latency neither piles up over a burst nor lets the medium carry more than a real bus would.
+  void hold_wire() {
+    wire_free = on_wire.start + bits_to_time(on_wire.bits, wire.bitrate);
     wire_timer.expires_at(wire_free);
     wire_timer.async_wait([s = self()](const boost::system::error_code& ec) {
       if (ec == asio::error::operation_aborted) return;
       auto& m = *s->impl_;
+      m.note_lateness();
       if (m.finish_copy()) {
-        m.hold_wire(true);
+        m.on_wire.start = m.wire_free;  // the duplicate follows at once
+        m.hold_wire();
         return;
       }
-      m.start_next(true);
+      m.start_next();
     });
+  }
+
+  // How late (process latency) the frame that has just ended is handed over.
+  void note_lateness() noexcept {
+    const auto late = core::SteadyClock::instance().now() - wire_free;
+    if (late <= core::Duration::zero()) return;
+    stats.lateness += late;
+    stats.max_lateness = std::max(stats.max_lateness, std::chrono::duration_cast<core::Duration>(late));
   }
 
   static bool later(const Delayed& a, const Delayed& b) noexcept {
@@ -277,7 +292,7 @@ struct VirtualBus::Impl {
       Delayed d = delayed.back();
       delayed.pop_back();
       d.frame.set_timestamp(core::SteadyClock::instance().wall());
-      deliver_all(d.frame, d.sender);
+      deliver_all(d.frame, d.sender, frame_bits(d.frame).total);
     }
     if (!delayed.empty()) arm_delay(delayed.front().due);
   }
@@ -296,7 +311,8 @@ Result<void> VirtualNode::submit(const Frame& frame) {
     return Error(CanErrc::tx_overflow,
                  fmt::format("virtual node {}: {} frames already wait for the wire", name(), tx_.size()));
   }
-  tx_.push_back(Queued{frame, impl_->next_seq++});
+  const core::TimePoint queued = impl_->pacing() ? core::SteadyClock::instance().now() : core::TimePoint{};
+  tx_.push_back(Queued{frame, impl_->next_seq++, queued});
   impl_->kick();
   return ok();
 }

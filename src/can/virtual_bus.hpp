@@ -36,6 +36,10 @@ struct VirtualBusStats {
   std::uint64_t fault_delayed = 0;
   std::uint64_t fault_duplicated = 0;
   std::uint64_t fault_corrupted = 0;
+  // Pacing: how much later than their scheduled end frames were handed over (the process woke up
+  // late), summed and at most. Large figures mean the machine, not the wire, set the pace.
+  core::Duration lateness{0};
+  core::Duration max_lateness{0};
   core::TimePoint created{};
 };
 

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <thread>
 #include <vector>
 
 using namespace axon;
@@ -158,6 +159,7 @@ TEST(VirtualBusWire, FramesQueuedDuringATransmissionCompeteForTheNext) {
   asio::io_context io;
   WireModel wire;
   wire.pace_realtime = true;
+  wire.bitrate = 10'000;  // about 5 ms per frame: b surely queues while 0x500 is on the wire
   auto medium = VirtualBus::create(io.get_executor(), "vcan0", wire);
   auto a = medium->attach(), b = medium->attach(), rx = medium->attach();
   asio::co_spawn(io, [&]() -> asio::awaitable<void> {
@@ -172,4 +174,29 @@ TEST(VirtualBusWire, FramesQueuedDuringATransmissionCompeteForTheNext) {
   std::vector<std::string> got;
   while (auto f = rx->try_receive()) got.push_back(f->to_string());
   EXPECT_EQ(got, (std::vector<std::string>{"500#", "100#", "400#"}));
+}
+
+TEST(VirtualBusWire, ALateWakeUpIsCountedAndKeepsTheSchedule) {
+  asio::io_context io;
+  WireModel wire;
+  wire.pace_realtime = true;
+  wire.bitrate = 125'000;  // 8 us a bit: an 8-byte frame takes about 1 ms
+  auto medium = VirtualBus::create(io.get_executor(), "vcan0", wire);
+  auto a = medium->attach(), b = medium->attach();
+  std::vector<Frame> frames;
+  for (int i = 0; i < 10; ++i) frames.push_back(F("123#1122334455667788"));
+  send_all(io, *a, frames);
+  while (b->pending() == 0 && io.run_one() > 0) {
+  }
+  // The process is descheduled for a while (what a loaded machine does to a simulator).
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  io.run();
+  EXPECT_EQ(b->pending(), frames.size());
+  // The stall shows up as lateness of the frame whose end fell into it...
+  EXPECT_GE(medium->stats().max_lateness, std::chrono::milliseconds(20) - frame_time(frames[0], wire.bitrate));
+  EXPECT_GE(medium->stats().lateness, medium->stats().max_lateness);
+  // ... and the wire carried each frame for exactly its bits, no more, no less.
+  std::uint64_t bits = 0;
+  for (const auto& f : frames) bits += frame_bits(f).total;
+  EXPECT_EQ(medium->stats().bits, bits);
 }

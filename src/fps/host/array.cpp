@@ -111,7 +111,10 @@ asio::awaitable<std::vector<Array::BusBroadcast>> Array::broadcast_on(std::vecto
   std::vector<BusBroadcast> out(buses.size());
   co_await for_each_concurrently(buses.size(), [&](std::size_t i) -> asio::awaitable<void> {
     BroadcastOptions o = options;
-    if (!o.expected) o.expected = ids_on(buses[i]).size();
+    if (!o.expected && !o.expected_ids) {
+      const auto ids = ids_on(buses[i]);
+      o.expected_ids = std::set<std::uint16_t>(ids.begin(), ids.end());
+    }
     out[i].bus = buses[i];
     out[i].result = co_await buses_[buses[i]].client->broadcast(c, {}, o);
   });

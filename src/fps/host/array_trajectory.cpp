@@ -60,6 +60,17 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
   if (auto g = may_move(rep.robots.front().id); !g) co_return g.error();
   const std::size_t n = rep.robots.size();
   const auto involved = buses_of(rep);
+  auto phase_start = now();
+  auto phase_end = [&](core::Duration& slot, std::string_view name) {
+    const auto t = now();
+    slot = std::chrono::duration_cast<core::Duration>(t - phase_start);
+    phase_start = t;
+    if (o.on_phase) o.on_phase(name);
+  };
+  auto traj_points = [&](const RobotRun& r) {
+    const auto& t = trajectories.at(r.id);
+    return t.alpha().size() + t.beta().size();
+  };
   auto fail = [&](RobotRun& r, RobotState s, std::string why) {
     r.state = s;
     r.detail = std::move(why);
@@ -102,6 +113,8 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
     r.target = end_of(*traj[i], pos.value());
   });
 
+  phase_end(rep.timings.check, "checked");
+
   // 3. Upload to every robot that passed, every reply checked.
   co_await for_each_concurrently(n, [&](std::size_t i) -> asio::awaitable<void> {
     auto& r = rep.robots[i];
@@ -113,6 +126,8 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
       fail(r, RobotState::upload_failed, r.upload.describe());
     }
   });
+
+  phase_end(rep.timings.upload, "uploaded");
 
   // 4. Start only if every robot is loaded (and nothing locked the array meanwhile).
   const auto failed = [&] {
@@ -127,11 +142,34 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
     rep.outcome = lock_now ? fmt::format("not started: the array is locked ({})", lock_.reason)
                            : fmt::format("not started: positioners {} failed validation or upload (see each robot)",
                                          fmt::join(failed, ", "));
-    // Drop the trajectories that did load, so that nothing (a stray sync pulse) can start them.
+    // Drop the trajectories that did load (and partial uploads), so that nothing (a stray sync
+    // pulse) can start them; say exactly what each robot holds when the abort did not reach it.
     auto results = co_await broadcast_on(involved, CommandId::trajectory_abort);
-    (void)results;
     for (auto& r : rep.robots) {
-      if (r.state == RobotState::loaded) fail(r, RobotState::withdrawn, "loaded, then withdrawn: " + rep.outcome);
+      std::string abort_failure;
+      bool acknowledged = false;
+      for (const auto& b : results) {
+        if (b.bus != r.bus) continue;
+        if (!b.result) {
+          abort_failure = fmt::format("the abort broadcast on bus {} failed: {}", bus_name(r.bus), b.result.error().message());
+        } else if (const Reply* reply = b.result.value().from(r.id); reply != nullptr && reply->accepted()) {
+          acknowledged = true;
+        } else {
+          abort_failure = "it did not acknowledge the abort";
+        }
+      }
+      if (r.state == RobotState::loaded) {
+        if (acknowledged) {
+          fail(r, RobotState::withdrawn, "loaded, then withdrawn (abort acknowledged): " + rep.outcome);
+        } else {
+          fail(r, RobotState::still_loaded,
+               fmt::format("still holds its whole trajectory ({} points): {}; {}", traj_points(r), abort_failure, rep.outcome));
+        }
+      } else if (r.state == RobotState::upload_failed && r.upload.stage != UploadResult::Stage::not_sent) {
+        r.detail += acknowledged ? "; the partial upload was discarded (abort acknowledged)"
+                                 : fmt::format("; may still hold a partial trajectory ({} of {} points accepted), not withdrawn: {}",
+                                               r.upload.points_accepted, traj_points(r), abort_failure);
+      }
     }
     spdlog::warn("fps array: trajectories {}", rep.outcome);
     co_return rep;
@@ -181,6 +219,7 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
     co_return rep;
   }
   rep.started = true;
+  phase_end(rep.timings.start, "started");
   if (!o.wait) {
     rep.outcome = "started; not waiting for the end";
     co_return rep;
@@ -224,6 +263,7 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
     }
     r.state = RobotState::completed;
   });
+  phase_end(rep.timings.move, "finished");
   rep.completed = rep.all(RobotState::completed);
   if (rep.completed) {
     rep.outcome = fmt::format("completed: {} robots at their targets", n);

@@ -120,9 +120,11 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
     bool granted = false;
   };
   struct Collector {
-    Collector(const asio::any_io_executor& e, std::optional<std::size_t> exp) : wake(e), expected(exp) {}
+    Collector(const asio::any_io_executor& e, std::optional<std::size_t> exp, std::optional<std::set<std::uint16_t>> ids)
+        : wake(e), expected(exp), waiting(std::move(ids)) {}
     core::Wakeup wake;
     std::optional<std::size_t> expected;
+    std::optional<std::set<std::uint16_t>> waiting;  // expected_ids not heard from yet
     BroadcastResult result;
   };
 
@@ -215,7 +217,8 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
     ++counters.replies;
     ++counters.by_code[static_cast<std::size_t>(r.code) & 0xF];
     c.result.replies.push_back(r);
-    if (c.expected && c.result.replies.size() >= *c.expected) {
+    if (c.waiting) c.waiting->erase(r.positioner);
+    if ((c.expected && c.result.replies.size() >= *c.expected) || (c.waiting && c.waiting->empty())) {
       c.result.complete = true;
       c.wake.notify();
     }
@@ -439,7 +442,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
     }
     if (auto r = check_running(); !r) co_return r.error();
 
-    Collector c(ex, bo.expected);
+    Collector c(ex, bo.expected, bo.expected_ids);
     collectors[n] = &c;
     struct CollectorGuard {
       Impl& self;
@@ -467,7 +470,8 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
       }
     }
     ++counters.broadcasts;
-    if (bo.expected && c.result.replies.size() >= *bo.expected) c.result.complete = true;
+    if ((bo.expected && c.result.replies.size() >= *bo.expected) || (c.waiting && c.waiting->empty()))
+      c.result.complete = true;
     const auto deadline = now() + bo.window.value_or(options.broadcast_window);
     while (!c.result.complete && !stopping && !closed) {
       if (!co_await c.wake.wait_until(deadline)) break;

@@ -41,6 +41,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <vector>
@@ -113,6 +114,9 @@ struct RequestOptions {
 struct BroadcastOptions {
   // Stop collecting as soon as this many distinct positioners replied.
   std::optional<std::size_t> expected;
+  // Or as soon as every one of these replied (replies from others are collected too, but do not
+  // count: a robot nobody knows cannot stand in for a known one that stays silent).
+  std::optional<std::set<std::uint16_t>> expected_ids;
   // Collect this long at most (default ClientOptions::broadcast_window).
   std::optional<core::Duration> window;
   // Called instead of sending the broadcast frame, once the collection is ready: for replies that

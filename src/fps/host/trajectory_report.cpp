@@ -14,6 +14,7 @@ const char* to_string(RobotState s) noexcept {
     case RobotState::upload_failed: return "upload-failed";
     case RobotState::loaded: return "loaded";
     case RobotState::withdrawn: return "withdrawn";
+    case RobotState::still_loaded: return "still-loaded";
     case RobotState::not_started: return "not-started";
     case RobotState::started: return "started";
     case RobotState::stopped: return "stopped";
@@ -45,7 +46,7 @@ const RobotRun* TrajectoryReport::find(std::uint16_t id) const noexcept {
 std::string TrajectoryReport::summary() const {
   std::string out = outcome + "\n";
   constexpr std::array kStates{RobotState::pending,     RobotState::not_ready, RobotState::upload_failed,
-                               RobotState::loaded,      RobotState::withdrawn, RobotState::not_started,
+                               RobotState::loaded,      RobotState::withdrawn, RobotState::still_loaded, RobotState::not_started,
                                RobotState::started,     RobotState::stopped,     RobotState::collided,  RobotState::timeout,
                                RobotState::position_mismatch, RobotState::completed};
   std::string counts;

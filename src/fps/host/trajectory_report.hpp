@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,8 @@ enum class RobotState : std::uint8_t {
   upload_failed,      // refused or did not answer part of its upload (see `upload`)
   loaded,             // trajectory accepted; not started (load-only runs)
   withdrawn,          // loaded fine, then aborted because another robot failed: nothing started
+  still_loaded,       // loaded fine, the run was called off, but the abort did not reach it: it
+                      // still holds its whole trajectory (a sync pulse would start it)
   not_started,        // did not acknowledge the start: every robot was stopped
   started,            // acknowledged the start; the run did not wait for the end
   stopped,            // started, then stopped because of another robot (start failure or collision)
@@ -57,6 +60,17 @@ struct TrajectoryOptions {
   // Starts with the sync line instead of a START_TRAJECTORY broadcast: called once every bus
   // listens for the acknowledgements (uid 0). Must drive the line high long enough (about 0.5 s).
   std::function<asio::awaitable<Result<void>>()> sync_line;
+  // Called as each phase ends ("checked": robots checked, "uploaded": every upload done,
+  // "started": start acknowledged, "finished": every robot done), e.g. for timings and progress.
+  std::function<void(std::string_view phase)> on_phase;
+};
+
+// Wall time of each phase of a run (zero for phases not reached).
+struct TrajectoryTimings {
+  core::Duration check{0};   // abort/stop broadcasts, settle, status and position of each robot
+  core::Duration upload{0};  // every trajectory uploaded, every reply checked
+  core::Duration start{0};   // start broadcast or sync line, acknowledgements collected
+  core::Duration move{0};    // from the start until every robot was seen done
 };
 
 struct TrajectoryReport {
@@ -64,6 +78,7 @@ struct TrajectoryReport {
   bool started = false;          // the start went out and every robot acknowledged it
   bool completed = false;        // every robot finished at its target
   std::string outcome;           // one line: what happened overall
+  TrajectoryTimings timings;
 
   [[nodiscard]] bool ok(bool load_only = false) const noexcept { return load_only ? !robots.empty() && all(RobotState::loaded) : completed; }
   [[nodiscard]] bool all(RobotState s) const noexcept;

@@ -356,6 +356,21 @@ std::uint64_t Simulator::receive_overflows() const noexcept {
   return n;
 }
 
+namespace {
+// The robots behind `ids`, or an error naming the first unknown one.
+template <class Map>
+auto lookup(Map& by_id, std::span<const std::uint16_t> ids) -> Result<std::vector<typename Map::mapped_type>> {
+  std::vector<typename Map::mapped_type> out;
+  out.reserve(ids.size());
+  for (auto id : ids) {
+    const auto it = by_id.find(id);
+    if (it == by_id.end()) return make_error(CoreErrc::invalid_argument, fmt::format("simulator: no positioner {}", id));
+    out.push_back(it->second);
+  }
+  return out;
+}
+}  // namespace
+
 void Simulator::power_off(bool save_position) {
   const SimTime t = now();
   for (auto& r : state_->robots) {
@@ -363,6 +378,31 @@ void Simulator::power_off(bool save_position) {
     while (r->bus->try_receive()) {
     }  // what was waiting in the receive buffer is gone with the power
   }
+}
+
+Result<void> Simulator::power_off(std::span<const std::uint16_t> ids, bool save_position) {
+  AXON_TRY(robots, lookup(state_->by_id, ids));
+  const SimTime t = now();
+  for (auto* r : robots) {
+    r->model.power_off(t, save_position);
+    while (r->bus->try_receive()) {
+    }
+  }
+  return ok();
+}
+
+Result<void> Simulator::power_on(std::span<const std::uint16_t> ids, bool sync_line_low) {
+  AXON_TRY(robots, lookup(state_->by_id, ids));
+  const SimTime t = now();
+  for (auto* r : robots) r->model.power_on(t, sync_line_low);
+  return ok();
+}
+
+Result<void> Simulator::sync_pulse(std::span<const std::uint16_t> ids) {
+  AXON_TRY(robots, lookup(state_->by_id, ids));
+  const SimTime t = now();
+  for (auto* r : robots) state_->emit(*r, r->model.sync_pulse(t), true);
+  return ok();
 }
 
 void Simulator::power_on(bool sync_line_low) {

@@ -32,6 +32,7 @@
 
 #include <chrono>
 #include <memory>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -108,6 +109,11 @@ class Simulator {
   void power_on(bool sync_line_low = false);
   void power_cycle(bool sync_line_low = false);
   void sync_pulse();
+  // The same for the listed robots only (a sextant's power relay, robots on one sync line).
+  // CoreErrc::invalid_argument names an unknown id; nothing is switched then.
+  Result<void> power_off(std::span<const std::uint16_t> ids, bool save_position = true);
+  Result<void> power_on(std::span<const std::uint16_t> ids, bool sync_line_low = false);
+  Result<void> sync_pulse(std::span<const std::uint16_t> ids);
 
   // Faults.
   Result<void> force_collision(std::uint16_t id, Arm arm);

@@ -1,0 +1,132 @@
+// `axon fps plane ...`: the whole focal plane of a layout at once (every gateway, every bus, the
+// PLC): layout check, status of every robot, a coordinated move of every robot started by
+// broadcast or by the sync line.
+#include "commands.hpp"
+#include "fps/host/focal_plane_array.hpp"
+#include "layout_name.hpp"
+#include "net/endpoint.hpp"
+#include "run.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <map>
+
+namespace axon::app {
+namespace {
+
+namespace host = fps::host;
+namespace protocol = fps::protocol;
+
+struct PlaneArgs {
+  std::string layout;
+  std::string plc;
+  double window_s = 0.5;
+  double alpha = 0;
+  double beta = 180;
+  double duration_s = 10;
+  int points = 20;
+  bool sync = false;
+};
+
+host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
+  host::FocalPlaneArrayOptions o;
+  o.check_window = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(a.window_s));
+  if (!a.plc.empty()) o.plc = need(net::parse_endpoint(a.plc, 502));
+  return o;
+}
+
+int run_plane(const PlaneArgs& a, const std::string& action) {
+  const auto plane = need(resolve_layout(a.layout));
+  return run_command([&](asio::io_context& io, auto) -> asio::awaitable<int> {
+    const auto ex = io.get_executor();
+    auto connected = co_await host::FocalPlaneArray::connect(ex, plane, array_options(a));
+    auto fpa = need(std::move(connected));
+    int rc = 0;
+    if (action == "check") {
+      const auto check = co_await fpa->check_layout();
+      std::fputs(check.to_text().c_str(), stdout);
+      rc = check.ok() ? 0 : 1;
+    } else if (action == "status") {
+      auto d = co_await fpa->discover();
+      const auto found = need(std::move(d));
+      std::map<std::string, int> states;
+      for (const auto& row : found.table.rows) ++states[row.error.empty() ? row.state() : "no answer"];
+      std::printf("%zu robots known on %zu buses\n", found.table.rows.size(), fpa->bus_count());
+      for (const auto& [s, n] : states) std::printf("  %s: %d\n", s.c_str(), n);
+      for (const auto& p : found.problems) std::printf("problem: %s\n", p.c_str());
+      for (const auto& row : found.table.rows)
+        if (!row.error.empty()) std::printf("  positioner %u: %s\n", unsigned{row.id}, row.error.c_str());
+    } else if (action == "move") {
+      // Every known robot from where it is straight to (alpha, beta), all with the same timing.
+      const auto table = co_await fpa->array().status_table(true);
+      std::map<std::uint16_t, protocol::Trajectory> t;
+      for (const auto& row : table.rows) {
+        if (!row.position) {
+          std::printf("positioner %u: no position (%s); left out\n", unsigned{row.id}, row.error.c_str());
+          continue;
+        }
+        std::vector<protocol::ArmPoint> al, be;
+        for (int i = 1; i <= a.points; ++i) {
+          const double f = static_cast<double>(i) / a.points;
+          al.push_back({row.position->alpha + (a.alpha - row.position->alpha) * f, a.duration_s * f});
+          be.push_back({row.position->beta + (a.beta - row.position->beta) * f, a.duration_s * f});
+        }
+        t.emplace(row.id, need(protocol::Trajectory::from_physical(al, be)));
+      }
+      auto r = co_await fpa->run_trajectories(std::move(t), {}, a.sync);
+      const auto rep = need(std::move(r));
+      std::map<std::size_t, std::pair<int, int>> per_bus;  // started, robots
+      for (const auto& rr : rep.robots) {
+        auto& c = per_bus[rr.bus];
+        ++c.second;
+        const bool went = rr.state == host::RobotState::started || rr.state == host::RobotState::completed ||
+                          rr.state == host::RobotState::position_mismatch || rr.state == host::RobotState::timeout ||
+                          rr.state == host::RobotState::stopped || rr.state == host::RobotState::collided;
+        c.first += went ? 1 : 0;
+      }
+      for (const auto& [b, c] : per_bus)
+        std::printf("bus %s: %d of %d robots started\n", fpa->bus_ref(b).to_string().c_str(), c.first, c.second);
+      std::printf("start by %s; upload %.3f s, start %.3f s, move %.3f s\n", a.sync ? "the sync line" : "broadcast",
+                  std::chrono::duration<double>(rep.timings.upload).count(),
+                  std::chrono::duration<double>(rep.timings.start).count(),
+                  std::chrono::duration<double>(rep.timings.move).count());
+      const auto& lock = fpa->array().lock_state();
+      if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
+      std::fputs(rep.summary().c_str(), stdout);
+      rc = rep.completed ? 0 : 1;
+    }
+    std::fflush(stdout);
+    co_await fpa->close();
+    co_return rc;
+  });
+}
+
+}  // namespace
+
+void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
+  CLI::App* fps_cmd = app.get_subcommand("fps");
+  static PlaneArgs a;
+  auto* p = fps_cmd->add_subcommand("plane", "the whole focal plane of a layout: every gateway and bus, and the PLC");
+  p->require_subcommand(1);
+  p->add_option("--layout", a.layout, "layout: default, benchtop or FILE (gateway addresses from it)")->required();
+  p->add_option("--plc", a.plc, "the PLC at HOST[:PORT] (needed for --sync)");
+  p->add_subcommand("check", "GET_ID on every bus at once, compared with the layout")->callback([] {
+    exit_code() = run_plane(a, "check");
+  });
+  auto* ck = p->get_subcommand("check");
+  ck->add_option("--window", a.window_s, "seconds to collect GET_ID answers (default 0.5)");
+  p->add_subcommand("status", "discovery: firmware and status of every robot")->callback([] {
+    exit_code() = run_plane(a, "status");
+  });
+  auto* mv = p->add_subcommand("move", "every robot straight to one (alpha, beta) by a trajectory, all at once");
+  mv->add_option("--alpha", a.alpha, "degrees (default 0)");
+  mv->add_option("--beta", a.beta, "degrees (default 180: folded)");
+  mv->add_option("--duration", a.duration_s, "seconds of the trajectory (default 10)");
+  mv->add_option("--points", a.points, "points per arm (default 20)")->check(CLI::Range(1, 1000));
+  mv->add_flag("--sync", a.sync, "start with the PLC's sync line instead of the START_TRAJECTORY broadcast");
+  mv->callback([] { exit_code() = run_plane(a, "move"); });
+}
+
+}  // namespace axon::app

@@ -1,0 +1,162 @@
+#include "fps/host/focal_plane_array.hpp"
+
+#include "can/bus_spec.hpp"
+
+#include "fps/host/concurrent.hpp"
+#include "fps/layout/layout_sweep.hpp"
+
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/detached.hpp>
+#include <boost/asio/this_coro.hpp>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <set>
+
+namespace axon::fps::host {
+
+FocalPlaneArray::FocalPlaneArray(const FocalPlane& plane, FocalPlaneArrayOptions options)
+    : plane_(plane), options_(std::move(options)) {}
+
+FocalPlaneArray::~FocalPlaneArray() { *alive_ = false; }
+
+asio::awaitable<Result<std::unique_ptr<FocalPlaneArray>>> FocalPlaneArray::connect(asio::any_io_executor executor,
+                                                                                   const FocalPlane& plane,
+                                                                                   FocalPlaneArrayOptions options) {
+  std::unique_ptr<FocalPlaneArray> self(new FocalPlaneArray(plane, std::move(options)));
+  const auto by_bus = plane.by_bus();
+  if (by_bus.empty()) co_return Error(HostErrc::invalid_argument, fmt::format("layout '{}' has no robots", plane.name()));
+
+  // One link per gateway that carries robots, with the channels they use.
+  std::map<std::uint16_t, std::vector<int>> channels;
+  for (const auto& [ref, ids] : by_bus) channels[ref.gateway].push_back(ref.channel);
+  for (const auto& [gw, chans] : channels) {
+    GatewayLink link;
+    link.id = gw;
+    if (auto it = self->options_.addresses.find(gw); it != self->options_.addresses.end()) {
+      link.endpoint = it->second;
+    } else {
+      const auto* site = plane.gateway(gw);
+      auto ep = net::parse_endpoint(site != nullptr ? site->address : "", can::kCanNetPort);
+      if (!ep) co_return Error(HostErrc::invalid_argument, fmt::format("gateway {}: {}", gw, ep.error().message()));
+      link.endpoint = ep.value();
+    }
+    self->gateways_.push_back(std::move(link));
+  }
+
+  // Connect to all at once.
+  std::vector<std::optional<Error>> failures(self->gateways_.size());
+  FocalPlaneArray* s = self.get();
+  co_await for_each_concurrently(self->gateways_.size(), [&, s](std::size_t i) -> asio::awaitable<void> {
+    auto& link = s->gateways_[i];
+    const net::Endpoint ep = link.endpoint;
+    const std::vector<int> chans = channels[link.id];
+    auto r = co_await can::CanNetGateway::connect(executor, ep, chans, s->options_.gateway);
+    if (!r) {
+      failures[i] = r.error();
+      co_return;
+    }
+    link.gateway = std::move(r).value();
+  });
+  for (std::size_t i = 0; i < failures.size(); ++i) {
+    if (!failures[i]) continue;
+    for (auto& l : self->gateways_)
+      if (l.gateway) l.gateway->close();
+    co_return Error(failures[i]->code, fmt::format("gateway {} at {}: {}", self->gateways_[i].id,
+                                                   self->gateways_[i].endpoint.to_string(), failures[i]->detail));
+  }
+
+  // Buses in layout order (by gateway, then channel).
+  std::vector<can::Bus*> raw;
+  for (const auto& [ref, ids] : by_bus) {
+    for (auto& link : self->gateways_) {
+      if (link.id != ref.gateway) continue;
+      auto bus = link.gateway->bus(ref.channel);
+      if (!bus) co_return Error(bus.error().code, fmt::format("gateway {} channel {}: {}", ref.gateway, int{ref.channel},
+                                                              bus.error().detail));
+      link.buses.push_back(self->refs_.size());
+      self->refs_.push_back(ref);
+      raw.push_back(bus.value().get());
+      self->buses_.push_back(std::move(bus).value());
+    }
+  }
+  self->array_ = std::make_unique<Array>(raw, self->options_.array);
+  for (std::size_t i = 0; i < self->refs_.size(); ++i) {
+    for (auto id : by_bus.at(self->refs_[i])) {
+      const auto* site = plane.find(id);
+      if (site != nullptr && site->offline) continue;
+      auto added = self->array_->add(id, i);
+      if (!added) co_return added.error();
+    }
+  }
+  if (self->options_.plc) {
+    self->plc_ = std::make_unique<plc::AsyncPlc>(*self->options_.plc, self->options_.plc_map, self->options_.plc_client);
+  }
+  asio::co_spawn(executor, watch(self.get(), self->alive_), asio::detached);
+  co_return self;
+}
+
+std::optional<std::size_t> FocalPlaneArray::bus_index(const BusRef& ref) const {
+  for (std::size_t i = 0; i < refs_.size(); ++i)
+    if (refs_[i] == ref) return i;
+  return std::nullopt;
+}
+
+asio::awaitable<void> FocalPlaneArray::watch(FocalPlaneArray* self, std::shared_ptr<bool> alive) {
+  std::set<std::uint16_t> seen;
+  const auto ex = co_await asio::this_coro::executor;
+  while (*alive) {
+    co_await core::sleep_for(self->options_.connection_poll);
+    if (!*alive || self->closed_) co_return;
+    for (const auto& link : self->gateways_) {
+      if (link.gateway->is_connected() || seen.contains(link.id)) continue;
+      seen.insert(link.id);
+      self->lost_.push_back(link.id);
+      const auto reason = fmt::format("gateway {} at {} disconnected", link.id, link.endpoint.to_string());
+      spdlog::error("fps focal plane: {}: stopping every robot", reason);
+      asio::co_spawn(ex, self->array_->emergency_stop(reason), asio::detached);
+    }
+  }
+}
+
+asio::awaitable<LayoutCheck> FocalPlaneArray::check_layout() {
+  LayoutBuses buses;
+  for (std::size_t i = 0; i < refs_.size(); ++i) buses.emplace_back(refs_[i], &array_->client(i));
+  auto check = co_await check_layout_on_buses(plane_, buses, options_.check_window);
+  co_return check;
+}
+
+asio::awaitable<Result<DiscoveryReport>> FocalPlaneArray::discover() {
+  std::map<std::size_t, std::size_t> expected;
+  for (std::size_t i = 0; i < refs_.size(); ++i) expected[i] = array_->ids_on(i).size();
+  auto r = co_await array_->discover(expected);
+  co_return r;
+}
+
+asio::awaitable<Result<TrajectoryReport>> FocalPlaneArray::run_trajectories(
+    std::map<std::uint16_t, protocol::Trajectory> trajectories, TrajectoryOptions options, bool by_sync_line) {
+  if (by_sync_line) {
+    if (!plc_) co_return Error(HostErrc::invalid_argument, "start by the sync line needs the PLC (no PLC endpoint given)");
+    plc::AsyncPlc* p = plc_.get();
+    const core::Duration hold = options_.sync_hold;
+    options.sync_line = [p, hold]() -> asio::awaitable<Result<void>> {
+      auto r = co_await p->pulse_sync_line(hold);
+      co_return r;
+    };
+  }
+  auto r = co_await array_->run_trajectories(std::move(trajectories), std::move(options));
+  co_return r;
+}
+
+asio::awaitable<void> FocalPlaneArray::close() {
+  if (closed_) co_return;
+  closed_ = true;
+  *alive_ = false;
+  co_await array_->close();
+  for (auto& b : buses_) b->close();
+  for (auto& l : gateways_)
+    if (l.gateway) l.gateway->close();
+  plc_.reset();
+}
+
+}  // namespace axon::fps::host

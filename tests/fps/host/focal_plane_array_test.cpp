@@ -1,0 +1,234 @@
+// The whole focal plane at once: a small layout (2 sextants, 2 gateways, 4 buses, 12 robots)
+// simulated by FocalPlaneSimulator behind CAN@net gateway emulators and the PLC emulator, driven by
+// a FocalPlaneArray over real TCP on loopback (same process, separate sockets).
+#include "sim_rig.hpp"
+
+#include "fps/host/focal_plane_array.hpp"
+#include "fps/sim/focal_plane_sim.hpp"
+
+#include <boost/asio/detached.hpp>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+using namespace axon;
+using namespace axon::fps;
+using namespace axon::fps::host;
+using namespace axon::fps::host::testing;
+
+namespace {
+
+// Robots 1-6 in sextant 1 (gateway 1: bus 1 ids 1-3, bus 2 ids 4-6), 7-12 in sextant 2 (gateway 2),
+// two rows of the hexagonal grid apart.
+FocalPlane small_plane() {
+  FocalPlaneSpec spec;
+  spec.name = "two-sextants";
+  spec.gateways = {GatewaySite{1, "127.0.0.1:1", 1, 4}, GatewaySite{2, "127.0.0.1:1", 2, 4}};
+  for (std::uint16_t id = 1; id <= 12; ++id) {
+    RobotSite r;
+    r.id = id;
+    const int k = (id - 1) % 6;
+    r.x_mm = 22.4 * k;
+    r.y_mm = id <= 6 ? 0.0 : 38.8;
+    r.sextant = id <= 6 ? 1 : 2;
+    r.bus = BusRef{static_cast<std::uint16_t>(id <= 6 ? 1 : 2), static_cast<std::uint8_t>(k < 3 ? 1 : 2)};
+    r.fibres = {Fibre::boss};
+    spec.robots.push_back(r);
+  }
+  return FocalPlane::build(spec).value();
+}
+
+std::vector<std::uint16_t> ids_of(const std::vector<Misplaced>& v) {
+  std::vector<std::uint16_t> out;
+  for (const auto& m : v) out.push_back(m.id);
+  return out;
+}
+
+protocol::Trajectory straight(ArmAngles from, ArmAngles to, int points, double duration_s) {
+  std::vector<protocol::ArmPoint> a, b;
+  for (int i = 1; i <= points; ++i) {
+    const double f = static_cast<double>(i) / points;
+    a.push_back({from.alpha + (to.alpha - from.alpha) * f, duration_s * f});
+    b.push_back({from.beta + (to.beta - from.beta) * f, duration_s * f});
+  }
+  return protocol::Trajectory::from_physical(a, b).value();
+}
+
+struct PlaneRig {
+  Runner runner;
+  FocalPlane plane = small_plane();
+  std::unique_ptr<sim::FocalPlaneSimulator> sim;
+  std::unique_ptr<FocalPlaneArray> fpa;
+
+  explicit PlaneRig(sim::Scenario scenario = {}) {
+    sim::FocalPlaneSimOptions so;
+    so.simulator.time_scale = 20;
+    so.random_start = false;
+    so.scenario = std::move(scenario);
+    sim = sim::FocalPlaneSimulator::start(runner.io.get_executor(), plane, so).value();
+    runner.on_stop([this]() -> asio::awaitable<void> {
+      if (fpa) co_await fpa->close();
+      sim->stop();
+    });
+  }
+
+  // Connects the array (inside a test body).
+  asio::awaitable<void> connect() {
+    FocalPlaneArrayOptions o;
+    o.array = fast_array();
+    o.check_window = 300ms;
+    for (const auto& g : sim->gateways()) o.addresses[g.id] = g.endpoint;
+    o.plc = sim->plc()->endpoint();
+    o.sync_hold = 20ms;
+    auto r = co_await FocalPlaneArray::connect(runner.io.get_executor(), plane, o);
+    EXPECT_TRUE(r.has_value()) << r.error().message();
+    if (r) fpa = std::move(r).value();
+  }
+
+  std::map<std::uint16_t, protocol::Trajectory> everyone_to(ArmAngles to, int points = 10, double s = 4.0) {
+    std::map<std::uint16_t, protocol::Trajectory> t;
+    for (auto id : fpa->array().ids()) {
+      if (sim->simulator().find(id) != nullptr) t.emplace(id, straight({0, 180}, to, points, s));
+    }
+    return t;
+  }
+};
+
+}  // namespace
+
+TEST(FocalPlaneArray, LayoutCheckFindsMissingAndExtraRobots) {
+  sim::Scenario sc;
+  sc.absent = {5};
+  sc.extra[900] = BusRef{2, 1};
+  PlaneRig rig(sc);
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    EXPECT_EQ(rig.fpa->bus_count(), 4u);
+    const auto check = co_await rig.fpa->check_layout();
+    EXPECT_FALSE(check.ok());
+    EXPECT_EQ(check.missing, (std::vector<std::uint16_t>{5}));
+    EXPECT_EQ(ids_of(check.unexpected), (std::vector<std::uint16_t>{900}));
+    EXPECT_EQ(check.matched.size(), 11u);
+  });
+}
+
+TEST(FocalPlaneArray, SextantPowerCycleThroughThePlcEntersTheBootloader) {
+  PlaneRig rig;
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    auto* plc = rig.fpa->plc();
+    auto off = co_await plc->set_positioner_power(2, false);
+    EXPECT_TRUE(off.has_value());
+    EXPECT_TRUE(co_await eventually([&] { return rig.sim->counters().sextant_power_changes == 1; }));
+    auto table = co_await rig.fpa->array().status_table(false);
+    for (const auto& row : table.rows) {
+      if (row.id <= 6) {
+        EXPECT_EQ(row.state(), "ready") << row.id;
+      } else {
+        EXPECT_FALSE(row.error.empty()) << row.id << " answered with its power off";
+      }
+    }
+    auto on = co_await plc->set_positioner_power(2, true);
+    EXPECT_TRUE(on.has_value());
+    EXPECT_TRUE(co_await eventually([&] { return rig.sim->counters().sextant_power_changes == 2; }));
+    table = co_await rig.fpa->array().status_table(false);
+    for (const auto& row : table.rows) {
+      // Powered with the sync line low: the bootloader; sextant 1 never lost power.
+      EXPECT_EQ(row.state(), row.id <= 6 ? "ready" : "bootloader") << row.id << " " << row.error;
+    }
+  });
+}
+
+TEST(FocalPlaneArray, SyncLineStartReachesEveryBus) {
+  PlaneRig rig;
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    auto r = co_await rig.fpa->run_trajectories(rig.everyone_to({30, 170}), {}, true);
+    EXPECT_TRUE(r.has_value());
+    if (!r) co_return;
+    const auto& rep = r.value();
+    EXPECT_TRUE(rep.completed) << rep.summary();
+    EXPECT_EQ(rep.robots.size(), 12u);
+    std::set<std::size_t> buses;
+    for (const auto& rr : rep.robots) {
+      EXPECT_EQ(rr.state, RobotState::completed) << rr.id << " " << rr.detail;
+      buses.insert(rr.bus);
+    }
+    EXPECT_EQ(buses.size(), 4u);
+    EXPECT_EQ(rig.sim->counters().sync_edges, 1u);
+    for (std::uint16_t id = 1; id <= 12; ++id) {
+      EXPECT_NEAR(rig.sim->simulator().find(id)->physical_deg(sim::Arm::alpha), 30.0, 0.1) << id;
+    }
+  });
+}
+
+TEST(FocalPlaneArray, CollisionOnOneBusStopsEveryBus) {
+  sim::Scenario sc;
+  sc.collide_on_move = {8};  // gateway 2, bus 1
+  PlaneRig rig(sc);
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    auto r = co_await rig.fpa->run_trajectories(rig.everyone_to({90, 120}, 10, 40.0), {}, true);
+    EXPECT_TRUE(r.has_value());
+    if (!r) co_return;
+    const auto& rep = r.value();
+    EXPECT_FALSE(rep.completed);
+    EXPECT_TRUE(rig.fpa->array().locked());
+    EXPECT_EQ(rep.find(8)->state, RobotState::collided) << rep.summary();
+    for (const auto& rr : rep.robots) {
+      if (rr.id == 8) continue;
+      EXPECT_EQ(rr.state, RobotState::stopped) << rr.id << " " << rr.detail;
+    }
+    // Every robot on every bus stands still well short of its target.
+    EXPECT_TRUE(co_await eventually([&] {
+      for (auto* m : rig.sim->simulator().robots())
+        if (m->moving()) return false;
+      return true;
+    }));
+    for (auto* m : rig.sim->simulator().robots()) EXPECT_LT(m->physical_deg(sim::Arm::alpha), 80.0);
+  });
+}
+
+TEST(FocalPlaneArray, GatewayLostDuringUploadStartsNothingAndSaysWhatEachRobotHolds) {
+  PlaneRig rig;
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    // Cut gateway 2's power once the upload is under way (points have reached its robots).
+    bool cut = false;
+    asio::co_spawn(
+        rig.runner.io,
+        [&]() -> asio::awaitable<void> {
+          co_await eventually([&] { return rig.sim->simulator().find(7)->counters().requests >= 20; }, 20000);
+          cut = true;
+          (void)rig.sim->set_gateway_power(2, false);
+        },
+        asio::detached);
+    auto r = co_await rig.fpa->run_trajectories(rig.everyone_to({30, 170}, 200, 10.0), {}, true);
+    EXPECT_TRUE(r.has_value());
+    if (!r) co_return;
+    const auto& rep = r.value();
+    EXPECT_TRUE(cut);
+    EXPECT_FALSE(rep.started) << rep.summary();
+    EXPECT_EQ(rig.sim->counters().sync_edges, 0u);
+    EXPECT_EQ(rig.fpa->lost_gateways(), (std::vector<std::uint16_t>{2}));
+    for (const auto& rr : rep.robots) {
+      if (rr.id <= 6) {
+        // Reachable: the emergency stop's abort (or the final one) withdrew whatever they held.
+        EXPECT_TRUE(rr.state == RobotState::withdrawn || rr.state == RobotState::upload_failed)
+            << rr.id << " " << to_string(rr.state) << " " << rr.detail;
+        EXPECT_EQ(rr.detail.find("still hold"), std::string::npos) << rr.id << " " << rr.detail;
+      } else {
+        // Behind the lost gateway: the report says what each may still hold.
+        EXPECT_TRUE(rr.state == RobotState::upload_failed || rr.state == RobotState::still_loaded)
+            << rr.id << " " << to_string(rr.state) << " " << rr.detail;
+        EXPECT_NE(rr.detail.find("still hold"), std::string::npos) << rr.id << " " << rr.detail;
+      }
+    }
+    for (auto* m : rig.sim->simulator().robots()) EXPECT_FALSE(m->moving());
+  });
+}
