@@ -3,6 +3,7 @@
 // positions from the array, plans, uploads, starts, follows and verifies.
 #include "commands.hpp"
 #include "fps/layout/layout_file.hpp"
+#include "layout_name.hpp"
 #include "fps/plan/layout_model.hpp"
 #include "fps/plan/plan_file.hpp"
 #include "fps/plan/planner.hpp"
@@ -62,8 +63,8 @@ struct Loaded {
 };
 
 Loaded load(const PlanArgs& a) {
-  if (a.layout.empty()) throw Exception(Error(CoreErrc::invalid_argument, "give the focal-plane layout: --layout FILE"));
-  auto plane = need(fps::load_layout_file(a.layout));
+  if (a.layout.empty()) throw Exception(Error(CoreErrc::invalid_argument, "give the focal-plane layout: --layout default|benchtop|FILE"));
+  auto plane = need(resolve_layout(a.layout));
   plan::LayoutModelOptions lo;
   lo.buffer_mm = a.buffer;
   auto model = need(plan::model_from_layout(plane, lo));
@@ -230,7 +231,7 @@ void add_fps_plan_commands(CLI::App& app, GlobalOptions&) {
   CLI::App* fps_cmd = app.get_subcommand("fps");
   static PlanArgs a;
   auto common = [](CLI::App* c) {
-    c->add_option("--layout", a.layout, "focal-plane layout YAML (e.g. data/layouts/default.yaml)")->required();
+    c->add_option("--layout", a.layout, "focal-plane layout: default, benchtop or a YAML file")->required();
     c->add_option("--seed", a.seed, "seed for random poses and the planner's nudges (default 1)");
     c->add_option("--buffer", a.buffer, "collision buffer of every robot, mm (default 2.0)");
   };
