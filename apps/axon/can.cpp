@@ -222,12 +222,7 @@ int run_bridge(const BridgeOptions& o) {
     for (const auto& c : channels) names += (names.empty() ? "" : ", ") + c;
     spdlog::info("bridge: serving {} (Ctrl-C to stop)", names);
 
-    asio::steady_timer until(io, o.duration_s > 0 ? std::chrono::steady_clock::now() +
-                                                         std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.duration_s))
-                                                   : core::TimePoint::max());
-    set_on_signal([&] { until.cancel(); });
-    boost::system::error_code ec;
-    co_await until.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+    co_await wait_for_stop(io, o.duration_s, set_on_signal);
 
     for (auto& s : scd) s->stop();
     for (auto& g : gateways) g->stop();

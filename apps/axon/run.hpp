@@ -5,7 +5,12 @@
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/redirect_error.hpp>
 #include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/use_awaitable.hpp>
+
+#include <chrono>
 
 #include <csignal>
 #include <exception>
@@ -43,6 +48,20 @@ inline int run_command(const std::function<asio::awaitable<int>(asio::io_context
   io.run();
   if (failure) std::rethrow_exception(failure);
   return rc;
+}
+
+// For servers and simulators that run until told to stop: waits for `duration_s` seconds (0 or less:
+// for ever) or until the first SIGINT/SIGTERM, whichever comes first. `set_on_signal` is the second
+// argument run_command gives the body (taken by value: no temporary lives across the co_await).
+template <class SetOnSignal>
+asio::awaitable<void> wait_for_stop(asio::io_context& io, double duration_s, SetOnSignal set_on_signal) {
+  asio::steady_timer until(io, std::chrono::steady_clock::time_point::max());
+  if (duration_s > 0) until.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                          std::chrono::duration<double>(duration_s)));
+  set_on_signal([&until] { until.cancel(); });
+  boost::system::error_code ec;
+  co_await until.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+  set_on_signal([] {});  // `until` is about to go; as before, the next signal does nothing and a second one stops
 }
 
 // Unwraps a Result inside a command: its error becomes an axon::Exception for main to print.

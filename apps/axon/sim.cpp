@@ -126,12 +126,7 @@ int run_sim_layout(const SimFpsOptions& o) {
     spdlog::info("sim: layout '{}': {} positioners on {} buses behind {} gateways, time scale {} (Ctrl-C to stop)",
                  plane.name(), fp->simulator().size(), plane.buses().size(), fp->gateways().size(), o.time_scale);
 
-    asio::steady_timer until(io, o.duration_s > 0 ? std::chrono::steady_clock::now() +
-                                                         std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.duration_s))
-                                                   : core::TimePoint::max());
-    set_on_signal([&] { until.cancel(); });
-    boost::system::error_code ec;
-    co_await until.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+    co_await wait_for_stop(io, o.duration_s, set_on_signal);
     const auto& s = fp->simulator().stats();
     const auto& c = fp->counters();
     spdlog::info("sim: {} frames processed, {} sent ({} unsolicited), {} receive overflows, {} collisions "
@@ -190,12 +185,7 @@ int run_sim_fps(const SimFpsOptions& o) {
     spdlog::info("sim: {} positioners at time scale {} on {} (Ctrl-C to stop)", simulator->size(),
                  config.options.time_scale, where);
 
-    asio::steady_timer until(io, o.duration_s > 0 ? std::chrono::steady_clock::now() +
-                                                         std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.duration_s))
-                                                   : core::TimePoint::max());
-    set_on_signal([&] { until.cancel(); });
-    boost::system::error_code ec;
-    co_await until.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+    co_await wait_for_stop(io, o.duration_s, set_on_signal);
 
     if (scd) scd->stop();
     if (gateway) gateway->stop();
@@ -269,12 +259,7 @@ int run_sim_blmc(const SimBlmcOptions& o) {
     spdlog::info("sim: {} blmc board{} on {} (Ctrl-C to stop)", o.boards, o.boards == 1 ? "" : "s",
                  fmt::join(channels, ", "));
 
-    asio::steady_timer until(io, o.duration_s > 0 ? std::chrono::steady_clock::now() +
-                                                         std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.duration_s))
-                                                   : core::TimePoint::max());
-    set_on_signal([&] { until.cancel(); });
-    boost::system::error_code ec;
-    co_await until.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+    co_await wait_for_stop(io, o.duration_s, set_on_signal);
 
     scd->stop();
     for (std::size_t i = 0; i < runner.size(); ++i) {

@@ -49,12 +49,7 @@ int run_sim_plc(const SimPlcOptions& o) {
     std::printf("listening plc %s\n", emulator->endpoint().to_string().c_str());
     std::fflush(stdout);
     spdlog::info("sim: PLC emulator (Ctrl-C to stop)");
-    asio::steady_timer until(io, o.duration_s > 0 ? std::chrono::steady_clock::now() +
-                                                         std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.duration_s))
-                                                   : core::TimePoint::max());
-    set_on_signal([&] { until.cancel(); });
-    boost::system::error_code ec;
-    co_await until.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+    co_await wait_for_stop(io, o.duration_s, set_on_signal);
     const auto c = emulator->counters();
     emulator->stop();
     spdlog::info("sim: PLC served {} connections, {} requests, {} relay changes", c.connections, c.requests,
