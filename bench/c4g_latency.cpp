@@ -182,7 +182,7 @@ int main(int argc, char** argv) {
   const auto& ep = echo.processing;
   const auto& rs = to_server.report.rtt;
   const auto& re = to_echo.report.rtt;
-  auto us = [](const sim::RttHistogram& r, double p) { return static_cast<double>(r.percentile(p)) * 1e-3; };
+  auto us = [](const core::LatencyHistogram& r, double p) { return static_cast<double>(r.percentile(p * 100.0)) * 1e-3; };
   auto ull = [](std::uint64_t v) { return static_cast<unsigned long long>(v); };
   auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
 
@@ -199,8 +199,8 @@ int main(int argc, char** argv) {
               us(re, 0.99), us(re, 0.999), static_cast<double>(re.max()) * 1e-3, ull(re.count()));
   std::printf("over 500 us: server processing %llu, echo processing %zu; round trips server %llu echo %llu; round trips "
               "over 1 ms server %llu echo %llu; schedule overruns %llu / %llu; pid max following error %.5f turns\n",
-              ull(server->cycle().timing().missed_deadlines()), ep.over(kDeadlineNs), ull(rs.count_at_or_above(kDeadlineNs)),
-              ull(re.count_at_or_above(kDeadlineNs)), ull(rs.count_at_or_above(1'000'000)), ull(re.count_at_or_above(1'000'000)), ull(to_server.report.overruns),
+              ull(server->cycle().timing().missed_deadlines()), ep.over(kDeadlineNs), ull(rs.count_above(kDeadlineNs)),
+              ull(re.count_above(kDeadlineNs)), ull(rs.count_above(1'000'000)), ull(re.count_above(1'000'000)), ull(to_server.report.overruns),
               ull(to_echo.report.overruns), app.max_following_error());
   std::printf(
       "BENCH c4g_latency seconds=%.0f axes=%zu rounds_server=%llu rounds_echo=%llu server_proc_p50_us=%.1f "
@@ -211,8 +211,8 @@ int main(int argc, char** argv) {
       "rtt_ratio_p99=%.2f rtt_ratio_p999=%.2f ratio=%.2f\n",
       seconds, kAxes, ull(rs.count()), ull(re.count()), sp50, sp99, sp999, spmax, ep.us(50), ep.us(99), ep.us(99.9),
       ep.max_us(), us(rs, 0.5), us(re, 0.5), us(rs, 0.99), us(re, 0.99), us(rs, 0.999), us(re, 0.999),
-      ull(rs.count_at_or_above(kDeadlineNs)), ull(re.count_at_or_above(kDeadlineNs)), ull(rs.count_at_or_above(1'000'000)),
-      ull(re.count_at_or_above(1'000'000)),
+      ull(rs.count_above(kDeadlineNs)), ull(re.count_above(kDeadlineNs)), ull(rs.count_above(1'000'000)),
+      ull(re.count_above(1'000'000)),
       ratio(sp50, ep.us(50)), ratio(sp99, ep.us(99)), ratio(us(rs, 0.99), us(re, 0.99)),
       ratio(us(rs, 0.999), us(re, 0.999)), ratio(us(rs, 0.5), us(re, 0.5)));
   return 0;

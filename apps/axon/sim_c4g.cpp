@@ -114,8 +114,8 @@ int run_sim_c4g(const SimC4gOptions& o) {
         {"refused_requests", s.refused_requests},
         {"saturated_cycles", s.saturated_cycles},
         {"overruns", report.overruns},
-        {"rtt_us", {{"count", h.count()}, {"min", us(h.min())}, {"mean", h.mean() / 1000.0}, {"p50", us(h.percentile(0.5))},
-                    {"p99", us(h.percentile(0.99))}, {"p999", us(h.percentile(0.999))}, {"max", us(h.max())}}},
+        {"rtt_us", {{"count", h.count()}, {"min", us(h.min())}, {"mean", h.mean() / 1000.0}, {"p50", us(h.percentile(50))},
+                    {"p99", us(h.percentile(99))}, {"p999", us(h.percentile(99.9))}, {"max", us(h.max())}}},
         {"events", events},
     };
     std::printf("%s\n", j.dump(2).c_str());
@@ -131,7 +131,7 @@ int run_sim_c4g(const SimC4gOptions& o) {
                 static_cast<unsigned long long>(s.wrong_size), static_cast<unsigned long long>(s.malformed),
                 static_cast<unsigned long long>(report.overruns));
     std::printf("rtt: %llu samples, p50 %.1f us, p99 %.1f us, max %.1f us\n", static_cast<unsigned long long>(h.count()),
-                us(h.percentile(0.5)), us(h.percentile(0.99)), us(h.max()));
+                us(h.percentile(50)), us(h.percentile(99)), us(h.max()));
   }
   std::fflush(stdout);
   return rc;

@@ -13,8 +13,7 @@ void LoopTiming::cycle_started(core::TimePoint deadline, core::TimePoint actual)
     period_sum_ += p;
     const core::Duration j = p > nominal_ ? p - nominal_ : nominal_ - p;
     jitter_max_ = std::max(jitter_max_, j);
-    const auto us = static_cast<std::size_t>(std::chrono::duration_cast<std::chrono::microseconds>(j).count());
-    ++hist_[std::min(us, kBuckets - 1)];
+    jitter_.add(std::chrono::duration_cast<std::chrono::nanoseconds>(j).count());
     ++periods_;
   }
   const core::Duration late = actual > deadline ? actual - deadline : core::Duration{0};
@@ -42,17 +41,8 @@ LoopStats LoopTiming::stats() const noexcept {
     s.period_max = period_max_;
     s.period_mean = period_sum_ / static_cast<std::int64_t>(periods_);
     s.jitter_max = jitter_max_;
-    auto percentile = [&](double q) {
-      const auto want = static_cast<std::uint64_t>(q * static_cast<double>(periods_ - 1)) + 1;
-      std::uint64_t seen = 0;
-      for (std::size_t i = 0; i < kBuckets; ++i) {
-        seen += hist_[i];
-        if (seen >= want) return core::Duration(std::chrono::microseconds(i));
-      }
-      return jitter_max_;
-    };
-    s.jitter_p50 = percentile(0.5);
-    s.jitter_p99 = percentile(0.99);
+    s.jitter_p50 = std::chrono::nanoseconds(jitter_.percentile(50));
+    s.jitter_p99 = std::chrono::nanoseconds(jitter_.percentile(99));
   }
   if (cycles_ > 0) {
     s.late_max = late_max_;

@@ -2,13 +2,13 @@
 // compute time and overruns. Pure and allocation-free: the loop feeds it time stamps from its
 // clock, tests feed it a manual clock.
 //
-// Jitter percentiles come from a fixed histogram of 1 us buckets up to 5 ms (larger values land in
-// the last bucket; the exact maximum is kept separately).
+// Jitter percentiles come from a core::LatencyHistogram of 1 us buckets up to 5 ms, allocated at
+// construction (larger values land in its overflow bucket and read as the exact maximum).
 #pragma once
 
 #include "core/clock.hpp"
+#include "core/latency_histogram.hpp"
 
-#include <array>
 #include <cstdint>
 
 namespace axon::blmc::host {
@@ -28,7 +28,7 @@ class LoopTiming {
  public:
   static constexpr std::size_t kBuckets = 5000;  // 1 us each
 
-  explicit LoopTiming(core::Duration nominal) noexcept : nominal_(nominal) {}
+  explicit LoopTiming(core::Duration nominal) : nominal_(nominal), jitter_(1000, kBuckets) {}
 
   // A cycle began at `actual`; it was due at `deadline`.
   void cycle_started(core::TimePoint deadline, core::TimePoint actual) noexcept;
@@ -49,7 +49,7 @@ class LoopTiming {
   core::Duration last_period_{0};
   core::Duration period_min_ = core::Duration::max(), period_max_{0};
   core::Duration period_sum_{0}, jitter_max_{0}, late_max_{0}, late_sum_{0}, compute_max_{0}, compute_sum_{0};
-  std::array<std::uint32_t, kBuckets> hist_{};
+  core::LatencyHistogram jitter_;  // ns
 };
 
 }  // namespace axon::blmc::host

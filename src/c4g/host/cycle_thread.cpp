@@ -115,7 +115,7 @@ void CycleThread::run() {
 std::string CycleThread::summary() const {
   std::string out = timing_.summary();
   auto it = std::back_inserter(out);
-  auto pct = [&](const char* name, const LatencyHistogram& h) {
+  auto pct = [&](const char* name, const core::LatencyHistogram& h) {
     fmt::format_to(it, "{:<34}= p50 {:.6f} p99 {:.6f} p99.9 {:.6f} max {:.6f} ms (n {})\n", name,
                    static_cast<double>(h.percentile(50)) * 1e-6, static_cast<double>(h.percentile(99)) * 1e-6,
                    static_cast<double>(h.percentile(99.9)) * 1e-6, static_cast<double>(h.max()) * 1e-6, h.count());

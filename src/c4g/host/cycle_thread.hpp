@@ -13,7 +13,7 @@
 // stop() interrupts the socket wait (an eventfd) and joins: it returns within one handler call.
 #pragma once
 
-#include "c4g/host/latency_histogram.hpp"
+#include "core/latency_histogram.hpp"
 #include "c4g/host/pcap_recorder.hpp"
 #include "c4g/host/timing_stats.hpp"
 #include "core/realtime.hpp"
@@ -79,8 +79,8 @@ class CycleThread {
   [[nodiscard]] net::SocketAddress local_address() const noexcept { return socket_.local_address(); }
   [[nodiscard]] const net::UdpSocket& socket() const noexcept { return socket_; }
   [[nodiscard]] const TimingStats& timing() const noexcept { return timing_; }
-  [[nodiscard]] const LatencyHistogram& wakeup_latency() const noexcept { return wakeup_; }
-  [[nodiscard]] const LatencyHistogram& reply_latency() const noexcept { return reply_latency_; }
+  [[nodiscard]] const core::LatencyHistogram& wakeup_latency() const noexcept { return wakeup_; }
+  [[nodiscard]] const core::LatencyHistogram& reply_latency() const noexcept { return reply_latency_; }
   [[nodiscard]] const CycleCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const core::RealtimeReport& realtime_report() const noexcept { return report_; }
 
@@ -97,8 +97,8 @@ class CycleThread {
   std::vector<std::byte> rx_;
   std::vector<std::byte> tx_;
   TimingStats timing_;
-  LatencyHistogram wakeup_;
-  LatencyHistogram reply_latency_;
+  core::LatencyHistogram wakeup_;
+  core::LatencyHistogram reply_latency_;
   CycleCounters counters_;
   core::RealtimeReport report_;
   std::atomic<bool> running_{false};

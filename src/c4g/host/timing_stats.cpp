@@ -79,7 +79,7 @@ std::string TimingStats::summary() const {
     fmt::format_to(it, "Jitter range                      = [{:+.9f}; {:+.9f}] s\n", s(min_jitter_ns()), s(max_jitter_ns()));
     fmt::format_to(it, "Percentage jitter range           = [{:+.9f}; {:+.9f}] %\n", min_percent_jitter(), max_percent_jitter());
   }
-  auto pct = [&](const char* name, const LatencyHistogram& h) {
+  auto pct = [&](const char* name, const core::LatencyHistogram& h) {
     fmt::format_to(it, "{:<34}= p50 {:.6f} p99 {:.6f} p99.9 {:.6f} max {:.6f} ms (n {})\n", name,
          static_cast<double>(h.percentile(50)) * 1e-6, static_cast<double>(h.percentile(99)) * 1e-6,
          static_cast<double>(h.percentile(99.9)) * 1e-6, static_cast<double>(h.max()) * 1e-6, h.count());

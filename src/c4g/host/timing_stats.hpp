@@ -16,7 +16,7 @@
 // read from any thread while it runs.
 #pragma once
 
-#include "c4g/host/latency_histogram.hpp"
+#include "core/latency_histogram.hpp"
 
 #include <atomic>
 #include <cstdint>
@@ -56,8 +56,8 @@ class TimingStats {
   [[nodiscard]] double max_percent_jitter() const noexcept;
   [[nodiscard]] std::uint64_t missed_deadlines() const noexcept { return load(missed_); }
 
-  [[nodiscard]] const LatencyHistogram& cycle_times() const noexcept { return cycle_hist_; }
-  [[nodiscard]] const LatencyHistogram& inter_step_times() const noexcept { return inter_hist_; }
+  [[nodiscard]] const core::LatencyHistogram& cycle_times() const noexcept { return cycle_hist_; }
+  [[nodiscard]] const core::LatencyHistogram& inter_step_times() const noexcept { return inter_hist_; }
 
   // Multi-line report in seconds, in the manual's layout, followed by percentiles and misses.
   [[nodiscard]] std::string summary() const;
@@ -83,8 +83,8 @@ class TimingStats {
   std::atomic<std::int64_t> min_inter_step_{0};
   std::atomic<std::int64_t> max_inter_step_{0};
   std::atomic<std::uint64_t> missed_{0};
-  LatencyHistogram cycle_hist_;
-  LatencyHistogram inter_hist_;
+  core::LatencyHistogram cycle_hist_;
+  core::LatencyHistogram inter_hist_;
 };
 
 }  // namespace axon::c4g::host

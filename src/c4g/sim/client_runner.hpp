@@ -4,7 +4,7 @@
 #pragma once
 
 #include "c4g/sim/controller.hpp"
-#include "c4g/sim/rtt_histogram.hpp"
+#include "core/latency_histogram.hpp"
 #include "c4g/sim/udp_client.hpp"
 
 #include <atomic>
@@ -21,7 +21,7 @@ struct RunOptions {
 };
 
 struct RunReport {
-  RttHistogram rtt;
+  core::LatencyHistogram rtt;  // 1 us buckets to 20 ms
   std::uint64_t overruns = 0;   // ticks that started more than a period late (schedule reset)
   double elapsed_s = 0;
   bool stopped = false;         // ended by stop or duration rather than by the controller

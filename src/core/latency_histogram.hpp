@@ -8,6 +8,9 @@
 // bucket's upper edge is the largest value it holds. Samples above the covered range land in an
 // overflow bucket; the exact minimum and maximum
 // are kept beside the buckets, so max() is exact whatever the range.
+//
+// One type serves every timing figure of the project: the c4g server's cycle and reply times, the
+// c4g controller simulator's round trips and the blmc loop's jitter.
 #pragma once
 
 #include <atomic>
@@ -15,7 +18,7 @@
 #include <cstdint>
 #include <memory>
 
-namespace axon::c4g::host {
+namespace axon::core {
 
 class LatencyHistogram {
  public:
@@ -23,6 +26,10 @@ class LatencyHistogram {
   explicit LatencyHistogram(std::int64_t bucket_width_ns = 1'000, std::size_t buckets = 20'000);
   LatencyHistogram(const LatencyHistogram&) = delete;
   LatencyHistogram& operator=(const LatencyHistogram&) = delete;
+  // Moving is for results handed back by value once the writer has stopped; the moved-from
+  // histogram is left with no buckets and must not be used again.
+  LatencyHistogram(LatencyHistogram&& other) noexcept;
+  LatencyHistogram& operator=(LatencyHistogram&& other) noexcept;
 
   // Single writer. Negative samples (a clock step) count in bucket 0.
   void add(std::int64_t ns) noexcept;
@@ -39,6 +46,9 @@ class LatencyHistogram {
   // p % of the samples lie (or on which they lie), never above max(). Resolution is one bucket width; a percentile that
   // falls in the overflow bucket reports max(). 0 when empty.
   [[nodiscard]] std::int64_t percentile(double p) const noexcept;
+  // Samples above ns, overflow included; exact when ns is a multiple of the bucket width (else the
+  // bucket holding ns counts whole).
+  [[nodiscard]] std::uint64_t count_above(std::int64_t ns) const noexcept;
 
   [[nodiscard]] std::int64_t bucket_width_ns() const noexcept { return width_; }
   [[nodiscard]] std::size_t buckets() const noexcept { return buckets_; }
@@ -59,4 +69,4 @@ class LatencyHistogram {
   std::atomic<std::int64_t> sum_{0};
 };
 
-}  // namespace axon::c4g::host
+}  // namespace axon::core

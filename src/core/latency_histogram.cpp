@@ -1,9 +1,10 @@
-#include "c4g/host/latency_histogram.hpp"
+#include "core/latency_histogram.hpp"
 
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
-namespace axon::c4g::host {
+namespace axon::core {
 
 LatencyHistogram::LatencyHistogram(std::int64_t bucket_width_ns, std::size_t buckets)
     : width_(bucket_width_ns), buckets_(buckets) {
@@ -11,6 +12,26 @@ LatencyHistogram::LatencyHistogram(std::int64_t bucket_width_ns, std::size_t buc
     throw std::invalid_argument("LatencyHistogram: bucket width and count must be positive");
   counts_ = std::make_unique<std::atomic<std::uint64_t>[]>(buckets);
   reset();
+}
+
+LatencyHistogram::LatencyHistogram(LatencyHistogram&& other) noexcept : width_(other.width_), buckets_(0) {
+  *this = std::move(other);
+}
+
+LatencyHistogram& LatencyHistogram::operator=(LatencyHistogram&& other) noexcept {
+  if (this == &other) return *this;
+  width_ = other.width_;
+  buckets_ = other.buckets_;
+  counts_ = std::move(other.counts_);
+  auto take = [](auto& to, auto& from) { to.store(from.load(std::memory_order_relaxed), std::memory_order_relaxed); };
+  take(overflow_, other.overflow_);
+  take(min_, other.min_);
+  take(max_, other.max_);
+  take(sum_, other.sum_);
+  take(count_, other.count_);
+  other.buckets_ = 0;
+  other.count_.store(0, std::memory_order_relaxed);
+  return *this;
 }
 
 void LatencyHistogram::add(std::int64_t ns) noexcept {
@@ -62,4 +83,13 @@ std::int64_t LatencyHistogram::percentile(double p) const noexcept {
   return top;  // in the overflow bucket
 }
 
-}  // namespace axon::c4g::host
+std::uint64_t LatencyHistogram::count_above(std::int64_t ns) const noexcept {
+  // Bucket i holds ((i-1)w, iw]: the first bucket with anything above ns is floor(ns/w) + 1.
+  if (ns < 0) return count();
+  const std::int64_t first = ns / width_ + 1;
+  std::uint64_t n = overflow();
+  for (auto i = static_cast<std::size_t>(first); i < buckets_; ++i) n += counts_[i].load(std::memory_order_relaxed);
+  return n;
+}
+
+}  // namespace axon::core
