@@ -1,13 +1,16 @@
-// The controller's side of the UDP exchange with plain POSIX sockets: a connected UDP socket to the
-// PC's server address, send, and receive with an absolute steady-clock deadline. Small on purpose,
-// so it can be swapped for net::UdpSocket once that lands.
+// The controller's side of the UDP exchange: a net::UdpSocket bound to an ephemeral (or given)
+// local port that talks to one PC server. Adds what the simulated controller needs on top of the
+// socket: a receive with an absolute steady-clock deadline that ignores datagrams from anyone but
+// the server, and a drain of replies that came too late.
 #pragma once
 
 #include "core/error.hpp"
 #include "net/endpoint.hpp"
+#include "net/udp_socket.hpp"
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <span>
 
@@ -17,25 +20,25 @@ class UdpClient {
  public:
   using Clock = std::chrono::steady_clock;
 
-  // Resolves the server, binds to an ephemeral local port (or `local` when given) and connects.
+  // Resolves the server (IPv4), binds to an ephemeral local port (or `local` when given).
   static Result<UdpClient> open(const net::Endpoint& server, const std::optional<net::Endpoint>& local = std::nullopt);
-  UdpClient(UdpClient&& o) noexcept : fd_(o.fd_) { o.fd_ = -1; }
-  UdpClient& operator=(UdpClient&& o) noexcept;
-  UdpClient(const UdpClient&) = delete;
-  UdpClient& operator=(const UdpClient&) = delete;
-  ~UdpClient();
 
   Result<void> send(std::span<const std::byte> datagram);
-  // One datagram before the deadline: its size, 0 at the deadline. ICMP "port unreachable" from
-  // an absent server is not an error here (the controller counts the miss).
+  // One datagram from the server before the deadline: its size, 0 at the deadline. Datagrams
+  // from other senders are dropped and counted (foreign()).
   Result<std::size_t> receive(std::span<std::byte> buffer, Clock::time_point deadline);
   // Drops whatever is queued (replies that came after their deadline); returns how many.
   std::size_t drain(std::span<std::byte> scratch);
   [[nodiscard]] net::Endpoint local_endpoint() const;
+  [[nodiscard]] std::uint64_t foreign() const noexcept { return foreign_; }
+  [[nodiscard]] const net::UdpCounters& counters() const noexcept { return socket_.counters(); }
 
  private:
-  explicit UdpClient(int fd) : fd_(fd) {}
-  int fd_ = -1;
+  UdpClient(net::UdpSocket socket, net::SocketAddress server) : socket_(std::move(socket)), server_(server) {}
+
+  net::UdpSocket socket_;
+  net::SocketAddress server_;
+  std::uint64_t foreign_ = 0;
 };
 
 }  // namespace axon::c4g::sim
