@@ -57,6 +57,9 @@ struct ServeOptions {
   std::vector<double> frequency_hz;
   double open_time_s = 0;
   double ramp_s = 0.5;
+  std::string feed;
+  std::size_t feed_axes = 6;
+  double feed_timeout_ms = 100;
   std::vector<double> kp, kv, ki;
   bool no_dynamic_model = false;
   // recording
@@ -109,6 +112,17 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     apps::CorrectOptions c;
     c.arm = o.arm;
     if (!o.file.empty()) c.values = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(o.file, unit)));
+    if (!o.feed.empty()) {
+      apps::SensorFeedOptions f;
+      f.listen = need(net::parse_endpoint(o.feed, 0));
+      f.axes = o.feed_axes;
+      f.degrees = o.units == "deg";
+      c.feed = need(apps::SensorFeed::open(f));
+      c.feed_timeout_s = o.feed_timeout_ms * 1e-3;
+      std::printf("correct: feed listening on %s:%u (%zu values per datagram, %s)\n", f.listen.host.c_str(),
+                  static_cast<unsigned>(c.feed->port()), f.axes, f.degrees ? "deg" : "rad");
+      std::fflush(stdout);
+    }
     c.amplitude_rad = deg_to_rad(o.amplitude_deg);
     c.frequency_hz = o.frequency_hz;
     c.open_time_s = o.open_time_s;
@@ -349,6 +363,9 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("--frequency", so.frequency_hz, "correct/pid: sine frequency per axis [Hz] (default 0.5)")->delimiter(',');
   s->add_option("--open-time", so.open_time_s, "correct/pid: leave the open mode after this long [s] (0: until stopped)");
   s->add_option("--ramp", so.ramp_s, "fade in/out time of corrections and sines [s] (default 0.5)");
+  s->add_option("--feed", so.feed, "correct: live correction values over UDP on HOST:PORT (one datagram of numbers per measurement)");
+  s->add_option("--feed-axes", so.feed_axes, "correct: values per feed datagram (default 6)")->check(CLI::Range(1, 10));
+  s->add_option("--feed-timeout-ms", so.feed_timeout_ms, "correct: feed values older than this count as none (default 100)");
   s->add_option("--kp", so.kp, "pid: position gain per axis [1/s]")->delimiter(',');
   s->add_option("--kv", so.kv, "pid: velocity gain per axis [A/(turn/s)]")->delimiter(',');
   s->add_option("--ki", so.ki, "pid: velocity integral rate per axis [1/s]")->delimiter(',');

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <numbers>
 
 namespace axon::c4g::apps {
@@ -15,8 +16,11 @@ using protocol::Mode;
 
 CorrectApp::CorrectApp(CorrectOptions options) : options_(std::move(options)) {
   for (auto& a : applied_) a.store(0, std::memory_order_relaxed);
-  if (!options_.values && options_.amplitude_rad.empty())
-    throw Exception(Error(CoreErrc::invalid_argument, "correct: give amplitudes (a sine) or a file of values"));
+  const int sources = (options_.values ? 1 : 0) + (options_.feed ? 1 : 0) + (options_.amplitude_rad.empty() ? 0 : 1);
+  if (sources != 1)
+    throw Exception(Error(CoreErrc::invalid_argument, "correct: give exactly one of amplitudes (a sine), a file of values or a live feed"));
+  if (!(options_.feed_timeout_s > 0))
+    throw Exception(Error(CoreErrc::invalid_argument, "correct: the feed timeout must be positive"));
   if (options_.ramp_s < 0 || options_.open_time_s < 0)
     throw Exception(Error(CoreErrc::invalid_argument, "correct: times must not be negative"));
 }
@@ -34,7 +38,12 @@ void CorrectApp::setup(const protocol::InitPacket& init, const protocol::AxisMap
   const std::size_t n = view_->count;
   const double period = view_->period_s;
   const double max_step = options_.max_motor_speed * period;
-  if (options_.values) {
+  if (options_.feed) {
+    if (options_.feed->axes() != n) {
+      fail("correct: the feed sends %zu values, arm %zu has %zu axes", options_.feed->axes(), options_.arm, n);
+      set_phase(Phase::refused);
+    }
+  } else if (options_.values) {
     const Trajectory& f = *options_.values;
     if (f.axes() != n) {
       fail("correct: the file has %zu axes, arm %zu has %zu", f.axes(), options_.arm, n);
@@ -89,6 +98,22 @@ void CorrectApp::correction(double t, double env, protocol::ArmTransform::Vector
     for (std::size_t j = 0; j < n; ++j)
       link[static_cast<Eigen::Index>(j)] = env * amplitude_[j] * std::sin(2.0 * std::numbers::pi * frequency_[j] * t);
   }
+}
+
+void CorrectApp::feed_target(double env, protocol::ArmTransform::Vector& link) noexcept {
+  const std::size_t n = view_->count;
+  options_.feed->latest(reading_);  // on a torn read the previous reading stays
+  timespec now{};
+  clock_gettime(CLOCK_MONOTONIC, &now);
+  const std::int64_t now_ns = static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+  const bool stale = reading_.steady_ns == 0 ||
+                     static_cast<double>(now_ns - reading_.steady_ns) > options_.feed_timeout_s * 1e9;
+  if (stale != stale_) {
+    stale_ = stale;
+    if (reading_.steady_ns != 0) note(stale ? kNoteFeedStale : kNoteFeedBack);
+  }
+  if (stale) stale_cycles_.fetch_add(1, std::memory_order_relaxed);
+  for (std::size_t j = 0; j < n; ++j) link[static_cast<Eigen::Index>(j)] = stale ? 0.0 : env * reading_.values[j];
 }
 
 void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
@@ -159,12 +184,26 @@ void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) 
     }
   }
   protocol::ArmTransform::Vector link(static_cast<Eigen::Index>(n));
-  correction(t_, env, link);
-  const auto motor = view_->transform.motor_velocity(link);
+  if (options_.feed) feed_target(env, link);
+  else correction(t_, env, link);
+  auto motor = view_->transform.motor_velocity(link);
   const double max_step = options_.max_motor_speed * period;
+  if (options_.feed) {
+    // Slew towards the sensor's target; the fade ends only once the correction is back at zero.
+    bool at_zero = true;
+    for (std::size_t j = 0; j < n; ++j) {
+      auto& m = motor[static_cast<Eigen::Index>(j)];
+      m = last_[j] + std::clamp(m - last_[j], -max_step, max_step);
+      at_zero = at_zero && std::fabs(m) < 1e-12;
+    }
+    if (ph == Phase::exiting && !at_zero) {
+      set_phase(Phase::fading);
+      ph = Phase::fading;
+    }
+  }
   for (std::size_t j = 0; j < n; ++j) {
     const double inc = motor[static_cast<Eigen::Index>(j)] - last_[j];
-    if (!(std::fabs(inc) <= max_step)) {
+    if (!(std::fabs(inc) <= max_step * (1 + 1e-9))) {  // a slewed step may round just above the limit
       fail("correct: increment of %.4f motor turns on axis %zu exceeds %.4f", inc, j + 1, max_step);
       set_phase(Phase::refused);
       for (std::size_t i = 0; i < n; ++i) reply.axis(first + i).d1 = 0;
@@ -186,6 +225,9 @@ std::string CorrectApp::note_text(std::int32_t c) const {
     case kNoteStarted: return fmt::format("correct: correction started (mode 7, arm {})", options_.arm);
     case kNoteFading: return "correct: fading the correction out";
     case kNoteDone: return "correct: done, the arm is back in mode 0";
+    case kNoteFeedStale:
+      return fmt::format("correct: no feed values for {:.0f} ms: correction returning to zero", options_.feed_timeout_s * 1e3);
+    case kNoteFeedBack: return "correct: feed values again";
     default: return App::note_text(c);
   }
 }
@@ -200,8 +242,14 @@ std::string CorrectApp::status() const {
 
 std::string CorrectApp::summary() const {
   static constexpr std::string_view names[] = {"waiting", "correcting", "fading", "exiting", "done", "refused"};
-  return App::summary() + fmt::format("correct: {:.3f} s corrected, phase {}\n", elapsed_.load(std::memory_order_relaxed),
-                                      names[static_cast<int>(phase())]);
+  std::string out = App::summary() + fmt::format("correct: {:.3f} s corrected, phase {}\n",
+                                                elapsed_.load(std::memory_order_relaxed), names[static_cast<int>(phase())]);
+  if (options_.feed) {
+    out += fmt::format("correct: feed on port {}: {} datagrams accepted, {} rejected, {} stale cycles\n", options_.feed->port(),
+                       options_.feed->accepted(), options_.feed->rejected(), stale_cycles());
+    if (const auto e = options_.feed->last_error(); !e.empty()) out += "correct: last rejected datagram " + e + "\n";
+  }
+  return out;
 }
 
 }  // namespace axon::c4g::apps
