@@ -7,24 +7,22 @@
 // with the robot's collision buffer as radius. Two robots touch when their segments come closer
 // than the sum of their buffers; a robot touches an obstacle (a point or a segment with its own
 // radius, e.g. a fiducial with 3 mm) when the distance is below buffer + radius.
+//
+// The plane's vectors, segments and the exact segment distance are the planner's (fps/plan): the
+// simulator's collision check and the planner's dense checker measure with the same primitive.
 #pragma once
+
+#include "fps/plan/distance.hpp"
+#include "fps/plan/vec2.hpp"
 
 #include <string>
 
 namespace axon::fps::sim {
 
-struct Vec2 {
-  double x = 0;
-  double y = 0;
-};
+using plan::Segment;
+using plan::segment_distance;
+using plan::Vec2;
 
-struct Segment {
-  Vec2 a;
-  Vec2 b;
-};
-
-// Shortest distance between two segments (either may be a single point).
-double segment_distance(const Segment& s, const Segment& t) noexcept;
 // A quick test: true when the segments are certainly at least `limit` apart (false: maybe closer).
 bool surely_apart(const Segment& s, const Segment& t, double limit) noexcept;
 
