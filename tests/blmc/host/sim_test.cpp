@@ -182,35 +182,40 @@ TEST(BlmcHostSim, ReceiveTimeoutThenRecovery) {
   });
 }
 
-TEST(BlmcHostSim, EachErrorCodeIsSeenByNameWithPrecedence) {
-  struct Case {
-    std::vector<sim::FaultKind> kinds;
-    proto::ErrorCode expect;
-  };
-  const Case cases[] = {{{sim::FaultKind::encoder}, proto::ErrorCode::encoder},
-                        {{sim::FaultKind::pos_converter}, proto::ErrorCode::pos_converter},
-                        {{sim::FaultKind::transmit}, proto::ErrorCode::other},
-                        {{sim::FaultKind::over_current}, proto::ErrorCode::other},
-                        {{sim::FaultKind::pos_converter, sim::FaultKind::encoder}, proto::ErrorCode::encoder},
-                        {{sim::FaultKind::over_current, sim::FaultKind::pos_converter}, proto::ErrorCode::pos_converter}};
-  for (const auto& c : cases) {
-    SimRig rig;
-    rig.run([&]() -> asio::awaitable<void> {
-      Board board(*rig.host);
-      auto r = co_await board.enable();
-      CO_ASSERT(r);
-      for (auto k : c.kinds) rig.sim->inject(k);
-      auto again = co_await board.wait_ready(2500ms);
-      CO_ASSERT(!again);
-      EXPECT_EQ(again.error(), HostErrc::board_error);
-      EXPECT_NE(again.error().detail.find(std::string(proto::name(c.expect))), std::string::npos)
-          << again.error().detail;
-      // The glitch is gone: the documented recovery brings the board back.
-      auto rec = co_await board.recover();
-      EXPECT_TRUE(rec) << (rec ? "" : rec.error().message());
-    });
-  }
+// One case per test, so that ctest runs them side by side (each waits for the 1 Hz status).
+struct ErrorCase {
+  std::vector<sim::FaultKind> kinds;
+  proto::ErrorCode expect;
+};
+
+class BlmcHostSimErrors : public ::testing::TestWithParam<ErrorCase> {};
+
+TEST_P(BlmcHostSimErrors, EachErrorCodeIsSeenByNameWithPrecedence) {
+  const ErrorCase& c = GetParam();
+  SimRig rig;
+  rig.run([&]() -> asio::awaitable<void> {
+    Board board(*rig.host);
+    auto r = co_await board.enable();
+    CO_ASSERT(r);
+    for (auto k : c.kinds) rig.sim->inject(k);
+    auto again = co_await board.wait_ready(2500ms);
+    CO_ASSERT(!again);
+    EXPECT_EQ(again.error(), HostErrc::board_error);
+    EXPECT_NE(again.error().detail.find(std::string(proto::name(c.expect))), std::string::npos) << again.error().detail;
+    // The glitch is gone: the documented recovery brings the board back.
+    auto rec = co_await board.recover();
+    EXPECT_TRUE(rec) << (rec ? "" : rec.error().message());
+  });
 }
+
+INSTANTIATE_TEST_SUITE_P(
+    Faults, BlmcHostSimErrors,
+    ::testing::Values(ErrorCase{{sim::FaultKind::encoder}, proto::ErrorCode::encoder},
+                      ErrorCase{{sim::FaultKind::pos_converter}, proto::ErrorCode::pos_converter},
+                      ErrorCase{{sim::FaultKind::transmit}, proto::ErrorCode::other},
+                      ErrorCase{{sim::FaultKind::over_current}, proto::ErrorCode::other},
+                      ErrorCase{{sim::FaultKind::pos_converter, sim::FaultKind::encoder}, proto::ErrorCode::encoder},
+                      ErrorCase{{sim::FaultKind::over_current, sim::FaultKind::pos_converter}, proto::ErrorCode::pos_converter}));
 
 TEST(BlmcHostSim, BoardErrorDuringControlStopsAndIsNamed) {
   SimRig rig;
