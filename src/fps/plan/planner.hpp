@@ -45,7 +45,7 @@ struct PlannerOptions {
   double max_half_s = 90.0;       // time limit of each half
   std::uint64_t seed = 1;
   int retries = 3;                // re-planning rounds after parking or holding robots
-  int half_retries = 4;           // re-runs of a half that left robots stuck, those robots first
+  int half_retries = 8;           // re-runs of a half that left robots stuck, those robots first
   int relax_after = 1;            // from this retry on, stuck robots fold without turning alpha
   std::size_t max_points = 1023;  // per arm, after the start point (firmware limit)
   bool verify = true;             // run the checker on the result
