@@ -10,7 +10,7 @@
 // The reference planner cannot run here; its figures on random 500-robot problems on this kind of
 // machine (FIELD-NOTES / issue 5) are printed beside ours and give ratio = 28 s / our median.
 //
-// Usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S]
+// Usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K]
 #include "fps/layout/layout_generator.hpp"
 #include "fps/plan/layout_model.hpp"
 #include "fps/plan/planner.hpp"
@@ -55,9 +55,11 @@ int main(int argc, char** argv) {
     if (key == "--problems") problems = std::max(1, std::atoi(v));
     else if (key == "--seed") seed = std::strtoull(v, nullptr, 10);
     else if (key == "--step") options.step_deg = std::atof(v);
+    else if (key == "--half-retries") options.half_retries = std::atoi(v);
+    else if (key == "--relax-after") options.relax_after = std::atoi(v);
     else if (key == "--speed") options.speed = {std::atof(v), std::atof(v)};
     else {
-      std::fprintf(stderr, "usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S]\n");
+      std::fprintf(stderr, "usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K]\n");
       return 2;
     }
   }
@@ -67,8 +69,8 @@ int main(int argc, char** argv) {
   fmt::print("fps_plan: {} robots, {} fiducials, {} neighbour pairs; speed {} / {} deg/s, step {} deg, buffer 2.0 mm\n",
              model.size(), plane.fiducials().size(), model.robot_pairs().size(), options.speed.alpha_deg_s,
              options.speed.beta_deg_s, options.step_deg);
-  fmt::print("{:>3} {:>7} {:>8} {:>8} {:>8} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7} {:>8} {:>7}\n", "#", "from", "plan_s",
-             "search_s", "check_s", "success", "dead", "escape", "p_med", "p_max", "move_s", "min_clr", "rounds");
+  fmt::print("{:>3} {:>7} {:>8} {:>8} {:>8} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7} {:>8} {:>7} {:>5}\n", "#", "from", "plan_s",
+             "search_s", "check_s", "success", "dead", "escape", "p_med", "p_max", "move_s", "min_clr", "rounds", "mid_s");
 
   std::vector<double> times, moves, med_points;
   std::size_t solved = 0, max_points = 0;
@@ -91,10 +93,10 @@ int main(int argc, char** argv) {
     moves.push_back(p.stats.duration_s);
     med_points.push_back(static_cast<double>(p.stats.median_points));
     max_points = std::max(max_points, p.stats.max_points);
-    fmt::print("{:>3} {:>7} {:>8.3f} {:>8.3f} {:>8.3f} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7.1f} {:>8.3f} {:>7}\n", k,
+    fmt::print("{:>3} {:>7} {:>8.3f} {:>8.3f} {:>8.3f} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7.1f} {:>8.3f} {:>7} {:>5.1f}\n", k,
                from_folded ? "folded" : "random", p.stats.plan_s, p.stats.search_s, p.stats.check_s, ok ? "yes" : "no",
                p.not_reached, p.stats.escapes, p.stats.median_points, p.stats.max_points, p.stats.duration_s,
-               p.check.min_clearance_mm, p.stats.rounds);
+               p.check.min_clearance_mm, p.stats.rounds, p.stats.middle_s);
     if (!p.ok()) std::fputs(p.summary(model).c_str(), stdout);
     std::fflush(stdout);
   }

@@ -1,11 +1,15 @@
 // `axon demo`, fps section: the default focal plane (500 simulated robots on 24 buses behind 6
 // CAN@net gateway emulators, plus the PLC emulator) driven over loopback TCP by the host: layout
-// check, discovery, status sweep, a fold and a coordinated move both started by the PLC's sync
-// line, final positions verified, each phase timed against the wire time of its busiest bus.
+// check, discovery, status sweep, a fold, then a collision-free random reconfiguration of every
+// robot from the path planner, both started by the PLC's sync line, final positions and the
+// simulator's collision count verified, each phase timed against the wire time of its busiest bus.
 // The simulated plane runs on a thread of its own (sim_thread.hpp), the host on the caller's.
 #include "demo_fps.hpp"
 
 #include "fps/host/focal_plane_array.hpp"
+#include "fps/plan/layout_model.hpp"
+#include "fps/plan/planner.hpp"
+#include "fps/plan/problems.hpp"
 #include "fps/sim/focal_plane_sim.hpp"
 #include "layout_name.hpp"
 #include "run.hpp"
@@ -165,10 +169,45 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   fmt::print("4. fold (20 points per arm, 16 s simulated, started by the PLC's sync line): {}\n", folded.outcome);
   if (!folded.completed) throw Exception(Error(CoreErrc::invalid_argument, failure_text(folded)));
 
-  const host::ArmAngles target{120, 100};
-  const double move_s = 10.0;
+  // 5. A random reconfiguration of every robot, planned collision-free from the folded lattice
+  //    (docs/fps-plan.md) and verified by the planner's independent checker before anything moves.
+  const auto model = need(fps::plan::model_from_layout(plane));
+  fps::plan::PlanRequest req;
+  req.frozen = fps::plan::frozen_robots(plane);
+  req.current.assign(model.size(), fps::plan::Pose{0, 180});
+  req.target = fps::plan::random_poses(model, so.seed);
+  for (std::size_t i = 0; i < model.size(); ++i)
+    if (req.frozen[i] || !array.find(static_cast<std::uint16_t>(model.robot(i).id()))) {
+      req.frozen[i] = true;
+      req.target[i] = req.current[i];
+    }
+  fps::plan::PlannerOptions po;
+  po.seed = so.seed;
+  const auto plan = need(fps::plan::plan_moves(model, req, po));
+  fmt::print("5. planned a random reconfiguration of {} robots in {:.2f} s (engine {:.2f} s, checker {:.2f} s): "
+             "{} reach their targets, {} parked or held; {:.1f} s move, {} points per arm (median, max {}); "
+             "checker {} (min clearance {:.3f} mm at the full buffer)\n",
+             model.size(), plan.stats.plan_s, plan.stats.search_s, plan.stats.check_s, model.size() - plan.not_reached,
+             plan.not_reached, plan.stats.duration_s, plan.stats.median_points, plan.stats.max_points,
+             plan.verified ? "verified" : "REJECTED", plan.check.min_clearance_mm);
+  if (!plan.verified) throw Exception(Error(CoreErrc::invalid_argument, "the planner's checker rejected the plan"));
+  if (plan.not_reached > 0) fmt::print("{}", plan.summary(model));
+  const double move_s = plan.stats.duration_s;
   std::map<std::uint16_t, protocol::Trajectory> moves;
-  for (auto id : array.ids()) moves.emplace(id, straight({0, 180}, target, 20, move_s));
+  std::map<std::uint16_t, host::ArmAngles> ends;
+  for (std::size_t i = 0; i < model.size(); ++i) {
+    const auto id = static_cast<std::uint16_t>(model.robot(i).id());
+    const auto& t = plan.trajectories[i];
+    ends[id] = {plan.robots[i].end.alpha_deg, plan.robots[i].end.beta_deg};
+    if (t.alpha.size() <= 1 && t.beta.size() <= 1) continue;  // stays
+    std::vector<protocol::ArmPoint> a, b;
+    // The first point (0 s) is where the robot stands: the firmware adds it by itself.
+    for (std::size_t k = 1; k < t.alpha.size(); ++k) a.push_back({t.alpha[k].deg, t.alpha[k].t_s});
+    for (std::size_t k = 1; k < t.beta.size(); ++k) b.push_back({t.beta[k].deg, t.beta[k].t_s});
+    if (a.empty()) a.push_back({t.alpha.front().deg, 0.5});
+    if (b.empty()) b.push_back({t.beta.front().deg, 0.5});
+    moves.emplace(id, need(protocol::Trajectory::from_physical(a, b)));
+  }
   std::map<std::string, std::map<fps::BusRef, std::uint64_t>> marks;
   std::map<std::string, Clock::time_point> marks_t;
   bool moving = false, finished = false, progress_done = false;
@@ -207,9 +246,8 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   const auto run = need(std::move(r2));
   finished = true;
   while (!progress_done) co_await core::sleep_for(20ms);  // let the progress line end
-  fmt::print("5. coordinated move of all {} robots to alpha {} beta {} (20 points per arm, {} s simulated),\n"
-             "   started by the sync line: {}\n",
-             run.robots.size(), target.alpha, target.beta, move_s, run.outcome);
+  fmt::print("   planned move of {} robots ({:.1f} s simulated), started by the sync line: {}\n", run.robots.size(),
+             move_s, run.outcome);
   if (marks.contains("checked") && marks.contains("uploaded")) {
     phases.push_back({"upload", seconds(run.timings.upload), floor_s(marks["checked"], marks["uploaded"])});
   }
@@ -223,6 +261,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   std::size_t at_target = 0;
   for (const auto& rr : run.robots) {
     if (rr.reached) {
+      const auto& target = ends.at(rr.id);
       worst_host = std::max({worst_host, std::abs(rr.reached->alpha - target.alpha), std::abs(rr.reached->beta - target.beta)});
     }
   }
@@ -230,6 +269,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   sim_thread.call([&] {
     for (const auto& rr : run.robots) {
       if (const auto* m = sim->simulator().find(rr.id)) {
+        const auto& target = ends.at(rr.id);
         const double e = std::max(std::abs(m->physical_deg(fps::sim::Arm::alpha) - target.alpha),
                                   std::abs(m->physical_deg(fps::sim::Arm::beta) - target.beta));
         worst_sim = std::max(worst_sim, e);
@@ -238,10 +278,12 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
     }
   });
   const auto st = sim_thread.call([&] { return sim->simulator().stats(); });
-  fmt::print("6. verified: {} of {} robots at their target; worst error {:.4f} deg (host reading), {:.4f} deg "
+  fmt::print("6. verified: {} of {} robots at their planned end; worst error {:.4f} deg (host reading), {:.4f} deg "
              "(simulated arms); {} collisions\n",
              at_target, run.robots.size(), worst_host, worst_sim, st.neighbour_collisions + st.obstacle_collisions);
 
+  if (st.neighbour_collisions + st.obstacle_collisions > 0)
+    throw Exception(Error(CoreErrc::invalid_argument, "the simulator saw collisions during the planned move"));
   fmt::print("7. timings (floor: wire time of the busiest bus for the frames the phase put on it, 1 Mbit/s):\n");
   for (const auto& p : phases) {
     if (p.floor > 0) {

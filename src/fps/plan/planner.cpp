@@ -110,6 +110,43 @@ void drop_still_points(std::vector<TimedAngle>& pts) {
   pts = std::move(out);
 }
 
+std::size_t count_unreached(const StepperResult& r) {
+  return static_cast<std::size_t>(std::count(r.reached.begin(), r.reached.end(), false));
+}
+
+// One half, re-run while robots get stuck: each retry puts every robot stuck so far in front (it
+// steps first, the others yield to it) and draws a new seed; from the `relax_after`-th retry on, a
+// stuck robot also gives up turning alpha in this half (its goal alpha becomes its start alpha:
+// a pure beta fold), leaving the turn to the other half or to the middle phase. The run with the
+// fewest robots stuck (then the shortest) is kept; `robots` holds the goals of that run.
+StepperResult drive_with_retries(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperOptions so,
+                                 int retries, int relax_after, std::size_t& runs) {
+  StepperResult best = drive_to_goals(model, robots, so);
+  ++runs;
+  std::vector<StepperRobot> best_robots = robots;
+  std::vector<bool> listed(robots.size(), false);
+  for (int k = 0; k < retries && count_unreached(best) > 0; ++k) {
+    for (std::size_t i = 0; i < robots.size(); ++i) {
+      if (best.reached[i]) continue;
+      if (!listed[i]) {
+        listed[i] = true;
+        so.first.push_back(static_cast<std::uint32_t>(i));
+      }
+      if (k >= relax_after) robots[i].goal.alpha_deg = robots[i].start.alpha_deg;
+    }
+    so.seed = so.seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    StepperResult r = drive_to_goals(model, robots, so);
+    ++runs;
+    const std::size_t a = count_unreached(r), b = count_unreached(best);
+    if (a < b || (a == b && r.duration_s < best.duration_s)) {
+      best = std::move(r);
+      best_robots = robots;
+    }
+  }
+  robots = std::move(best_robots);
+  return best;
+}
+
 constexpr const char* kReverseStuck = "its target cannot be reached from the fold without a collision";
 
 std::size_t firmware_points(const std::vector<TimedAngle>& pts) { return pts.empty() ? 0 : pts.size() - 1; }
@@ -234,10 +271,13 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   so.margin_mm = o.margin_mm;
   so.max_duration_s = o.max_half_s;
 
-  StepperResult ra, rb;
+  StepperResult ra, rb, rm;
   std::vector<StepperRobot> fa(n), fb(n);
   double search_s = 0;
-  const int max_rounds = std::max(1, o.retries + 1) + 4;
+  const int max_rounds = std::max(1, o.retries + 1) + 8;
+  // Robots whose fold alpha was given up in a half (a pure beta fold from the start or the target):
+  // the fold is then at the current (A) or the target (B) alpha.
+  std::vector<bool> relax_a(n, false), relax_b(n, false);
   for (int round = 0;; ++round) {
     // The fold's alpha: alpha turns towards the target during B (as far as B's beta work allows)
     // and the rest during A.
@@ -251,21 +291,46 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
         continue;
       }
       const double at = target[i].alpha_deg, ac = request.current[i].alpha_deg;
-      const Pose fold{at + std::clamp(ac - at, -alpha_budget, alpha_budget), fold_beta(i)};
-      fa[i] = {request.current[i], fold, false};
-      fb[i] = {target[i], fold, false};
+      double f = at + std::clamp(ac - at, -alpha_budget, alpha_budget);
+      if (relax_b[i]) f = at;
+      if (relax_a[i]) f = ac;
+      fa[i] = {request.current[i], {f, fold_beta(i)}, false};
+      fb[i] = {target[i], {relax_b[i] ? at : f, fold_beta(i)}, false};
     }
     StepperOptions sa = so, sb = so;
     sa.seed = o.seed * 2 + 1 + static_cast<std::uint64_t>(round) * 7919;
     sb.seed = o.seed * 2 + 2 + static_cast<std::uint64_t>(round) * 7919;
     const auto t0 = Clock::now();
+    std::size_t runs_a = 0, runs_b = 0;
     if (o.parallel) {
-      std::thread worker([&] { ra = drive_to_goals(model, fa, sa); });
-      rb = drive_to_goals(model, fb, sb);
+      std::thread worker([&] { ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, runs_a); });
+      rb = drive_with_retries(model, fb, sb, o.half_retries, o.relax_after, runs_b);
       worker.join();
     } else {
-      ra = drive_to_goals(model, fa, sa);
-      rb = drive_to_goals(model, fb, sb);
+      ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, runs_a);
+      rb = drive_with_retries(model, fb, sb, o.half_retries, o.relax_after, runs_b);
+    }
+    // Folds given up by B: A turns those robots to the target alpha instead (one more A run), so
+    // that no middle phase is needed for them unless A gives up the turn as well.
+    bool rerun_a = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (still[i]) continue;
+      if (fa[i].goal.alpha_deg == request.current[i].alpha_deg && fa[i].goal.alpha_deg != target[i].alpha_deg &&
+          fb[i].goal.alpha_deg != fa[i].goal.alpha_deg)
+        relax_a[i] = true;
+      if (fb[i].goal.alpha_deg == target[i].alpha_deg && fb[i].goal.alpha_deg != fa[i].goal.alpha_deg && !relax_a[i]) {
+        relax_b[i] = true;
+        fa[i].goal.alpha_deg = target[i].alpha_deg;
+        rerun_a = true;
+      }
+    }
+    if (rerun_a) {
+      sa.seed += 104729;
+      ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, runs_a);
+      for (std::size_t i = 0; i < n; ++i)
+        if (!still[i] && fa[i].goal.alpha_deg == request.current[i].alpha_deg &&
+            fb[i].goal.alpha_deg != fa[i].goal.alpha_deg)
+          relax_a[i] = true;
     }
     search_s += seconds_since(t0);
     plan.stats.rounds = static_cast<std::size_t>(round) + 1;
@@ -286,6 +351,35 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
         changed = true;
       }
     }
+    if (!changed) {
+      // Middle phase: robots whose A and B folds differ turn alpha from one to the other while
+      // folded. Folded robots cannot touch each other, but a held or frozen neighbour may stand
+      // unfolded, so this runs through the engine too (everyone else stands still).
+      std::vector<StepperRobot> fm(n);
+      bool any_m = false;
+      for (std::size_t i = 0; i < n; ++i) {
+        const Pose from{ra.paths[i].alpha.back().deg, ra.paths[i].beta.back().deg};
+        const Pose to{rb.paths[i].alpha.back().deg, rb.paths[i].beta.back().deg};
+        fm[i] = {from, to, still[i] || from == to};
+        any_m = any_m || !fm[i].frozen;
+      }
+      rm = {};
+      if (any_m) {
+        StepperOptions sm = so;
+        sm.seed = o.seed * 2 + 77 + static_cast<std::uint64_t>(round) * 7919;
+        const auto tm0 = Clock::now();
+        rm = drive_to_goals(model, fm, sm);
+        search_s += seconds_since(tm0);
+        for (std::size_t i = 0; i < n; ++i)
+          if (!rm.reached[i]) {
+            plan.robots[i] = {RobotPlan::Status::parked, {}, "cannot turn to its fold alpha while folded",
+                              ids_of(rm.blockers[i])};
+            target[i] = park_pose(i);
+            relax_a[i] = relax_b[i] = false;
+            changed = true;
+          }
+      }
+    }
     if (!changed) break;
     if (round + 1 >= max_rounds)
       return make_error(PlanErrc::robot_collision,
@@ -296,7 +390,18 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   // Third phase for robots parked because the reverse half got stuck: with everyone else at rest
   // at the end, each tries forwards from its fold to its target. Robots that do not get there
   // stay folded, and the others are re-planned without them (they were certified against it).
-  const double ta = ra.duration_s, tb = rb.duration_s;
+  // Append the middle phase to A.
+  const double ta0 = ra.duration_s, tb = rb.duration_s;
+  const double tm = rm.paths.empty() ? 0.0 : rm.duration_s;
+  if (!rm.paths.empty())
+    for (std::size_t i = 0; i < n; ++i)
+      for (auto [arm, m] : {std::pair{&ra.paths[i].alpha, &rm.paths[i].alpha}, std::pair{&ra.paths[i].beta, &rm.paths[i].beta}}) {
+        if (m->size() < 2) continue;
+        if (arm->back().t_s < ta0) arm->push_back({ta0, arm->back().deg});
+        for (std::size_t k = 1; k < m->size(); ++k) arm->push_back({ta0 + (*m)[k].t_s, (*m)[k].deg});
+      }
+  const double ta = ta0 + tm;
+  plan.stats.middle_s = tm;
   std::vector<bool> in_c(n, false);
   for (std::size_t i = 0; i < n; ++i)
     in_c[i] = plan.robots[i].status == RobotPlan::Status::parked && plan.robots[i].reason == kReverseStuck &&
@@ -336,7 +441,7 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
     if (any_c && in_c[i]) {
       for (auto [arm, c] : {std::pair{&t.alpha, &rc.paths[i].alpha}, std::pair{&t.beta, &rc.paths[i].beta}})
         for (const auto& pt : *c) {
-          const double when = ta + tb + pt.t_s;
+          const double when = ta + tb + pt.t_s;  // after A, the middle phase and B
           if (arm->back().t_s >= when - 1e-9) continue;
           arm->push_back({when, pt.deg});
         }

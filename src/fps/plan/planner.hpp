@@ -45,6 +45,8 @@ struct PlannerOptions {
   double max_half_s = 90.0;       // time limit of each half
   std::uint64_t seed = 1;
   int retries = 3;                // re-planning rounds after parking or holding robots
+  int half_retries = 8;           // re-runs of a half that left robots stuck, those robots first
+  int relax_after = 1;            // from this retry on, stuck robots fold without turning alpha
   std::size_t max_points = 1023;  // per arm, after the start point (firmware limit)
   bool verify = true;             // run the checker on the result
   CheckOptions check{};           // the checker's settings (full buffer)
@@ -76,6 +78,7 @@ struct PlanStats {
   double search_s = 0;           // of which the engine
   double check_s = 0;            // of which the checker
   double duration_s = 0;         // the move
+  double middle_s = 0;           // of which the middle phase (folded robots turning alpha)
   std::size_t rounds = 0;        // engine rounds (1 + re-plans)
   std::size_t escapes = 0;       // escape episodes (deadlock nudges)
   std::size_t simplified = 0;    // robots whose simplified trajectories were kept

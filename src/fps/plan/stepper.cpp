@@ -318,18 +318,33 @@ StepperResult Stepper::run() {
   rank_.resize(n);
   std::iota(rank_.begin(), rank_.end(), 0u);
   std::shuffle(rank_.begin(), rank_.end(), rng_);
+  std::vector<bool> is_first(n, false);
+  for (const std::uint32_t i : o_.first)
+    if (i < n && !robots_[i].frozen) is_first[i] = true;
+  for (std::size_t i = 0; i < n; ++i)
+    if (is_first[i]) rank_[i] += static_cast<std::uint32_t>(n);
 
   const auto max_steps = static_cast<std::size_t>(std::ceil(o_.max_duration_s / o_.dt_s));
   std::size_t step = 0, last_motion = 0, quiet = 0;
+  const auto stall_steps = o_.stall_s > 0 ? static_cast<std::size_t>(std::ceil(o_.stall_s / o_.dt_s)) : max_steps;
+  std::size_t fewest_away = n + 1, last_arrival = 0;
   for (; step < max_steps; ++step) {
     bool pending = false;
-    for (const std::uint32_t i : order)
-      if (prev_[i] != robots_[i].goal || st_[i].escape_left > 0) {
-        pending = true;
-        break;
-      }
+    std::size_t away = 0;
+    for (const std::uint32_t i : order) {
+      if (prev_[i] != robots_[i].goal) ++away;
+      if (prev_[i] != robots_[i].goal || st_[i].escape_left > 0) pending = true;
+    }
     if (!pending) break;
+    if (away < fewest_away) {
+      fewest_away = away;
+      last_arrival = step;
+    } else if (step - last_arrival > stall_steps) {
+      break;  // the robots left keep each other stuck
+    }
     std::shuffle(order.begin(), order.end(), rng_);
+    if (!o_.first.empty())
+      std::stable_partition(order.begin(), order.end(), [&](std::uint32_t i) { return is_first[i]; });
     for (const std::uint32_t i : order) step_robot(i);
     bool moved = false;
     const double t = static_cast<double>(step) * o_.dt_s;

@@ -46,12 +46,17 @@ struct StepperOptions {
   double beta_step_deg = 1.0;
   double margin_mm = 0.05;       // clearance every step's end keeps (or its start value if less)
   double max_duration_s = 90.0;  // give up after this much simulated time
+  double stall_s = 20.0;         // or after this long without any robot arriving (0: never)
   std::uint64_t seed = 1;
   double alpha_weight = 1.0;     // cost = weight * |angle to go|, per arm
   double beta_weight = 2.0;
   int stuck_steps = 6;           // steps without progress before a robot escapes
   int escape_min_steps = 3;
   int escape_max_steps = 15;
+  // Robots (model indices) that rank above every other robot: they step first in every time step
+  // (so the others make way) and lower-ranked blockers yield to them. Used to retry a half with
+  // the robots that got stuck the last time in front.
+  std::vector<std::uint32_t> first;
 };
 
 struct StepperResult {
