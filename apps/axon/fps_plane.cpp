@@ -3,6 +3,8 @@
 // broadcast or by the sync line.
 #include "commands.hpp"
 #include "fps/host/focal_plane_array.hpp"
+#include "fps/host/cold_control.hpp"
+#include "fps/host/plane_upgrade.hpp"
 #include "layout_name.hpp"
 #include "net/endpoint.hpp"
 #include "run.hpp"
@@ -11,6 +13,8 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <map>
 
 namespace axon::app {
@@ -28,7 +32,24 @@ struct PlaneArgs {
   double duration_s = 10;
   int points = 20;
   bool sync = false;
+  std::string image;              // upgrade
+  std::string version;            // upgrade: expected version
+  std::vector<int> sextants;      // upgrade
+  double power_off_s = 1.0;       // upgrade
+  bool watch = false;             // cold
+  double period_s = 60;           // cold --watch
+  double for_s = 0;               // cold --watch: 0 until a signal
 };
+
+Error usage(std::string text) { return Error(CoreErrc::invalid_argument, std::move(text)); }
+
+std::vector<std::uint8_t> read_image(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Exception(usage(fmt::format("cannot open {}", path)));
+  std::vector<std::uint8_t> image((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw Exception(usage(fmt::format("cannot read {}", path)));
+  return image;
+}
 
 host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
   host::FocalPlaneArrayOptions o;
@@ -39,8 +60,20 @@ host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
 
 int run_plane(const PlaneArgs& a, const std::string& action) {
   const auto plane = need(resolve_layout(a.layout));
-  return run_command([&](asio::io_context& io, auto) -> asio::awaitable<int> {
+  return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
     const auto ex = io.get_executor();
+    std::vector<std::uint8_t> image;
+    host::PlaneUpgradeOptions uo;
+    if (action == "upgrade") {
+      image = read_image(a.image);
+      if (!a.version.empty()) uo.expected_version = need(protocol::FirmwareVersion::parse(a.version));
+      uo.sextants = a.sextants;
+      uo.power_off_time = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(a.power_off_s));
+      uo.progress = [](const host::SextantProgress& p) {
+        std::fprintf(stderr, "%s\n", p.to_text().c_str());
+        std::fflush(stderr);
+      };
+    }
     auto connected = co_await host::FocalPlaneArray::connect(ex, plane, array_options(a));
     auto fpa = need(std::move(connected));
     int rc = 0;
@@ -97,6 +130,40 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
       std::fputs(rep.summary().c_str(), stdout);
       rc = rep.completed ? 0 : 1;
     }
+    if (action == "cold") {
+      // Once, or every period until a signal (or --for): the settings go out only when they change.
+      host::ColdControl cold(*fpa);
+      bool stop = false;
+      set_on_signal([&stop] { stop = true; });
+      const auto t0 = std::chrono::steady_clock::now();
+      bool first = true;
+      while (!stop) {
+        auto r = co_await cold.step(first);
+        first = false;
+        if (!r) {
+          std::printf("cold policy: %s\n", r.error().message().c_str());
+          rc = 1;
+        } else if (r.value().sent || !a.watch) {
+          std::fputs(r.value().to_text().c_str(), stdout);
+          rc = r.value().failed.empty() ? 0 : 1;
+        }
+        std::fflush(stdout);
+        if (!a.watch) break;
+        const auto next = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.period_s);
+        while (!stop && std::chrono::steady_clock::now() < next) {
+          co_await core::sleep_for(std::chrono::milliseconds(50));
+          if (a.for_s > 0 && std::chrono::steady_clock::now() - t0 >= std::chrono::duration<double>(a.for_s)) stop = true;
+        }
+      }
+      set_on_signal([] {});
+    }
+    if (action == "upgrade") {
+      if (!uo.expected_version) std::printf("no --version given: versions are reported, not checked\n");
+      auto r = co_await host::upgrade_plane(*fpa, image, uo);
+      const auto rep = need(std::move(r));
+      std::fputs(rep.summary().c_str(), stdout);
+      rc = rep.ok() ? 0 : 1;
+    }
     std::fflush(stdout);
     co_await fpa->close();
     co_return rc;
@@ -127,6 +194,29 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   mv->add_option("--points", a.points, "points per arm (default 20)")->check(CLI::Range(1, 1000));
   mv->add_flag("--sync", a.sync, "start with the PLC's sync line instead of the START_TRAJECTORY broadcast");
   mv->callback([] { exit_code() = run_plane(a, "move"); });
+  auto* up = p->add_subcommand("upgrade",
+                               "firmware of every robot, sextant by sextant: power-cycled into the bootloader by the PLC, "
+                               "upgraded (one retry), powered back, version checked (needs --plc)");
+  up->add_option("--image", a.image, "firmware image file")->required()->check(CLI::ExistingFile);
+  up->add_option("--version", a.version, "version the robots must run afterwards (XX.YY.ZZ); without it, not checked");
+  up->add_option("--sextant", a.sextants, "only these sextants (repeatable; default every sextant with robots)")
+      ->check(CLI::Range(1, 6));
+  up->add_option("--power-off", a.power_off_s, "seconds without positioner power before powering up (default 1)")
+      ->check(CLI::Range(0.0, 60.0));
+  auto* cd = p->add_subcommand("cold",
+                               "cold-temperature policy: PLC temperatures -> speed and holding current of every robot "
+                               "(needs --plc)");
+  cd->add_flag("--watch", a.watch, "keep going: read every --period, send only when the decision changes");
+  cd->add_option("--period", a.period_s, "seconds between readings with --watch (default 60)")->check(CLI::Range(0.05, 86400.0));
+  cd->add_option("--for", a.for_s, "with --watch: stop after this many seconds (default: at a signal)");
+  cd->callback([] {
+    if (a.plc.empty()) throw Exception(usage("fps plane cold needs --plc"));
+    exit_code() = run_plane(a, "cold");
+  });
+  up->callback([] {
+    if (a.plc.empty()) throw Exception(usage("fps plane upgrade needs --plc"));
+    exit_code() = run_plane(a, "upgrade");
+  });
 }
 
 }  // namespace axon::app

@@ -132,6 +132,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
   std::unordered_map<std::uint32_t, PoolEntry> pools;
   std::size_t in_flight = 0;
   std::deque<SlotWaiter*> slot_waiters;
+  std::size_t slot_grants = 0;  // slots handed to waiters that have not resumed yet
   std::unordered_map<std::uint8_t, Collector*> collectors;
   std::unordered_map<std::uint8_t, std::deque<core::Wakeup*>> collector_waiters;
   std::map<std::uint64_t, Handler> subscribers;
@@ -298,7 +299,9 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
   }
 
   asio::awaitable<Result<void>> acquire_slot() {
-    if (slot_waiters.empty() && slot_free()) {
+    // A slot handed to a waiter that has not resumed yet counts as a waiter: taking a free slot
+    // past it would send this request before an earlier one of the same pipeline (out of order).
+    if (slot_waiters.empty() && slot_grants == 0 && slot_free()) {
       ++in_flight;
       co_return ok();
     }
@@ -311,7 +314,10 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
       ~Unlist() { q.erase(std::remove(q.begin(), q.end(), w), q.end()); }
     } unlist{slot_waiters, &w};
     for (;;) {
-      if (w.granted) co_return ok();
+      if (w.granted) {
+        --slot_grants;
+        co_return ok();
+      }
       if (auto r = check_running(); !r) co_return r.error();
       w.wake.reset();
       co_await w.wake.wait_until(core::TimePoint::max());
@@ -323,6 +329,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
       SlotWaiter* w = slot_waiters.front();  // the slot passes on: in_flight stays
       slot_waiters.pop_front();
       w->granted = true;
+      ++slot_grants;
       w->wake.notify();
       return;
     }

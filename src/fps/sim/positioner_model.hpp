@@ -156,6 +156,8 @@ class PositionerModel {
   // The version the robot answers GET_FIRMWARE_VERSION with right now.
   [[nodiscard]] protocol::FirmwareVersion running_version() const noexcept;
   [[nodiscard]] bool led_on() const noexcept { return led_; }
+  // Motor speed set for an arm (SET_SPEED), rpm at the motor.
+  [[nodiscard]] std::uint32_t speed_rpm(Arm a) const noexcept { return arms_[a].speed_rpm; }
   [[nodiscard]] bool collision_detection(Arm a) const noexcept { return arms_[a].detection; }
   [[nodiscard]] const Flash& flash() const noexcept { return flash_; }
   [[nodiscard]] const Calibration& calibration() const noexcept { return cal_; }
