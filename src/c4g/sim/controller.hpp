@@ -36,6 +36,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -168,6 +169,7 @@ class Controller {
   void cyclic_tick();
   void apply_reply();
   void handle_request(std::size_t i, std::int32_t req);
+  void handle_mode_request(std::size_t i, std::int32_t req, const std::function<void(std::string_view)>& refuse);
   void advance_modes();
   void set_mode(std::size_t i, std::int32_t mode, std::string_view why);
   void set_arm_mode(std::size_t arm, std::int32_t mode, std::string_view why);
