@@ -394,7 +394,10 @@ void Controller::apply_reply() {
   for (std::size_t arm = 1; arm <= P::kMaxArms; ++arm) {
     if (!arms_[arm].present || !P::exit_from_open(reply_.infpar, arm)) continue;
     any_exit = true;
-    if (arms_[arm].open) exit_requested_[arm] = true;
+    if (arms_[arm].open && !exit_requested_[arm]) {
+      exit_requested_[arm] = true;
+      arms_[arm].exit_while_moving = arms_[arm].move.active;
+    }
   }
   if (frozen_active_ && any_exit) {
     frozen_active_ = false;
@@ -514,6 +517,7 @@ void Controller::handle_mode_request(std::size_t i, std::int32_t req, const std:
     a.open = true;
     a.type = OpenType::a;  // no program motion asked for: the PC alone moves the arm
     a.open_mode = req;
+    a.exit_while_moving = false;
   }
 }
 
@@ -661,7 +665,17 @@ void Controller::advance_modes() {
       }
       any_open |= is_open_mode(ax.mode) || ax.exit.active || P::base_of_standby(ax.mode).has_value();
     }
-    if (a.open && !any_open) a.open = false;
+    if (a.open && !any_open) {
+      a.open = false;
+      // Chapter 13: the open modality ends on two events, the controller's trajectory end and the
+      // PC's exit-from-open, in either order; say which came last.
+      emit(EventLevel::info, event::kOpenEnd,
+           a.type == OpenType::a
+               ? fmt::format("arm {}: open type A (mode {}) ended by the PC's exit-from-open", arm, a.open_mode)
+               : fmt::format("arm {}: open type B (mode {}) ended: {}", arm, a.open_mode,
+                             a.exit_while_moving ? "PC exit first, then the controller's trajectory end"
+                                                 : "controller's trajectory end first, then the PC exit"));
+    }
   }
 }
 
@@ -879,6 +893,7 @@ bool Controller::start_step(const Step& s) {
         a.open = is_open_mode(s.mode);
         a.type = s.type;
         a.open_mode = s.mode;
+        a.exit_while_moving = false;
       }
       return true;
     case StepKind::move: {

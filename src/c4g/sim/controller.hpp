@@ -157,6 +157,7 @@ class Controller {
     bool open = false;        // a GO OPEN is in progress (until its exit sequence ends)
     OpenType type = OpenType::a;
     std::int32_t open_mode = 0;
+    bool exit_while_moving = false;  // type B: the PC's exit-from-open came before the controller's move ended
     std::uint8_t cmd = 0;
     Move move;
     std::optional<protocol::ArmTransform> transform;
