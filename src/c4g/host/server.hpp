@@ -59,6 +59,10 @@ struct CycleContext {
   // when released) and discards this cycle's reply; the call is neither timed nor counted late, so
   // the controller may do long non-real-time work here (see Server::request_freeze).
   bool frozen = false;
+
+  // The motion type the robot program set for an arm (1..4): its byte of CMD, $ARM_DATA[arm].
+  // C4GOPEN_CMD[1] (manual chapters 8 and 18); 0 when none was set.
+  [[nodiscard]] std::uint8_t motion_type(std::size_t arm) const noexcept { return protocol::arm_byte(request.cmd, arm); }
 };
 
 // Helps the controller fill the reply, which arrives pre-filled with the safe reply.

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 #include <array>
 #include <cstring>
 #include <filesystem>
@@ -357,6 +359,21 @@ TEST(Server, OpenModeFromMode0NeedsDrivesOnAndTheArmAtRest) {
   // Drive off is a special request: accepted whatever the drives and the trajectory do.
   rig.controller.law = [](const CycleContext&, ReplyBuilder& r) { r.set_mode(0, code(Mode::drive_off)); };
   EXPECT_EQ(rig.peer.ask(moving).axes[0].mode, code(Mode::drive_off));
+}
+
+TEST(Server, ControllerSeesTheMotionTypeOfEachArm) {
+  Rig rig;
+  rig.init();
+  std::atomic<int> arm1{-1}, arm2{-1};
+  rig.controller.law = [&](const CycleContext& ctx, ReplyBuilder&) {
+    arm1 = ctx.motion_type(1);
+    arm2 = ctx.motion_type(2);
+  };
+  auto p = cyclic(130, 0);
+  p.cmd = 0x0903;  // arm 1: 3, arm 2: 9
+  rig.peer.ask(p);
+  EXPECT_EQ(arm1.load(), 3);
+  EXPECT_EQ(arm2.load(), 9);
 }
 
 TEST(Server, SafeReplyHoldsTheLastAbsoluteTarget) {
