@@ -8,6 +8,7 @@
 
 #include <cstring>
 #include <iterator>
+#include <thread>
 
 namespace axon::c4g::host {
 
@@ -25,6 +26,17 @@ std::string_view to_string(ServerState s) noexcept {
   return "unknown";
 }
 
+std::string_view to_string(FreezeState s) noexcept {
+  switch (s) {
+    case FreezeState::off: return "off";
+    case FreezeState::pending: return "pending (waiting for mode 0)";
+    case FreezeState::entering: return "entering (500 sent)";
+    case FreezeState::frozen: return "frozen";
+    case FreezeState::leaving: return "leaving (exit-from-open sent)";
+  }
+  return "unknown";
+}
+
 namespace {
 std::int64_t steady_ns() noexcept {
   timespec ts{};
@@ -32,6 +44,12 @@ std::int64_t steady_ns() noexcept {
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 void bump(std::atomic<std::uint64_t>& a) noexcept { a.fetch_add(1, std::memory_order_relaxed); }
+
+bool every_axis_in(const protocol::Packet& p, std::int32_t mode) noexcept {
+  for (std::size_t i = 0; i < p.count; ++i)
+    if (p.axes[i].mode != mode) return false;
+  return p.count > 0;
+}
 
 std::int32_t read_i32(std::span<const std::byte> in, std::size_t offset) noexcept {
   std::uint32_t v = 0;
@@ -193,6 +211,14 @@ void Server::build_safe_reply(const protocol::Packet& req, protocol::Packet& rep
   }
 }
 
+bool Server::arm_trajectory_moving(const protocol::Packet& req, std::size_t arm) const noexcept {
+  for (std::size_t k = 0; k < req.count; ++k) {
+    const std::size_t a = have_axes_ ? axes_.logical(k).arm : 1;
+    if (a == arm && req.axes[k].d2 != 0.0f) return true;
+  }
+  return false;
+}
+
 void Server::enforce_mode_rules(const protocol::Packet& req, protocol::Packet& rep) noexcept {
   rep.num = protocol::reply_number(req.num, options_.numbering);  // not the controller's to change
   rep.count = req.count;
@@ -200,7 +226,15 @@ void Server::enforce_mode_rules(const protocol::Packet& req, protocol::Packet& r
     const std::size_t arm = have_axes_ ? axes_.logical(i).arm : 1;
     if (req.axes[i].mode == code(Mode::mode0)) exit_sent_[i] = false;
     const auto change = protocol::check_mode_change(req.axes[i].mode, rep.axes[i].mode, exit_sent_[i]);
-    if (change != protocol::ModeChange::allowed && change != protocol::ModeChange::unchanged) {
+    bool refused = change != protocol::ModeChange::allowed && change != protocol::ModeChange::unchanged;
+    if (change == protocol::ModeChange::allowed && req.axes[i].mode == code(Mode::mode0) &&
+        !protocol::is_special_mode(rep.axes[i].mode)) {
+      // What the rules cannot see (docs/c4g-server.md, "Who sets the mode"): an open mode needs the
+      // drives on (chapter 11, second phase) and the controller's trajectory at rest (chapter 13:
+      // between two moves); its target velocity D2 tells.
+      refused = !protocol::drives_on(req.infpar, arm) || arm_trajectory_moving(req, arm);
+    }
+    if (refused) {
       bump(counters_.refused_mode_changes);
       rep.axes[i].mode = req.axes[i].mode;
     }
@@ -224,6 +258,71 @@ std::size_t Server::encode(const protocol::Packet& req, protocol::Packet& rep, s
   return protocol::encode_packet(rep, out).ok() ? protocol::packet_size(rep.count) : 0;
 }
 
+bool Server::wait_frozen(std::chrono::nanoseconds timeout) const {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (!frozen()) {
+    if (std::chrono::steady_clock::now() >= until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+bool Server::update_freeze(const protocol::Packet& req) noexcept {
+  const bool want = freeze_wanted_.load(std::memory_order_acquire);
+  FreezeState st = freeze_state_.load(std::memory_order_relaxed);
+  const bool all0 = every_axis_in(req, code(Mode::mode0));
+  const bool all500 = every_axis_in(req, code(Mode::freezing_active));
+  switch (st) {
+    case FreezeState::off:
+      if (want) st = all0 && have_init_ ? FreezeState::entering : FreezeState::pending;
+      break;
+    case FreezeState::pending:
+      if (!want) st = FreezeState::off;
+      else if (all0 && have_init_) st = FreezeState::entering;
+      break;
+    case FreezeState::entering:
+      if (all500) {
+        bump(counters_.freezes);
+        st = want ? FreezeState::frozen : FreezeState::leaving;
+      } else if (!want) {
+        st = FreezeState::off;  // the controller never took it: nothing to undo
+      } else if (!all0) {
+        st = FreezeState::pending;  // the controller moved on (drive on, a program mode): wait for mode 0
+      }
+      break;
+    case FreezeState::frozen:
+      if (!all500) st = want ? FreezeState::pending : FreezeState::off;  // left by the controller (drive off, restart)
+      else if (!want) st = FreezeState::leaving;
+      break;
+    case FreezeState::leaving:
+      if (!every_axis_in(req, code(Mode::freezing_active))) st = want ? FreezeState::pending : FreezeState::off;
+      break;
+  }
+  freeze_state_.store(st, std::memory_order_release);
+  return st == FreezeState::entering || st == FreezeState::frozen || st == FreezeState::leaving;
+}
+
+void Server::build_freeze_reply(const protocol::Packet& req, protocol::Packet& rep) noexcept {
+  const FreezeState st = freeze_state_.load(std::memory_order_relaxed);
+  rep.num = protocol::reply_number(req.num, options_.numbering);
+  rep.infpar = 0;
+  rep.cmd = 0;
+  rep.count = req.count;
+  for (std::size_t i = 0; i < req.count; ++i) {
+    rep.axes[i] = protocol::Axis{};
+    // Mode 0 content is meaningless to the controller (the manual's precondition), so zero data.
+    rep.axes[i].mode = code(Mode::freezing_active);
+  }
+  if (st == FreezeState::leaving) {
+    if (have_axes_) {
+      for (std::size_t arm = 1; arm <= protocol::kMaxArms; ++arm)
+        if (axes_.arm_count(arm) > 0) rep.infpar = protocol::request_exit_from_open(rep.infpar, arm);
+    } else {
+      rep.infpar = protocol::request_exit_from_open(rep.infpar, 1);
+    }
+  }
+}
+
 std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Datagram& info, std::span<std::byte> out) noexcept {
   bump(counters_.cyclic_packets);
   const auto fault = have_init_ && have_axes_
@@ -231,13 +330,14 @@ std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Data
                          : protocol::decode_packet(in, request_);
   if (!fault.ok()) return answer_bad_cyclic(in, out);
 
+  const bool freezing = update_freeze(request_);
   build_safe_reply(request_, safe_);
   reply_ = safe_;
   bool used_controller = false;
   safety_.begin_cycle();
   if (!safety_.faulted()) {
-    const CycleContext ctx{request_, have_init_ ? &init_ : nullptr, have_axes_ ? &axes_ : nullptr, cyclic_count_,
-                           info.wall_ns};
+    const CycleContext ctx{request_,      have_init_ ? &init_ : nullptr, have_axes_ ? &axes_ : nullptr, cyclic_count_,
+                           info.wall_ns, freezing};
     ReplyBuilder builder(reply_);
     const std::int64_t t0 = steady_ns();
     try {
@@ -249,16 +349,24 @@ std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Data
       reply_ = safe_;
     }
     const std::int64_t took = steady_ns() - t0;
-    if (took > options_.controller_budget.count()) {
+    if (freezing) {
+      late_in_row_ = 0;  // the controller no longer checks replies: lateness is allowed
+    } else if (took > options_.controller_budget.count()) {
       bump(counters_.controller_late);
       if (options_.max_late_cycles > 0 && ++late_in_row_ >= options_.max_late_cycles)
         safety_.trip(FaultReason::controller_late);
     } else {
       late_in_row_ = 0;
     }
-    if (used_controller) enforce_mode_rules(request_, reply_);
+    if (used_controller && !freezing) enforce_mode_rules(request_, reply_);
   }
-  if (!used_controller) bump(counters_.safe_replies);
+  if (freezing) {
+    bump(counters_.frozen_cycles);
+    build_freeze_reply(request_, reply_);
+    used_controller = false;
+  } else if (!used_controller) {
+    bump(counters_.safe_replies);
+  }
   ++cyclic_count_;
   safety_.apply(request_, reply_);
   return encode(request_, reply_, out);
@@ -269,10 +377,11 @@ std::string Server::summary() const {
   auto it = std::back_inserter(out);
   fmt::format_to(it,
                  "Packets {} (init {}, cyclic {}), protocol errors {}, unanswered {}, controller exceptions {}, "
-                 "late {}, refused mode changes {}, safe replies {}\n",
+                 "late {}, refused mode changes {}, safe replies {}, frozen cycles {} (freezes {}, now {})\n",
                  counters_.packets.load(), counters_.init_packets.load(), counters_.cyclic_packets.load(),
                  counters_.protocol_errors.load(), counters_.unanswered.load(), counters_.controller_exceptions.load(),
-                 counters_.controller_late.load(), counters_.refused_mode_changes.load(), counters_.safe_replies.load());
+                 counters_.controller_late.load(), counters_.refused_mode_changes.load(), counters_.safe_replies.load(),
+                 counters_.frozen_cycles.load(), counters_.freezes.load(), to_string(freeze_state()));
   fmt::format_to(it, "Safety: {} (axis {}), currents clamped {}, drive-off replies {}, following-error replies {}\n",
                  to_string(safety_.reason()), safety_.fault_axis(), safety_.counters().currents_clamped.load(),
                  safety_.counters().drive_off_replies.load(), safety_.counters().following_error_replies.load());

@@ -55,6 +55,14 @@ struct CycleContext {
   const protocol::AxisMap* axes;      // nullptr until then (or if its axis lists were bad)
   std::uint64_t cycle;                // cyclic packets handled so far (0 for the first)
   std::int64_t arrival_wall_ns;       // kernel arrival stamp (or clock at receive)
+  // Active freezing (500) is in force: the Server answers on its own (every axis 500, exit-from-open
+  // when released) and discards this cycle's reply; the call is neither timed nor counted late, so
+  // the controller may do long non-real-time work here (see Server::request_freeze).
+  bool frozen = false;
+
+  // The motion type the robot program set for an arm (1..4): its byte of CMD, $ARM_DATA[arm].
+  // C4GOPEN_CMD[1] (manual chapters 8 and 18); 0 when none was set.
+  [[nodiscard]] std::uint8_t motion_type(std::size_t arm) const noexcept { return protocol::arm_byte(request.cmd, arm); }
 };
 
 // Helps the controller fill the reply, which arrives pre-filled with the safe reply.
@@ -117,7 +125,19 @@ struct ServerCounters {
   std::atomic<std::uint64_t> controller_late{0};
   std::atomic<std::uint64_t> refused_mode_changes{0};  // controller asked for a change the rules forbid
   std::atomic<std::uint64_t> safe_replies{0};      // cycles answered without the controller's reply
+  std::atomic<std::uint64_t> frozen_cycles{0};     // cycles answered under active freezing (500 .. back to 0)
+  std::atomic<std::uint64_t> freezes{0};           // active freezings the controller entered
 };
+
+// Active freezing (special mode 500), as the Server drives it.
+enum class FreezeState : std::uint8_t {
+  off,       // normal exchange
+  pending,   // asked for; waits until every axis shows mode 0 (the manual's precondition)
+  entering,  // 500 sent on every axis; the controller has not shown it yet
+  frozen,    // the controller shows 500: it no longer checks the PC's replies
+  leaving,   // released: exit-from-open sent on every arm until the controller shows mode 0
+};
+std::string_view to_string(FreezeState s) noexcept;
 
 class Server : private CycleHandler {
  public:
@@ -143,6 +163,40 @@ class Server : private CycleHandler {
   [[nodiscard]] const PcapRecorder* recorder() const noexcept { return recorder_.get(); }
   [[nodiscard]] std::string summary() const;
 
+  // ---- active freezing (500) ----
+  // request_freeze(): from the next packet in which every axis is in mode 0 (drives on or off, not
+  // while driving on), the Server answers 500 on every axis; once the controller shows 500 it stops
+  // checking replies, so this process may stall (file I/O, allocation, a debugger) without a
+  // communication error. release_freeze(): the Server sends exit-from-open on every arm until the
+  // controller shows mode 0 again, then the normal exchange resumes. Any thread; atomics only.
+  // While in force the Controller is still called with ctx.frozen = true (its reply is discarded,
+  // the call is not timed); a latched safety fault overrides the freeze (drive off goes out).
+  void request_freeze() noexcept { freeze_wanted_.store(true, std::memory_order_release); }
+  void release_freeze() noexcept { freeze_wanted_.store(false, std::memory_order_release); }
+  [[nodiscard]] bool freeze_requested() const noexcept { return freeze_wanted_.load(std::memory_order_acquire); }
+  [[nodiscard]] FreezeState freeze_state() const noexcept { return freeze_state_.load(std::memory_order_acquire); }
+  // The controller no longer checks replies (state frozen).
+  [[nodiscard]] bool frozen() const noexcept { return freeze_state() == FreezeState::frozen; }
+
+  // Scoped freeze: requests on construction, releases on destruction. It does not wait: poll
+  // frozen() (or wait_frozen) before starting the long work.
+  class FreezeGuard {
+   public:
+    explicit FreezeGuard(Server& s) noexcept : s_(&s) { s.request_freeze(); }
+    ~FreezeGuard() { if (s_ != nullptr) s_->release_freeze(); }
+    FreezeGuard(FreezeGuard&& o) noexcept : s_(o.s_) { o.s_ = nullptr; }
+    FreezeGuard(const FreezeGuard&) = delete;
+    FreezeGuard& operator=(const FreezeGuard&) = delete;
+    FreezeGuard& operator=(FreezeGuard&&) = delete;
+
+   private:
+    Server* s_;
+  };
+  [[nodiscard]] FreezeGuard freeze() noexcept { return FreezeGuard(*this); }
+  // Polls (1 ms sleeps; not for the cycle thread) until the controller shows 500 or the timeout
+  // passes; true when frozen.
+  bool wait_frozen(std::chrono::nanoseconds timeout) const;
+
  private:
   Server(Controller& controller, const ServerOptions& options);
   std::size_t on_packet(std::span<const std::byte> request, const net::Datagram& info,
@@ -154,6 +208,10 @@ class Server : private CycleHandler {
   std::size_t answer_bad_cyclic(std::span<const std::byte> in, std::span<std::byte> out) noexcept;
   void build_safe_reply(const protocol::Packet& request, protocol::Packet& reply) noexcept;
   void enforce_mode_rules(const protocol::Packet& request, protocol::Packet& reply) noexcept;
+  bool arm_trajectory_moving(const protocol::Packet& request, std::size_t arm) const noexcept;
+  // Advances the freeze state for this request; true when the freeze owns this cycle's reply.
+  bool update_freeze(const protocol::Packet& request) noexcept;
+  void build_freeze_reply(const protocol::Packet& request, protocol::Packet& reply) noexcept;
   std::size_t encode(const protocol::Packet& request, protocol::Packet& reply, std::span<std::byte> out) noexcept;
 
   Controller& controller_;
@@ -163,6 +221,8 @@ class Server : private CycleHandler {
   Safety safety_;
   ServerCounters counters_;
   std::atomic<ServerState> state_{ServerState::waiting};
+  std::atomic<bool> freeze_wanted_{false};
+  std::atomic<FreezeState> freeze_state_{FreezeState::off};
 
   mutable std::mutex init_mutex_;  // init_copy_ only; the cycle thread takes it once per init packet
   std::optional<protocol::InitPacket> init_copy_;

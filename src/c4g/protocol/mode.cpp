@@ -153,8 +153,12 @@ ModeChange check_mode_change(std::int32_t current, std::int32_t requested, bool 
   if (!is_known_mode(requested)) return ModeChange::unknown_mode;
   if (requested == code(Mode::drive_off) || requested == code(Mode::following_error)) return ModeChange::allowed;
   if (current == code(Mode::driving_on)) return ModeChange::driving_on;
-  if (current == code(Mode::mode0)) return ModeChange::allowed;
   const ModeInfo* r = find_mode(requested);
+  if (requested == code(Mode::mode2_standby) && current == code(Mode::mode2)) return ModeChange::allowed;
+  if (r->kind == ModeKind::standby || (r->kind == ModeKind::special && r->origin == Origin::controller &&
+                                       requested != code(Mode::server_restart)))
+    return ModeChange::controller_only;
+  if (current == code(Mode::mode0)) return ModeChange::allowed;
   if (r->kind == ModeKind::special) return ModeChange::not_from_mode0;  // specials need mode 0 first
   return exit_from_open_sent ? ModeChange::allowed : ModeChange::not_from_mode0;
 }
@@ -166,6 +170,7 @@ std::string_view to_string(ModeChange c) noexcept {
     case ModeChange::unknown_mode: return "unknown mode";
     case ModeChange::driving_on: return "refused while the drives are switching on";
     case ModeChange::not_from_mode0: return "refused: change modes from mode 0 or after exit-from-open";
+    case ModeChange::controller_only: return "refused: only the controller issues this code";
   }
   return "?";
 }

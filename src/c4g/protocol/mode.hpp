@@ -79,6 +79,8 @@ struct ModeInfo {
 // nullptr for codes the interface does not define (including 507 and 0xFF).
 const ModeInfo* find_mode(std::int32_t code) noexcept;
 inline bool is_known_mode(std::int32_t code) noexcept { return find_mode(code) != nullptr; }
+// The special codes 500..508 (freezing, driving on, exit, drive off, restart, following error).
+constexpr bool is_special_mode(std::int32_t code) noexcept { return code >= 500 && code <= 508; }
 std::string_view mode_name(std::int32_t code) noexcept;  // "unknown" when not defined
 std::span<const ModeInfo> all_modes() noexcept;           // every named mode, in code order
 // Accepts a name ("mode4", "drive_off"), a label ("0'", "1'") or a number ("505").
@@ -88,12 +90,16 @@ std::optional<std::int32_t> parse_mode(std::string_view text) noexcept;
 Fault check_modes(const Packet& pkt) noexcept;
 
 // ---- Mode changes -------------------------------------------------------------------------------
-// Whether the controller accepts a change of an axis from `current` to `requested`. Rules (manual
-// chapters 11, 13, 15 and the field libraries): unchanged is always fine; drive-off (505) and
-// following-error (508) requests are always accepted; while driving on (501) nothing else is; the
-// other special codes need mode 0; any other mode may be entered only from mode 0 or once the PC has
-// sent exit-from-open; codes the interface does not define are refused.
-enum class ModeChange { allowed, unchanged, unknown_mode, driving_on, not_from_mode0 };
+// Whether the controller accepts a change of an axis from `current` to `requested` asked by the PC.
+// Rules (manual chapters 11, 13, 15 and the field libraries): unchanged is always fine; drive-off
+// (505) and following-error (508) requests are always accepted; while driving on (501) nothing else
+// is (15.2); codes only the controller issues (the standby codes, 501..504) are refused, except 2'
+// from mode 2 (the PC starts the end of mode 2, state machine 24.2.4); the other special codes need
+// mode 0; any other mode may be entered from mode 0 (the PC may set a mode once the drives are on,
+// chapter 11 second phase and 15.2) or once the PC has sent exit-from-open; codes the interface does
+// not define are refused. What this function cannot see (drives on, the controller's trajectory
+// still moving) is checked by its callers: see docs/c4g-server.md, "Who sets the mode".
+enum class ModeChange { allowed, unchanged, unknown_mode, driving_on, not_from_mode0, controller_only };
 ModeChange check_mode_change(std::int32_t current, std::int32_t requested, bool exit_from_open_sent) noexcept;
 inline bool may_set_mode(std::int32_t current, std::int32_t requested, bool exit_from_open_sent) noexcept {
   const auto c = check_mode_change(current, requested, exit_from_open_sent);

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <numbers>
 
@@ -393,7 +394,10 @@ void Controller::apply_reply() {
   for (std::size_t arm = 1; arm <= P::kMaxArms; ++arm) {
     if (!arms_[arm].present || !P::exit_from_open(reply_.infpar, arm)) continue;
     any_exit = true;
-    if (arms_[arm].open) exit_requested_[arm] = true;
+    if (arms_[arm].open && !exit_requested_[arm]) {
+      exit_requested_[arm] = true;
+      arms_[arm].exit_while_moving = arms_[arm].move.active;
+    }
   }
   if (frozen_active_ && any_exit) {
     frozen_active_ = false;
@@ -425,7 +429,7 @@ void Controller::handle_request(std::size_t i, std::int32_t req) {
          fmt::format("arm {} axis {}: the PC sent mode {} while in {}: {}", ax.arm, ax.axis, mode_text(req), mode_text(cur), why));
   };
   if (!pc_special) {
-    refuse("modes are set by the robot program; the PC may only send 500, 505, 506 or 508");
+    handle_mode_request(i, req, refuse);
     return;
   }
   if (cur == P::code(P::Mode::driving_on)) {
@@ -470,6 +474,50 @@ void Controller::handle_request(std::size_t i, std::int32_t req) {
       break;
     }
     default: break;
+  }
+}
+
+// A mode asked by the PC (chapter 11, second phase; 15.2: the mode is the one set by the PC or by
+// the program): taken from mode 0 once the drives are on and the arm's trajectory is at rest
+// (chapter 13: modes change between moves). While the PC's own exit-from-open is carried out, its
+// SM field is not a request (the next mode is taken from mode 0).
+void Controller::handle_mode_request(std::size_t i, std::int32_t req, const std::function<void(std::string_view)>& refuse) {
+  AxisSim& ax = axes_[i];
+  const std::int32_t cur = ax.mode;
+  if (ax.exit.active) return;
+  if (cur == P::code(P::Mode::driving_on)) {
+    refuse("ignored while driving on (501)");
+    return;
+  }
+  const auto change = P::check_mode_change(cur, req, false);
+  if (change != P::ModeChange::allowed) {
+    refuse(P::to_string(change));
+    return;
+  }
+  ArmSim& a = arms_[ax.arm];
+  if (req == P::code(P::Mode::mode2_standby)) {  // the PC ends mode 2 (state machine, mode 2)
+    start_exit(ax.arm);
+    return;
+  }
+  if (!drives_on(ax.arm)) {
+    refuse("the drives are off: open modes are set once they are on (chapter 11)");
+    return;
+  }
+  if (a.move.active) {
+    refuse("the robot moves: modes change only between two moves (chapter 13)");
+    return;
+  }
+  const P::ModeInfo* info = P::find_mode(req);
+  if (info == nullptr || !info->available) {
+    refuse("not available on this controller");
+    return;
+  }
+  set_mode(i, req, {});
+  if (is_open_mode(req) && !a.open) {
+    a.open = true;
+    a.type = OpenType::a;  // no program motion asked for: the PC alone moves the arm
+    a.open_mode = req;
+    a.exit_while_moving = false;
   }
 }
 
@@ -617,7 +665,17 @@ void Controller::advance_modes() {
       }
       any_open |= is_open_mode(ax.mode) || ax.exit.active || P::base_of_standby(ax.mode).has_value();
     }
-    if (a.open && !any_open) a.open = false;
+    if (a.open && !any_open) {
+      a.open = false;
+      // Chapter 13: the open modality ends on two events, the controller's trajectory end and the
+      // PC's exit-from-open, in either order; say which came last.
+      emit(EventLevel::info, event::kOpenEnd,
+           a.type == OpenType::a
+               ? fmt::format("arm {}: open type A (mode {}) ended by the PC's exit-from-open", arm, a.open_mode)
+               : fmt::format("arm {}: open type B (mode {}) ended: {}", arm, a.open_mode,
+                             a.exit_while_moving ? "PC exit first, then the controller's trajectory end"
+                                                 : "controller's trajectory end first, then the PC exit"));
+    }
   }
 }
 
@@ -835,6 +893,7 @@ bool Controller::start_step(const Step& s) {
         a.open = is_open_mode(s.mode);
         a.type = s.type;
         a.open_mode = s.mode;
+        a.exit_while_moving = false;
       }
       return true;
     case StepKind::move: {

@@ -36,6 +36,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -156,6 +157,7 @@ class Controller {
     bool open = false;        // a GO OPEN is in progress (until its exit sequence ends)
     OpenType type = OpenType::a;
     std::int32_t open_mode = 0;
+    bool exit_while_moving = false;  // type B: the PC's exit-from-open came before the controller's move ended
     std::uint8_t cmd = 0;
     Move move;
     std::optional<protocol::ArmTransform> transform;
@@ -168,6 +170,7 @@ class Controller {
   void cyclic_tick();
   void apply_reply();
   void handle_request(std::size_t i, std::int32_t req);
+  void handle_mode_request(std::size_t i, std::int32_t req, const std::function<void(std::string_view)>& refuse);
   void advance_modes();
   void set_mode(std::size_t i, std::int32_t mode, std::string_view why);
   void set_arm_mode(std::size_t arm, std::int32_t mode, std::string_view why);

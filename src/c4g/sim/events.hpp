@@ -26,6 +26,7 @@ inline constexpr std::string_view kSynchronised = "SYNCHRONISED";
 inline constexpr std::string_view kInitSent = "INIT_PACKET_SENT";
 inline constexpr std::string_view kRequestRefused = "REQUEST_REFUSED";
 inline constexpr std::string_view kFreezing = "FREEZING";
+inline constexpr std::string_view kOpenEnd = "OPEN_END";  // an arm's open modality ended (type, which event came last)
 inline constexpr std::string_view kStep = "STEP";
 inline constexpr std::string_view kScenarioDone = "SCENARIO_DONE";
 inline constexpr std::string_view kScenarioError = "SCENARIO_ERROR";

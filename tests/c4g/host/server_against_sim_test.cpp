@@ -270,6 +270,105 @@ TEST(ServerAgainstSim, ActiveFreezing500ToleratesAStalledPcUntilExitFromOpen) {
   EXPECT_TRUE(done);
 }
 
+TEST(ServerAgainstSim, RequestFreezeFromAnotherThreadSends500AndLetsTheControllerStallWithoutFaults) {
+  // The application asks for a freeze from a non-real-time thread once the drives are on; the
+  // Server enters 500 on its own, the controller (called with ctx.frozen) then blocks three cycles in
+  // a row for 30 ms each: unfrozen that is a communication error for the robot controller and a
+  // controller_late fault for the Server (budget 5 ms here, three late calls in a row). Released, the
+  // Server sends exit-from-open until mode 0 shows, and the normal exchange resumes.
+  TestController pc;
+  std::atomic<bool> ready{false};
+  std::atomic<int> stalls{0}, frozen_calls{0}, normal_after{0};
+  std::atomic<bool> saw_frozen{false};
+  pc.cycle = [&](const H::CycleContext& ctx, H::ReplyBuilder& r) {
+    if (P::drives_on(ctx.request.infpar, 1) && all_modes(ctx.request, 0)) ready = true;
+    if (ctx.frozen) {
+      ++frozen_calls;
+      r.set_mode(0, 4);  // discarded: the freeze owns the reply
+      if (all_modes(ctx.request, 500)) {
+        saw_frozen = true;
+        if (stalls < 3) {
+          ++stalls;
+          std::this_thread::sleep_for(std::chrono::milliseconds(30));
+        }
+      }
+    } else if (saw_frozen && all_modes(ctx.request, 0)) {
+      ++normal_after;
+    }
+  };
+  H::ServerOptions o;  // start_server() turns the lateness check off; this test needs it on
+  o.listen = net::Endpoint{"127.0.0.1", 0};
+  o.max_late_cycles = 3;
+  o.controller_budget = std::chrono::milliseconds(5);  // only the 30 ms stalls are late
+  auto started = H::Server::start(pc, o);
+  ASSERT_TRUE(started) << started.error().detail;
+  auto server = std::move(started).value();
+  std::thread control([&] {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (!ready && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    server->request_freeze();
+    EXPECT_TRUE(server->wait_frozen(std::chrono::seconds(5))) << to_string(server->freeze_state());
+    while (stalls < 3 && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    server->release_freeze();
+    while (server->freeze_state() != H::FreezeState::off && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  });
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - delay: 3.0
+  - exit_open)");
+  control.join();
+  server->stop();
+  EXPECT_TRUE(run.c->scenario_done()) << run.log();
+  EXPECT_FALSE(run.c->communication_error()) << run.log();
+  EXPECT_TRUE(run.has(S::event::kFreezing, "active freezing (500)")) << run.log();
+  EXPECT_TRUE(run.has(S::event::kFreezing, "ended by the PC's exit-from-open")) << run.log();
+  EXPECT_EQ(run.c->stats().refused_requests, 0u) << run.log();
+  EXPECT_EQ(stalls.load(), 3);
+  EXPECT_GT(normal_after.load(), 0);
+  EXPECT_EQ(server->counters().freezes.load(), 1u);
+  EXPECT_GE(server->counters().frozen_cycles.load(), static_cast<std::uint64_t>(frozen_calls.load()));
+  EXPECT_EQ(server->counters().controller_late.load(), 0u);
+  EXPECT_EQ(server->safety().reason(), H::FaultReason::none) << server->summary();
+  EXPECT_EQ(server->freeze_state(), H::FreezeState::off);
+}
+
+TEST(ServerAgainstSim, FreezeRequestedOutsideMode0WaitsForMode0) {
+  // In mode 7 the PC's corrections matter to the controller: the freeze waits (pending) until the
+  // program's open mode ended and every axis shows mode 0.
+  TestController pc;
+  std::atomic<int> cycles7{0};
+  std::atomic<bool> asked{false};
+  std::atomic<bool> frozen_in7{false};
+  H::Server* srv = nullptr;
+  pc.cycle = [&](const H::CycleContext& ctx, H::ReplyBuilder& r) {
+    const auto m = ctx.request.axes[0].mode;
+    if (m == 7) {
+      if (ctx.frozen) frozen_in7 = true;
+      if (++cycles7 == 5) {
+        srv->request_freeze();  // from the cycle thread here only to time it; any thread may
+        asked = true;
+      }
+      if (cycles7 > 50) r.exit_from_open(1);
+    }
+    if (m == 500 && ctx.frozen) srv->release_freeze();
+  };
+  auto server = start_server(pc);
+  srv = server.get();
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - go_open: {type: A, mode: 7, arms: [1]}
+  - wait_for_pc: {timeout: 5}
+  - delay: 0.5
+  - exit_open)");
+  server->stop();
+  EXPECT_TRUE(run.c->scenario_done()) << run.log();
+  EXPECT_TRUE(asked.load());
+  EXPECT_FALSE(frozen_in7.load());
+  EXPECT_EQ(server->counters().freezes.load(), 1u) << server->summary();
+  EXPECT_EQ(run.c->stats().refused_requests, 0u) << run.log();
+}
+
 // ---- mode-change rules ------------------------------------------------------------------------------
 
 TEST(ServerAgainstSim, ForbiddenModeRequestsAreRefusedByTheServerAndNeverReachTheController) {
@@ -302,6 +401,41 @@ TEST(ServerAgainstSim, ForbiddenModeRequestsAreRefusedByTheServerAndNeverReachTh
   EXPECT_FALSE(run.has(S::event::kRequestRefused));
   // The PC's exit came while the controller's move still ran: 7' until it ends, then 7'', then 0.
   EXPECT_EQ(modes, (std::vector<std::int32_t>{0, 501, 7, 17, 170, 0, 504})) << run.log();
+}
+
+TEST(ServerAgainstSim, ThePcSetsAnOpenModeFromMode0AndBothSidesAgree) {
+  // Chapter 11 (second phase) and 15.2: with the drives on and the robot at rest, the PC may set the
+  // mode itself; the Server lets the request through, the controller takes it, and the PC's
+  // exit-from-open ends it. During drive on (501) the same request is refused by the Server.
+  TestController pc;
+  std::atomic<int> cycles9{0};
+  std::atomic<bool> done{false};
+  std::vector<std::int32_t> modes;
+  pc.cycle = [&](const H::CycleContext& ctx, H::ReplyBuilder& r) {
+    const auto m = ctx.request.axes[0].mode;
+    if (modes.empty() || modes.back() != m) modes.push_back(m);
+    if (m == 501) {
+      for (std::size_t i = 0; i < r.axis_count(); ++i) r.set_mode(i, 9);
+    } else if (m == 9) {
+      if (++cycles9 > 50) {
+        r.exit_from_open(1);
+        done = true;
+      }
+    } else if (m == 0 && !done && P::drives_on(ctx.request.infpar, 1)) {
+      for (std::size_t i = 0; i < r.axis_count(); ++i) r.set_mode(i, 9);
+    }
+  };
+  auto server = start_server(pc);
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - delay: 1.0
+  - exit_open)");
+  server->stop();
+  EXPECT_TRUE(run.c->scenario_done()) << run.log();
+  EXPECT_EQ(run.c->stats().refused_requests, 0u) << run.log();
+  EXPECT_GE(server->counters().refused_mode_changes.load(), 1u);  // the ones during 501
+  EXPECT_EQ(modes, (std::vector<std::int32_t>{0, 501, 0, 9, 0, 504})) << run.log();
+  EXPECT_GT(cycles9.load(), 50);
 }
 
 // ---- silence on either side --------------------------------------------------------------------------

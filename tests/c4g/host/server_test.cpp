@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 #include <array>
 #include <cstring>
 #include <filesystem>
@@ -340,6 +342,38 @@ TEST(Server, ForbiddenModeChangesAreRefused) {
   const auto a = rig.peer.ask(cyclic(92, code(Mode::mode7)));
   EXPECT_EQ(a.axes[1].mode, code(Mode::drive_off));
   EXPECT_TRUE(protocol::exit_from_open(a.infpar, 1));
+}
+
+TEST(Server, OpenModeFromMode0NeedsDrivesOnAndTheArmAtRest) {
+  Rig rig;
+  rig.init();
+  rig.controller.law = [](const CycleContext&, ReplyBuilder& r) { r.set_mode(0, code(Mode::mode4)); };
+  auto off = cyclic(120, 0);
+  off.infpar = 0;  // drives off
+  EXPECT_EQ(rig.peer.ask(off).axes[0].mode, 0);
+  auto moving = cyclic(121, 0);
+  moving.axes[1].d2 = 0.01f;  // the controller's trajectory moves (target velocity)
+  EXPECT_EQ(rig.peer.ask(moving).axes[0].mode, 0);
+  EXPECT_EQ(rig.server->counters().refused_mode_changes.load(), 2u);
+  EXPECT_EQ(rig.peer.ask(cyclic(122, 0)).axes[0].mode, code(Mode::mode4));
+  // Drive off is a special request: accepted whatever the drives and the trajectory do.
+  rig.controller.law = [](const CycleContext&, ReplyBuilder& r) { r.set_mode(0, code(Mode::drive_off)); };
+  EXPECT_EQ(rig.peer.ask(moving).axes[0].mode, code(Mode::drive_off));
+}
+
+TEST(Server, ControllerSeesTheMotionTypeOfEachArm) {
+  Rig rig;
+  rig.init();
+  std::atomic<int> arm1{-1}, arm2{-1};
+  rig.controller.law = [&](const CycleContext& ctx, ReplyBuilder&) {
+    arm1 = ctx.motion_type(1);
+    arm2 = ctx.motion_type(2);
+  };
+  auto p = cyclic(130, 0);
+  p.cmd = 0x0903;  // arm 1: 3, arm 2: 9
+  rig.peer.ask(p);
+  EXPECT_EQ(arm1.load(), 3);
+  EXPECT_EQ(arm2.load(), 9);
 }
 
 TEST(Server, SafeReplyHoldsTheLastAbsoluteTarget) {

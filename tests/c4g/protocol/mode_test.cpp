@@ -89,6 +89,9 @@ TEST(C4gMode, ModeChangeRules) {
   EXPECT_EQ(check_mode_change(501, 0, false), ModeChange::driving_on);
   EXPECT_EQ(check_mode_change(0, 507, false), ModeChange::unknown_mode);
   EXPECT_EQ(check_mode_change(0, 500, false), ModeChange::allowed);       // freezing from mode 0
+  EXPECT_EQ(check_mode_change(0, 14, false), ModeChange::controller_only);   // standby codes are the controller's
+  EXPECT_EQ(check_mode_change(0, 502, false), ModeChange::controller_only);  // so is passive freezing
+  EXPECT_EQ(check_mode_change(2, 12, false), ModeChange::allowed);         // the PC starts the end of mode 2
   EXPECT_EQ(check_mode_change(4, 500, true), ModeChange::not_from_mode0);  // ... only from mode 0
   EXPECT_TRUE(may_set_mode(2, 2, false));
   EXPECT_FALSE(may_set_mode(2, 9, false));

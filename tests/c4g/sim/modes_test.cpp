@@ -259,11 +259,41 @@ TEST(C4gSimModes, PassiveFreezingAndExitOpen) {
   EXPECT_EQ(silent, 50u);  // 0.1 s at 2 ms without packets
 }
 
-TEST(C4gSimModes, ThePcCannotSetAnOrdinaryMode) {
+TEST(C4gSimModes, ThePcSetsAModeFromMode0OnlyWithDrivesOnAndTheArmAtRest) {
+  // Chapter 11 (second phase) and 15.2: once driven on, the mode is the one the PC or the program
+  // set; chapter 13: only between two moves. The PC's mode 4 holds the actual position.
+  auto c = make_controller("steps:\n  - delay: 0.1\n  - drive_on\n  - move: {deg: [5], duration: 0.5}\n  - run\n");
+  PcResponder pc;
+  pc.fill = [](const P::Packet& q, P::Packet& r) {
+    for (std::size_t i = 0; i < r.count; ++i) {
+      r.axes[i].mode = 4;
+      r.axes[i].d1 = q.axes[i].d3;
+    }
+  };
+  pc.run(c, 10);  // drives off: refused, once per change of the request
+  EXPECT_TRUE(all_modes(c, 0));
+  EXPECT_GE(c.stats().refused_requests, 1u);
+  ASSERT_TRUE(pc.run_until(c, [&] { return c.drives_on(1); }, 500));
+  pc.run(c, 20);  // the move runs: still refused
+  EXPECT_TRUE(all_modes(c, 0));
+  const auto refused_before = c.stats().refused_requests;
+  EXPECT_GE(pc.count_events(event::kRequestRefused), 1u);
+  ASSERT_TRUE(pc.run_until(c, [&] { return all_modes(c, 4); }, 1000));  // taken once the move ended
+  EXPECT_EQ(c.stats().refused_requests, refused_before);
+  // The PC's exit-from-open ends it (4' then 0); its SM meanwhile is no request.
+  pc.fill = [](const P::Packet& q, P::Packet& r) {
+    r.infpar = P::request_exit_from_open(0, 1);
+    for (std::size_t i = 0; i < r.count; ++i) r.axes[i].d1 = q.axes[i].d3;
+  };
+  ASSERT_TRUE(pc.run_until(c, [&] { return all_modes(c, 0); }, 200));
+  EXPECT_EQ(c.stats().refused_requests, refused_before);
+}
+
+TEST(C4gSimModes, ThePcCannotIssueTheControllersCodes) {
   auto c = make_controller("steps:\n  - drive_on\n  - run\n");
   PcResponder pc;
   ASSERT_TRUE(pc.run_until(c, [&] { return c.drives_on(1); }));
-  pc.fill = [](const P::Packet&, P::Packet& r) { r.axes[0].mode = 4; };
+  pc.fill = [](const P::Packet&, P::Packet& r) { r.axes[0].mode = 14; };  // a standby code
   pc.run(c, 5);
   EXPECT_EQ(c.axis_mode(0), 0);
   EXPECT_EQ(c.stats().refused_requests, 1u);  // reported once per change of the request
