@@ -31,6 +31,7 @@
 #include "c4g/sim/events.hpp"
 #include "c4g/sim/robots.hpp"
 #include "c4g/sim/scenario.hpp"
+#include "c4g/sim/soft_switch.hpp"
 #include "core/error.hpp"
 
 #include <array>
@@ -112,6 +113,8 @@ class Controller {
   [[nodiscard]] double axis_current(std::size_t open) const noexcept { return axes_[open].model.current(); }
   [[nodiscard]] double axis_reference(std::size_t open) const noexcept { return axes_[open].ref_pos; }
   [[nodiscard]] const AxisModel& axis_model(std::size_t open) const noexcept { return axes_[open].model; }
+  // Soft control switching of an axis as of the last period (interval none when no switch is under way).
+  [[nodiscard]] const protocol::SwitchSample& axis_switch(std::size_t open) const noexcept { return axes_[open].scs.last(); }
   [[nodiscard]] float axis_measure(std::size_t open) const noexcept { return axes_[open].measure; }
   [[nodiscard]] bool drives_on(std::size_t arm) const noexcept;
   // Joint positions of an arm at the link [deg], from the motor positions.
@@ -135,7 +138,7 @@ class Controller {
     double hold_pos = 0;      // modes 1, 2: where the DSA holds while control switches
     double ref_pos = 0, ref_vel = 0, prev_ref_pos = 0;  // reported target; previous DSA reference
     double dsa_ref = 0;       // the position reference the DSA tracked last period
-    double scs = 0;           // soft control switching: 0 = DSA, 1 = PC
+    SoftSwitch scs;           // soft control switching entering/leaving modes 1 and 2
     protocol::Axis pc{};      // the PC's data from the last good reply
     std::int32_t last_request = 0;
     std::int32_t sent_mode = 0;   // the code in the last packet sent
@@ -181,6 +184,7 @@ class Controller {
   void advance_moves();
   void step_physics();
   void check_following_error();
+  void check_soft_switch();
   void run_scenario();
   bool start_step(const Step& s);
   bool step_complete(const Step& s);
