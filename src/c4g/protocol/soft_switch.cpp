@@ -34,7 +34,9 @@ std::string_view to_string(SwitchDirection d) noexcept {
 SwitchSample linear_switch(const SwitchTimes& times, SwitchDirection direction, double elapsed_s) noexcept {
   SwitchSample s;
   s.direction = direction;
-  s.elapsed_s = std::max(0.0, elapsed_s);
+  // Elapsed time to the nanosecond: times computed as differences of clock readings and as packet
+  // counts x period then fall into the same interval at the boundaries.
+  s.elapsed_s = std::max(0.0, std::round(elapsed_s * 1e9) * 1e-9);
   const double t = s.elapsed_s;
   const double t1 = std::max(0.0, times.t1_s), t2 = std::max(0.0, times.t2_s), t3 = std::max(0.0, times.t3_s);
   if (t < t1) {

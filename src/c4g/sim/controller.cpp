@@ -740,6 +740,13 @@ void Controller::check_following_error() {
   }
 }
 
+bool Controller::arm_moving(std::size_t arm) const {
+  const std::size_t first = map_.arm_first(arm), n = map_.arm_count(arm);
+  for (std::size_t i = first; i < first + n; ++i)
+    if (std::fabs(axes_[i].model.velocity()) > robot_.scs.still_velocity) return true;
+  return false;
+}
+
 void Controller::check_soft_switch() {
   for (std::size_t i = 0; i < map_.count(); ++i) {
     AxisSim& ax = axes_[i];
@@ -817,7 +824,7 @@ bool Controller::start_step(const Step& s) {
           fail_scenario(s, fmt::format("arm {}: drives are not on", arm));
           return false;
         }
-        if (a.move.active) {
+        if (a.move.active || arm_moving(arm)) {
           fail_scenario(s, fmt::format("arm {}: the robot moves; modes change only between moves", arm));
           return false;
         }

@@ -191,6 +191,7 @@ class Controller {
   void fail_scenario(const Step& s, std::string_view why);
   std::vector<std::size_t> step_arms(const Step& s) const;
   bool arm_idle(std::size_t arm) const;
+  bool arm_moving(std::size_t arm) const;  // an axis faster than the soft-switching still velocity
   double ticks_to_s(std::uint64_t t) const noexcept { return static_cast<double>(t) * period_; }
 
   RobotConfig robot_;

@@ -41,6 +41,8 @@ struct AxisParams {
 struct SoftSwitchConfig {
   protocol::SwitchTimes times;    // T1, T2, T3 (defaults 50 + 100 + 50 ms: protocol/soft_switch.hpp)
   double still_tolerance = 0.02;  // [motor turns] largest excursion from the start during T1..T3
+  double still_velocity = 0.2;    // [motor turns/s] faster than this, the robot moves: the program
+                                  // cannot change modes (the state machine's S00 state is "not moving")
   bool reduce_pc_current = true;  // the controller scales the PC's current (eta in, rho out); false:
                                   // the PC's regulators do it themselves and D5 is applied as sent
 };

@@ -11,9 +11,7 @@ void SoftSwitch::start(P::SwitchDirection direction, double position) noexcept {
   state_ = State::starting;
   direction_ = direction;
   anchor_ = position;
-  t0_ = 0;
-  last_ = P::SwitchSample{};
-  last_.direction = direction;
+  t0_ = 0;  // last_ keeps the previous period's sample until the next sample()
 }
 
 P::SwitchSample SoftSwitch::sample(const SoftSwitchConfig& config, double t) noexcept {
