@@ -824,7 +824,8 @@ bool Controller::start_step(const Step& s) {
           fail_scenario(s, fmt::format("arm {}: drives are not on", arm));
           return false;
         }
-        if (a.move.active || arm_moving(arm)) {
+        const bool switches = s.mode == 1 || s.mode == 2;  // soft switching needs a still robot (T1..T3)
+        if (a.move.active || (switches && arm_moving(arm))) {
           fail_scenario(s, fmt::format("arm {}: the robot moves; modes change only between moves", arm));
           return false;
         }
