@@ -111,6 +111,7 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
       if (leaving_by_pc && (stop_requested() || (options_.open_time_s > 0 && t_ >= options_.open_time_s))) {
         set_phase(Phase::fading);
         ph = Phase::fading;
+        settle_s_ = 0;
         note(kNoteLeaving);
       }
     }
@@ -118,8 +119,18 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
       env_ = options_.ramp_s > 0 ? std::max(0.0, env_ - period / options_.ramp_s) : 0.0;
       if (env_ < 1e-9) {
         env_ = 0.0;
-        set_phase(Phase::exiting);
-        ph = Phase::exiting;
+        // Soft switching back needs a still robot: ask for the exit once every axis has settled on
+        // the hold position (or after kMaxSettle_s, when the watchdog will tell).
+        bool settled = true;
+        for (std::size_t j = 0; j < n; ++j) {
+          const auto& q = req.axes[first + j];
+          settled = settled && std::fabs(q.d3 - hold_[j]) < kSettleTurns && std::fabs(q.d4) / period < kSettleTurnsPerS;
+        }
+        settle_s_ += period;
+        if (settled || settle_s_ >= kMaxSettle_s) {
+          set_phase(Phase::exiting);
+          ph = Phase::exiting;
+        }
       }
     }
   } else if (m0 == code(Mode::mode2)) {

@@ -26,7 +26,10 @@
 //     reach the drive (anti-windup: it cannot wind up against a reduced output);
 //   - sends the full regulator current from the first packet of the mode (the manual's drive-on rule:
 //     the first packet of a mode carries that mode's data) and lets the controller apply the reducer,
-//     or, with reduce_in_pc, scales D5 by the factor itself (for a controller that does not).
+//     or, with reduce_in_pc, scales D5 by the factor itself (for a controller that does not);
+//   - leaving mode 1, asks for the exit only once the faded trajectory has settled on the hold
+//     position (every axis within 0.0002 turns and 0.02 turns/s, at most 1 s), so the switch back
+//     starts from a still robot.
 //
 // Safety: the server's Safety layer checks the following error (508) and clamps D5 again; this app
 // also tracks the largest following error for the status line.
@@ -127,6 +130,8 @@ class PidApp final : public App {
   double t_ = 0;
   std::uint64_t ticks_ = 0;
   double env_ = 0;
+  double settle_s_ = 0;  // time spent at the end of the fade waiting for the robot to settle
+  static constexpr double kSettleTurns = 2e-4, kSettleTurnsPerS = 0.02, kMaxSettle_s = 1.0;
   std::int32_t mode_ = 0;  // 1 or 2 while controlling
 };
 

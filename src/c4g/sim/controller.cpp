@@ -595,6 +595,9 @@ void Controller::advance_modes() {
     if (exit_requested_[arm]) {
       exit_requested_[arm] = false;
       start_exit(arm);
+      // The standby codes count from the next packet (as when the program starts the exit): the loop
+      // below would otherwise take one tick off at once (and one period off the switch back).
+      for (std::size_t i = first; i < first + n; ++i) axes_[i].exit.remaining += axes_[i].exit.active ? 1 : 0;
     }
     bool any_open = false;
     for (std::size_t i = first; i < first + n; ++i) {
