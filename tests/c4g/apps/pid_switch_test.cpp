@@ -28,7 +28,7 @@ using P::Mode;
 using P::SwitchInterval;
 
 constexpr double kStillBound = 0.001;  // [motor turns] excursion during T1..T3 (watchdog: 0.02)
-constexpr double kCurrentBound = 0.5;  // [A] reference current during T1..T3 (limits 9.5 / 24.5 A)
+constexpr double kCurrentBound = 0.1;  // [A] reference current during T1..T3 (limits 9.5 / 24.5 A)
 
 TEST(PidSoftSwitch, TheReducerFactorFollowsEtaInAndRhoOut) {
   host::SwitchTracker tracker(P::SwitchTimes{0.01, 0.02, 0.01});  // 5 + 10 + 5 packets at 2 ms
