@@ -46,7 +46,7 @@ namespace axon::c4g::apps {
 // kv 0.5 puts its velocity loop near 150 rad/s, what a 2 ms loop with one period of delay keeps
 // stable) and kp by the heaviest (about 57 turns/s^2 per A: velocity loop near 30 rad/s, kp 20 keeps
 // the cascade damped, zeta about 0.6). Measured: hold within 0.002 motor turns, a 0.5 deg / 1 Hz sine
-// on every joint in mode 1 within 0.031 turns (the base axes: mode 1 has no acceleration
+// on every joint in mode 1 within 0.016 turns (the base axes: mode 1 has no acceleration
 // feed-forward), the controller's 3 deg / 0.5 s move in mode 2 within 0.0006 turns. Per-axis gains
 // (--kp/--kv/--ki) do better on a known robot.
 struct PidGains {
