@@ -62,6 +62,8 @@ struct ServeOptions {
   double feed_timeout_ms = 100;
   std::vector<double> kp, kv, ki;
   bool no_dynamic_model = false;
+  bool reduce_in_pc = false;
+  double switch_t1_ms = 50, switch_t2_ms = 100, switch_t3_ms = 50;
   // recording
   int moni = -1;
   std::string csv;
@@ -138,6 +140,7 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     p.open_time_s = o.open_time_s;
     p.ramp_s = o.ramp_s;
     p.dynamic_model_feedforward = !o.no_dynamic_model;
+    p.reduce_in_pc = o.reduce_in_pc;
     const std::size_t n = std::max({o.kp.size(), o.kv.size(), o.ki.size()});
     auto pick = [](const std::vector<double>& v, std::size_t i, double def) {
       return v.empty() ? def : (i < v.size() ? v[i] : v.back());
@@ -176,6 +179,7 @@ int run_serve(const ServeOptions& o) {
   else if (o.numbering == "next") so.numbering = protocol::ReplyNumbering::next;
   else throw bad("--numbering must be same or next");
   so.pcap_path = o.pcap;
+  so.soft_switch = {o.switch_t1_ms * 1e-3, o.switch_t2_ms * 1e-3, o.switch_t3_ms * 1e-3};
   so.cycle.realtime.fifo_priority = o.rt_priority;
   so.cycle.realtime.lock_memory = o.rt_priority > 0;
   so.cycle.realtime.cpus = o.cpus;
@@ -370,6 +374,10 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("--kv", so.kv, "pid: velocity gain per axis [A/(turn/s)]")->delimiter(',');
   s->add_option("--ki", so.ki, "pid: velocity integral rate per axis [1/s]")->delimiter(',');
   s->add_flag("--no-dynamic-model", so.no_dynamic_model, "pid: do not feed the controller's dynamic-model current forward");
+  s->add_flag("--reduce-in-pc", so.reduce_in_pc, "pid: scale D5 by the soft-switching factor here (for a controller that does not)");
+  s->add_option("--switch-t1-ms", so.switch_t1_ms, "the controller's soft switching T1 [ms] (default 50)")->check(CLI::Range(0.0, 60000.0));
+  s->add_option("--switch-t2-ms", so.switch_t2_ms, "the controller's soft switching T2 [ms] (default 100)")->check(CLI::Range(0.0, 60000.0));
+  s->add_option("--switch-t3-ms", so.switch_t3_ms, "the controller's soft switching T3 [ms] (default 50)")->check(CLI::Range(0.0, 60000.0));
   s->add_option("--moni", so.moni, "with --csv: monitoring view 19..24 of the manual (default 0: every field)");
   s->add_option("--csv", so.csv, "write every cycle to this CSV file");
   s->add_option("--numbering", so.numbering, "reply number: same (the manual) or next (NUM + 1)");

@@ -34,6 +34,10 @@ struct SimC4gOptions {
   std::string numbering = "same";
   int sync_packets = 3;
   bool json = false;
+  // soft control switching (entering / leaving modes 1 and 2); negative: the robot's default
+  double switch_t1_ms = -1, switch_t2_ms = -1, switch_t3_ms = -1;
+  double switch_tolerance = -1;
+  std::string switch_reducer = "controller";
 };
 
 
@@ -41,6 +45,12 @@ double us(std::int64_t ns) { return static_cast<double>(ns) / 1000.0; }
 
 int run_sim_c4g(const SimC4gOptions& o) {
   auto robot = need(sim::find_robot(o.robot));
+  if (o.switch_t1_ms >= 0) robot.scs.times.t1_s = o.switch_t1_ms * 1e-3;
+  if (o.switch_t2_ms >= 0) robot.scs.times.t2_s = o.switch_t2_ms * 1e-3;
+  if (o.switch_t3_ms >= 0) robot.scs.times.t3_s = o.switch_t3_ms * 1e-3;
+  if (o.switch_tolerance >= 0) robot.scs.still_tolerance = o.switch_tolerance;
+  if (o.switch_reducer == "pc") robot.scs.reduce_pc_current = false;
+  else if (o.switch_reducer != "controller") throw Exception(Error(CoreErrc::invalid_argument, "--switch-reducer is controller or pc"));
   const auto scenario = o.scenario.empty() ? sim::Scenario::default_scenario() : need(sim::Scenario::load_file(o.scenario));
   sim::ControllerOptions co;
   co.period_ms = o.period_ms;
@@ -152,6 +162,11 @@ void add_sim_c4g_command(CLI::App& sim_cmd) {
   c->add_option("--numbering", opts.numbering, "reply numbering expected: same (manual) or next (NUM + 1)");
   c->add_option("--sync-packets", opts.sync_packets, "answered sync packets before the initialization packet")->check(CLI::Range(0, 1000));
   c->add_flag("--json", opts.json, "print the summary (and events) as JSON");
+  c->add_option("--switch-t1-ms", opts.switch_t1_ms, "soft switching pre-switching interval T1 [ms] (default 50)")->check(CLI::Range(0.0, 60000.0));
+  c->add_option("--switch-t2-ms", opts.switch_t2_ms, "soft switching ramp T2 [ms] (default 100)")->check(CLI::Range(0.0, 60000.0));
+  c->add_option("--switch-t3-ms", opts.switch_t3_ms, "soft switching post-switching interval T3 [ms] (default 50)")->check(CLI::Range(0.0, 60000.0));
+  c->add_option("--switch-tolerance", opts.switch_tolerance, "motor turns the robot may move during T1..T3 (default 0.02)")->check(CLI::Range(0.0, 1e6));
+  c->add_option("--switch-reducer", opts.switch_reducer, "who scales the PC's current while switching: controller (default) or pc");
   c->callback([] { exit_code() = run_sim_c4g(opts); });
 }
 

@@ -60,6 +60,9 @@ skip_without_sim_c4g() {
 # start_c4g_serve ARGS...: starts `axon c4g serve --listen 127.0.0.1:0 ARGS` in the background; sets
 # C4G_PORT and SERVE_PID.
 start_c4g_serve() {
+  # A previous server's output must not be read as this one's (the redirection below truncates the
+  # file in the background process, possibly after wait_for_line looked).
+  rm -f "$TMP/serve.out" "$TMP/serve.err"
   "$AXON" c4g serve --listen 127.0.0.1:0 --status-interval 0.5 "$@" >"$TMP/serve.out" 2>"$TMP/serve.err" &
   SERVE_PID=$!
   PIDS+=($SERVE_PID)

@@ -15,7 +15,7 @@ using protocol::code;
 using protocol::Mode;
 
 double AxisPid::update(const PidGains& g, double p_target, double v_target, double p_actual, double v_actual,
-                       double feedforward, double limit, double dt) noexcept {
+                       double feedforward, double limit, double dt, double authority) noexcept {
   const double lim = limit > 0 ? limit : std::numeric_limits<double>::infinity();
   const double v_ref = v_target + g.kp * (p_target - p_actual);
   const double ev = v_ref - v_actual;
@@ -23,7 +23,8 @@ double AxisPid::update(const PidGains& g, double p_target, double v_target, doub
   const double out = std::clamp(u, -lim, lim);
   saturated_ = out != u;
   // Conditional integration: grow the integral only when that does not push further into saturation.
-  if (!saturated_ || (u > lim && ev < 0) || (u < -lim && ev > 0)) integral_ += g.kv * g.ki * ev * dt;
+  const double share = std::clamp(authority, 0.0, 1.0);
+  if (!saturated_ || (u > lim && ev < 0) || (u < -lim && ev > 0)) integral_ += share * g.kv * g.ki * ev * dt;
   integral_ = std::clamp(integral_, -lim, lim);
   return out;
 }
@@ -100,7 +101,9 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
   }
 
   const bool leaving_by_pc = mode_ == 1;
-  if (m0 == code(Mode::mode1)) {
+  // Soft switching: mode 1's own trajectory waits until the switch to the PC is done.
+  const bool switched = ctx.switching == nullptr || ctx.switching->axis(first).interval == protocol::SwitchInterval::done;
+  if (m0 == code(Mode::mode1) && switched) {
     t_ = static_cast<double>(++ticks_) * period;
     elapsed_.store(t_, std::memory_order_relaxed);
     if (ph == Phase::controlling) {
@@ -108,6 +111,7 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
       if (leaving_by_pc && (stop_requested() || (options_.open_time_s > 0 && t_ >= options_.open_time_s))) {
         set_phase(Phase::fading);
         ph = Phase::fading;
+        settle_s_ = 0;
         note(kNoteLeaving);
       }
     }
@@ -115,8 +119,18 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
       env_ = options_.ramp_s > 0 ? std::max(0.0, env_ - period / options_.ramp_s) : 0.0;
       if (env_ < 1e-9) {
         env_ = 0.0;
-        set_phase(Phase::exiting);
-        ph = Phase::exiting;
+        // Soft switching back needs a still robot: ask for the exit once every axis has settled on
+        // the hold position (or after kMaxSettle_s, when the watchdog will tell).
+        bool settled = true;
+        for (std::size_t j = 0; j < n; ++j) {
+          const auto& q = req.axes[first + j];
+          settled = settled && std::fabs(q.d3 - hold_[j]) < kSettleTurns && std::fabs(q.d4) / period < kSettleTurnsPerS;
+        }
+        settle_s_ += period;
+        if (settled || settle_s_ >= kMaxSettle_s) {
+          set_phase(Phase::exiting);
+          ph = Phase::exiting;
+        }
       }
     }
   } else if (m0 == code(Mode::mode2)) {
@@ -130,6 +144,8 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
   const auto offset = view_->transform.motor_velocity(link);
 
   double worst = max_error_.load(std::memory_order_relaxed);
+  double worst_switch = max_switch_error_.load(std::memory_order_relaxed);
+  double worst_current = max_switch_current_.load(std::memory_order_relaxed);
   bool any_saturated = false;
   for (std::size_t j = 0; j < n; ++j) {
     const auto& q = req.axes[first + j];
@@ -144,7 +160,16 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
       vel = q.d2 / period;
     }
     const double ff = options_.dynamic_model_feedforward ? q.ext1 : 0.0;
-    const double current = loops_[j].update(gains_[j], ref, vel, q.d3, q.d4 / period, ff, limit_[j], period);
+    // The reducer's factor: eta entering, rho leaving, 1 once the PC has the axis (no tracker: 1).
+    const protocol::SwitchSample* sw = ctx.switching ? &ctx.switching->axis(first + j) : nullptr;
+    const double factor = sw ? sw->pc_gain() : 1.0;
+    if (j == 0) factor_.store(factor, std::memory_order_relaxed);
+    double current = loops_[j].update(gains_[j], ref, vel, q.d3, q.d4 / period, ff, limit_[j], period, factor);
+    if (options_.reduce_in_pc) current *= factor;
+    if (sw && sw->robot_must_be_still()) {
+      worst_switch = std::max(worst_switch, std::fabs(ref - q.d3));
+      worst_current = std::max(worst_current, std::fabs(current));
+    }
     any_saturated = any_saturated || loops_[j].saturated();
     auto& r = reply.axis(first + j);
     if (mode1) {
@@ -157,6 +182,8 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
     worst = std::max(worst, std::fabs(ref - q.d3));
   }
   max_error_.store(worst, std::memory_order_relaxed);
+  max_switch_error_.store(worst_switch, std::memory_order_relaxed);
+  max_switch_current_.store(worst_current, std::memory_order_relaxed);
   if (any_saturated) saturated_cycles_.fetch_add(1, std::memory_order_relaxed);
   if (ph == Phase::exiting && m0 == code(Mode::mode1)) exit_from_open(reply, view_->arm);
 }
@@ -178,8 +205,9 @@ std::string PidApp::status() const {
 }
 
 std::string PidApp::summary() const {
-  return App::summary() + fmt::format("pid: max following error {:.5f} motor turns, {} cycles with a saturated current\n",
-                                      max_following_error(), saturated_cycles());
+  return App::summary() + fmt::format("pid: max following error {:.5f} motor turns, {} cycles with a saturated current\n"
+                                      "pid: soft switching: max following error {:.5f} motor turns, max current {:.3f} A\n",
+                                      max_following_error(), saturated_cycles(), max_switch_error(), max_switch_current());
 }
 
 }  // namespace axon::c4g::apps

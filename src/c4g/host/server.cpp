@@ -59,9 +59,10 @@ std::int32_t read_i32(std::span<const std::byte> in, std::size_t offset) noexcep
 }  // namespace
 
 Server::Server(Controller& controller, const ServerOptions& options)
-    : controller_(controller), options_(options), safety_(options.safety) {}
+    : controller_(controller), options_(options), safety_(options.safety), switch_(options.soft_switch) {}
 
 Result<std::unique_ptr<Server>> Server::start(Controller& controller, const ServerOptions& options) {
+  AXON_TRY(protocol::validate(options.soft_switch));
   std::unique_ptr<Server> s(new Server(controller, options));
   AXON_TRY(socket, net::UdpSocket::open(options.listen, options.udp));
   if (!options.pcap_path.empty()) {
@@ -148,6 +149,7 @@ std::size_t Server::answer_init(std::span<const std::byte> in, std::span<std::by
     }
     have_target_ = {};
     exit_sent_ = {};
+    switch_.reset();
     cyclic_count_ = 0;
     state_.store(ServerState::running, std::memory_order_release);
     if (have_axes_) {
@@ -333,11 +335,12 @@ std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Data
   const bool freezing = update_freeze(request_);
   build_safe_reply(request_, safe_);
   reply_ = safe_;
+  switch_.update(request_, have_init_ && init_.period_ms > 0 ? init_.period_ms * 1e-3 : 0.002);
   bool used_controller = false;
   safety_.begin_cycle();
   if (!safety_.faulted()) {
     const CycleContext ctx{request_,      have_init_ ? &init_ : nullptr, have_axes_ ? &axes_ : nullptr, cyclic_count_,
-                           info.wall_ns, freezing};
+                           info.wall_ns, &switch_, freezing};
     ReplyBuilder builder(reply_);
     const std::int64_t t0 = steady_ns();
     try {

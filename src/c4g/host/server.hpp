@@ -27,6 +27,7 @@
 #include "c4g/host/cycle_thread.hpp"
 #include "c4g/host/pcap_recorder.hpp"
 #include "c4g/host/safety.hpp"
+#include "c4g/host/switch_tracker.hpp"
 #include "c4g/protocol/axis_map.hpp"
 #include "c4g/protocol/init_packet.hpp"
 #include "c4g/protocol/packet.hpp"
@@ -55,6 +56,9 @@ struct CycleContext {
   const protocol::AxisMap* axes;      // nullptr until then (or if its axis lists were bad)
   std::uint64_t cycle;                // cyclic packets handled so far (0 for the first)
   std::int64_t arrival_wall_ns;       // kernel arrival stamp (or clock at receive)
+  // Soft control switching per axis as inferred from the modes (interval, chi/eta/rho, the PC
+  // reducer's factor pc_gain()); nullptr when the caller does not track it (hand-made contexts).
+  const SwitchTracker* switching = nullptr;
   // Active freezing (500) is in force: the Server answers on its own (every axis 500, exit-from-open
   // when released) and discards this cycle's reply; the call is neither timed nor counted late, so
   // the controller may do long non-real-time work here (see Server::request_freeze).
@@ -104,6 +108,9 @@ struct ServerOptions {
   // latch a fault (0 disables).
   std::chrono::nanoseconds controller_budget = std::chrono::microseconds(400);
   int max_late_cycles = 3;
+  // Soft control switching intervals T1, T2, T3 of the controller (the PC infers the switch's phase
+  // from the modes and these; they must match the controller's configuration).
+  protocol::SwitchTimes soft_switch;
 };
 
 enum class ServerState : std::uint8_t {
@@ -158,6 +165,7 @@ class Server : private CycleHandler {
   [[nodiscard]] const ServerCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] Safety& safety() noexcept { return safety_; }
   [[nodiscard]] const Safety& safety() const noexcept { return safety_; }
+  [[nodiscard]] const SwitchTracker& switch_tracker_unsafe() const noexcept { return switch_; }  // cycle thread only
   [[nodiscard]] const CycleThread& cycle() const noexcept { return *cycle_; }
   [[nodiscard]] const core::RealtimeReport& realtime_report() const noexcept { return cycle_->realtime_report(); }
   [[nodiscard]] const PcapRecorder* recorder() const noexcept { return recorder_.get(); }
@@ -237,6 +245,7 @@ class Server : private CycleHandler {
   protocol::Packet safe_{};
   std::uint64_t cyclic_count_ = 0;
   int late_in_row_ = 0;
+  SwitchTracker switch_;
   std::array<float, protocol::kMaxAxes> last_target_{};
   std::array<bool, protocol::kMaxAxes> have_target_{};
   std::array<bool, protocol::kMaxAxes> exit_sent_{};

@@ -1,5 +1,7 @@
 #include "c4g/sim/axis_model.hpp"
 
+#include "c4g/protocol/soft_switch.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -44,14 +46,14 @@ void AxisModel::step(const AxisCommand& cmd, bool powered) noexcept {
     const double err = vel_ref - vel_;
     const double loop_limit = std::max(0.0, cmd.loop_limit) * limit;
     const double unclamped = kv_ * err + integral_;
-    loop = clamp_abs(unclamped, loop_limit);
+    loop = protocol::limit_current(unclamped, std::max(0.0, cmd.loop_limit), limit);
     // Anti-windup: integrate only while the loop output is not held by its limiter, or when the
     // error drives it back.
     if (unclamped == loop || (unclamped > loop) != (err > 0)) integral_ = clamp_abs(integral_ + ki_ * err * kDsaPeriod, loop_limit);
   } else {
     integral_ = 0;
   }
-  const double wanted = loop + cmd.current_add + (cmd.dynamic_model ? dyn_current_ : 0.0);
+  const double wanted = loop + cmd.current_add + (cmd.dynamic_model ? cmd.dynamic_gain * dyn_current_ : 0.0);
   current_ = clamp_abs(wanted, limit);
   saturated_ = current_ != wanted;
   // Mechanics at the current-loop rate (semi-implicit Euler).

@@ -20,9 +20,11 @@ struct AxisCommand {
   double acceleration = 0;    // reference acceleration [turns/s^2], for the dynamic model
   bool loops = true;          // DSA position and velocity loops run (false: the PC closes them)
   double loop_limit = 1.0;    // soft control switching: DSA loop current bounded by loop_limit * Imax
+                              // (the variable-threshold limiter, Imin = 0)
   double velocity_add = 0;    // [turns/s] extra input of the velocity loop (mode 8)
   double current_add = 0;     // [A] current contribution from the PC (modes 1, 2, 9)
   bool dynamic_model = true;  // add the dynamic-model current (its channel is the PC's in 1, 2, 9)
+  double dynamic_gain = 1.0;  // soft control switching: the dynamic-model current's share (rho / eta)
 };
 
 class AxisModel {

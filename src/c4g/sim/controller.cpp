@@ -298,6 +298,7 @@ void Controller::end_cycle() {
 
   step_physics();
   check_following_error();
+  check_soft_switch();
 
   // The program's special codes take effect once their packet went out.
   if (phase_ == Phase::cycle && sent_special != 0 && sent_special == pending_special_) {
@@ -527,9 +528,10 @@ void Controller::set_mode(std::size_t i, std::int32_t mode, std::string_view) {
   AxisSim& ax = axes_[i];
   if (ax.mode == mode) return;
   const std::int32_t base = base_mode(mode);
-  if ((base == 1 || base == 2) && base_mode(ax.mode) != base) {
+  const bool to_pc = (base == 1 || base == 2) && base_mode(ax.mode) != base;
+  if (to_pc || ((mode == 11 || mode == 12) && ax.mode == base)) {  // soft switching in or out: hold here
     ax.hold_pos = ax.model.position();
-    ax.scs = robot_.scs_ramp_s > 0 ? 0.0 : 1.0;  // no ramp: the PC's current applies at once
+    ax.scs.start(to_pc ? P::SwitchDirection::to_pc : P::SwitchDirection::to_drive, ax.hold_pos);
   }
   ax.mode = mode;
 }
@@ -571,7 +573,7 @@ void Controller::drive_off(std::size_t arm, std::int32_t shown_code) {
   for (std::size_t i = first; i < first + n; ++i) {
     AxisSim& ax = axes_[i];
     ax.exit.active = false;
-    ax.scs = 0;
+    ax.scs.clear();
     ax.traj_vel = ax.traj_acc = 0;
     set_mode(i, shown_code != 0 ? shown_code : (frozen_active_ ? ax.mode : 0), {});
   }
@@ -579,7 +581,7 @@ void Controller::drive_off(std::size_t arm, std::int32_t shown_code) {
 }
 
 int Controller::standby_ticks(std::int32_t code) const {
-  if (code == 11 || code == 12) return std::max(1, static_cast<int>(std::lround(robot_.scs_ramp_s / period_)));
+  if (code == 11 || code == 12) return std::max(1, static_cast<int>(std::lround(robot_.scs.times.total_s() / period_)));
   return std::max(1, robot_.standby_cycles);
 }
 
@@ -621,7 +623,7 @@ void Controller::finish_open_mode(std::size_t i) {
     ax.offset = 0;
   }
   ax.exit.active = false;
-  ax.scs = 0;
+  ax.scs.clear();
   set_mode(i, 0, {});
 }
 
@@ -641,14 +643,13 @@ void Controller::advance_modes() {
     if (exit_requested_[arm]) {
       exit_requested_[arm] = false;
       start_exit(arm);
+      // The standby codes count from the next packet (as when the program starts the exit): the loop
+      // below would otherwise take one tick off at once (and one period off the switch back).
+      for (std::size_t i = first; i < first + n; ++i) axes_[i].exit.remaining += axes_[i].exit.active ? 1 : 0;
     }
     bool any_open = false;
     for (std::size_t i = first; i < first + n; ++i) {
       AxisSim& ax = axes_[i];
-      // Soft control switching ramps of modes 1 and 2.
-      const double step = robot_.scs_ramp_s > 0 ? period_ / robot_.scs_ramp_s : 1.0;
-      if (ax.mode == 1 || ax.mode == 2) ax.scs = std::min(1.0, ax.scs + step);
-      else if (ax.mode == 11 || ax.mode == 12) ax.scs = std::max(0.0, ax.scs - step);
       if (ax.exit.active) {
         const std::int32_t code = ax.exit.seq.codes[ax.exit.index];
         const bool waits_for_motion = code == P::code(P::Mode::mode7_standby) && a.move.active;
@@ -738,17 +739,11 @@ void Controller::step_physics() {
         reported = pc.d1;
         vel = pc.d2 / period_;
         acc = 0;
-        c.loops = ax.scs < 1.0;
-        c.loop_limit = 1.0 - ax.scs;
         c.velocity = 0;
-        c.current_add = ax.scs * P::saturate_current(pc.d5, static_cast<float>(limit));
-        c.dynamic_model = false;
+        ax.scs.command(robot_.scs, time_s(), pc.d5, limit, c);
         break;
       case 2:  // the controller generates, the PC closes the loops
-        c.loops = ax.scs < 1.0;
-        c.loop_limit = 1.0 - ax.scs;
-        c.current_add = ax.scs * P::saturate_current(pc.d5, static_cast<float>(limit));
-        c.dynamic_model = false;
+        ax.scs.command(robot_.scs, time_s(), pc.d5, limit, c);
         break;
       case 4:  // absolute targets from the PC
         dsa_ref = reported = pc.d1;
@@ -802,6 +797,25 @@ void Controller::check_following_error() {
     emit(EventLevel::error, event::kFollowErrorController,
          fmt::format("arm {} axis {}: following error {:.3f} turns over {:.3f} in mode {}", ax.arm, ax.axis,
                      ax.dsa_ref - ax.model.position(), threshold, mode_text(ax.mode)));
+    drive_off(ax.arm, 0);
+  }
+}
+
+bool Controller::arm_moving(std::size_t arm) const {
+  const std::size_t first = map_.arm_first(arm), n = map_.arm_count(arm);
+  for (std::size_t i = first; i < first + n; ++i)
+    if (std::fabs(axes_[i].model.velocity()) > robot_.scs.still_velocity) return true;
+  return false;
+}
+
+void Controller::check_soft_switch() {
+  for (std::size_t i = 0; i < map_.count(); ++i) {
+    AxisSim& ax = axes_[i];
+    if (!arms_[ax.arm].powered || !ax.scs.moved(robot_.scs, ax.model.position())) continue;
+    emit(EventLevel::error, event::kSoftSwitchMotion,
+         fmt::format("arm {} axis {}: moved {:.4f} motor turns during soft control switching ({} {}), over {:.4f}", ax.arm,
+                     ax.axis, ax.model.position() - ax.scs.anchor(), P::to_string(ax.scs.direction()),
+                     P::to_string(ax.scs.last().interval), robot_.scs.still_tolerance));
     drive_off(ax.arm, 0);
   }
 }
@@ -871,7 +885,8 @@ bool Controller::start_step(const Step& s) {
           fail_scenario(s, fmt::format("arm {}: drives are not on", arm));
           return false;
         }
-        if (a.move.active) {
+        const bool switches = s.mode == 1 || s.mode == 2;  // soft switching needs a still robot (T1..T3)
+        if (a.move.active || (switches && arm_moving(arm))) {
           fail_scenario(s, fmt::format("arm {}: the robot moves; modes change only between moves", arm));
           return false;
         }

@@ -31,6 +31,7 @@
 #include "c4g/sim/events.hpp"
 #include "c4g/sim/robots.hpp"
 #include "c4g/sim/scenario.hpp"
+#include "c4g/sim/soft_switch.hpp"
 #include "core/error.hpp"
 
 #include <array>
@@ -113,6 +114,8 @@ class Controller {
   [[nodiscard]] double axis_current(std::size_t open) const noexcept { return axes_[open].model.current(); }
   [[nodiscard]] double axis_reference(std::size_t open) const noexcept { return axes_[open].ref_pos; }
   [[nodiscard]] const AxisModel& axis_model(std::size_t open) const noexcept { return axes_[open].model; }
+  // Soft control switching of an axis as of the last period (interval none when no switch is under way).
+  [[nodiscard]] const protocol::SwitchSample& axis_switch(std::size_t open) const noexcept { return axes_[open].scs.last(); }
   [[nodiscard]] float axis_measure(std::size_t open) const noexcept { return axes_[open].measure; }
   [[nodiscard]] bool drives_on(std::size_t arm) const noexcept;
   // Joint positions of an arm at the link [deg], from the motor positions.
@@ -136,7 +139,7 @@ class Controller {
     double hold_pos = 0;      // modes 1, 2: where the DSA holds while control switches
     double ref_pos = 0, ref_vel = 0, prev_ref_pos = 0;  // reported target; previous DSA reference
     double dsa_ref = 0;       // the position reference the DSA tracked last period
-    double scs = 0;           // soft control switching: 0 = DSA, 1 = PC
+    SoftSwitch scs;           // soft control switching entering/leaving modes 1 and 2
     protocol::Axis pc{};      // the PC's data from the last good reply
     std::int32_t last_request = 0;
     std::int32_t sent_mode = 0;   // the code in the last packet sent
@@ -184,12 +187,14 @@ class Controller {
   void advance_moves();
   void step_physics();
   void check_following_error();
+  void check_soft_switch();
   void run_scenario();
   bool start_step(const Step& s);
   bool step_complete(const Step& s);
   void fail_scenario(const Step& s, std::string_view why);
   std::vector<std::size_t> step_arms(const Step& s) const;
   bool arm_idle(std::size_t arm) const;
+  bool arm_moving(std::size_t arm) const;  // an axis faster than the soft-switching still velocity
   double ticks_to_s(std::uint64_t t) const noexcept { return static_cast<double>(t) * period_; }
 
   RobotConfig robot_;

@@ -19,6 +19,9 @@ inline constexpr std::string_view kFollowErrorFromPc = "ERR_C4GOPEN_FOLLOW_ERROR
 inline constexpr std::string_view kDriveOffFromPc = "ERR_C4GOPEN_DRIVEOFF_SERVER";  // 505 from the PC
 // Not in the open interface's table: the controller's own following-error check (the DSA's).
 inline constexpr std::string_view kFollowErrorController = "DSA_FOLLOWING_ERROR";
+// Not in the table either: the robot moved during soft control switching (T1, T2 or T3), which the
+// manual forbids; the controller switches the drives off.
+inline constexpr std::string_view kSoftSwitchMotion = "SCS_ROBOT_MOVED";
 inline constexpr std::string_view kModeChange = "MODE_CHANGE";
 inline constexpr std::string_view kDrivesOn = "DRIVES_ON";
 inline constexpr std::string_view kDrivesOff = "DRIVES_OFF";

@@ -8,6 +8,7 @@
 #pragma once
 
 #include "c4g/protocol/init_packet.hpp"
+#include "c4g/protocol/soft_switch.hpp"
 #include "core/error.hpp"
 
 #include <array>
@@ -36,6 +37,16 @@ struct AxisParams {
   }
 };
 
+// Soft control switching on the controller's side (sim/soft_switch.hpp, docs/c4g-simulator.md).
+struct SoftSwitchConfig {
+  protocol::SwitchTimes times;    // T1, T2, T3 (defaults 50 + 100 + 50 ms: protocol/soft_switch.hpp)
+  double still_tolerance = 0.02;  // [motor turns] largest excursion from the start during T1..T3
+  double still_velocity = 0.2;    // [motor turns/s] faster than this, the robot moves: the program
+                                  // cannot change modes (the state machine's S00 state is "not moving")
+  bool reduce_pc_current = true;  // the controller scales the PC's current (eta in, rho out); false:
+                                  // the PC's regulators do it themselves and D5 is applied as sent
+};
+
 struct RobotConfig {
   std::string name;
   protocol::InitPacket init;       // what the controller announces (period, axes, limits, ...)
@@ -43,7 +54,7 @@ struct RobotConfig {
   std::array<std::array<AxisParams, protocol::kAxesPerArm>, protocol::kMaxArms> axes{};
   double drive_on_s = 0.3;         // length of the drive-on procedure (mode 501)
   double drive_off_s = 0.05;       // length of the drive-off procedure (mode 505 shown meanwhile)
-  double scs_ramp_s = 0.1;         // soft control switching ramp entering/leaving modes 1 and 2
+  SoftSwitchConfig scs;            // soft control switching entering/leaving modes 1 and 2
   int standby_cycles = 3;          // cycles spent in a standby code (4', 5', 7'', ...) when leaving
 };
 

@@ -21,6 +21,7 @@ struct Harness {
   protocol::Packet req;
   protocol::Packet rep;
   std::uint64_t cycle = 0;
+  host::SwitchTracker* tracker = nullptr;  // when set: updated per cycle and handed to the app, as the Server does
 
   Harness() {
     req.count = 6;
@@ -56,7 +57,8 @@ struct Harness {
       rep.axes[i].mode = req.axes[i].mode;
       if (req.axes[i].mode == protocol::code(protocol::Mode::mode4)) rep.axes[i].d1 = req.axes[i].d3;
     }
-    const host::CycleContext ctx{req, &init, &map, cycle, static_cast<std::int64_t>(cycle) * 2'000'000};
+    if (tracker) tracker->update(req, period());
+    const host::CycleContext ctx{req, &init, &map, cycle, static_cast<std::int64_t>(cycle) * 2'000'000, tracker};
     host::ReplyBuilder builder(rep);
     app.on_cycle(ctx, builder);
     ++cycle;

@@ -589,5 +589,66 @@ TEST(ServerAgainstSim, MalformedReorderedAndDuplicatedDatagramsAreCountedNotFata
   EXPECT_EQ(server->safety().reason(), H::FaultReason::none);
 }
 
+// ---- soft control switching (modes 1 and 2) over UDP ------------------------------------------------
+
+namespace soft_switch {
+
+// Records, per packet, the switching phase the server inferred and hands over to the controller.
+class SwitchProbe : public H::Controller {
+ public:
+  std::vector<P::SwitchSample> samples;  // axis 1, packets in modes 1, 2, 11, 12
+  int first_mode1_has_target = -1;       // whether the first mode-1 reply carried the mode's target
+  void on_cycle(const H::CycleContext& ctx, H::ReplyBuilder& r) override {
+    const auto m = ctx.request.axes[0].mode;
+    if (ctx.switching == nullptr || !(m == 1 || m == 11)) return;
+    samples.push_back(ctx.switching->axis(0));
+    // Hold where mode 1 began (a P-D on the actual position), targets and current from the first packet.
+    for (std::size_t i = 0; i < r.axis_count(); ++i) {
+      const auto& q = ctx.request.axes[i];
+      if (hold.size() < r.axis_count()) hold.push_back(q.d3);
+      r.axis(i).d1 = hold[i];
+      r.axis(i).d5 = static_cast<float>(20.0 * (hold[i] - q.d3) - 0.5 * q.d4 / 0.002);
+    }
+    if (first_mode1_has_target < 0) first_mode1_has_target = r.axis(0).d1 == ctx.request.axes[0].d3 && r.axis(0).d1 != 0.0f ? 1 : 0;
+    if (samples.size() == 300) r.exit_from_open(1);
+  }
+  std::vector<float> hold;
+};
+
+TEST(ServerAgainstSim, SoftSwitchingPhaseIsInferredPacketForPacketAndTheRobotStaysStill) {
+  SwitchProbe pc;
+  auto server = start_server(pc);
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - go_open: {type: A, mode: 1, arms: [1]}
+  - wait_for_pc: {timeout: 5}
+  - exit_open)", 10);
+  EXPECT_TRUE(run.c->scenario_done()) << run.log();
+  EXPECT_FALSE(run.has(S::event::kSoftSwitchMotion)) << run.log();
+  EXPECT_FALSE(run.c->communication_error());
+  EXPECT_EQ(pc.first_mode1_has_target, 1);
+  // 2 ms: 25 + 50 + 25 packets in, then mode 1 alone, then 1' for 100 packets (the last one shows 0).
+  ASSERT_GE(pc.samples.size(), 400u);
+  int pre = 0, ramp = 0, post = 0;
+  double last_gain = -1;
+  for (std::size_t k = 0; k < 100; ++k) {
+    const auto& s = pc.samples[k];
+    EXPECT_EQ(s.direction, P::SwitchDirection::to_pc);
+    pre += s.interval == P::SwitchInterval::pre;
+    ramp += s.interval == P::SwitchInterval::switching;
+    post += s.interval == P::SwitchInterval::post;
+    EXPECT_GE(s.pc_gain(), last_gain);  // eta never decreases on the way in
+    last_gain = s.pc_gain();
+  }
+  EXPECT_EQ(pre, 25);
+  EXPECT_EQ(ramp, 50);
+  EXPECT_EQ(post, 25);
+  EXPECT_EQ(pc.samples[100].interval, P::SwitchInterval::done);
+  EXPECT_EQ(pc.samples.back().direction, P::SwitchDirection::to_drive);
+  EXPECT_EQ(pc.samples.back().pc_gain(), 0.0);  // rho at the end of the way back
+}
+
+}  // namespace soft_switch
+
 }  // namespace
 }  // namespace axon::c4g::test

@@ -40,7 +40,7 @@ TEST(C4gSimModes, DriveOnShows501AndThenTheInfparDrivesOnByte) {
 
 TEST(C4gSimModes, Mode1CurrentFromThePcAcceleratesTheAxisAsThePhysicsSays) {
   RobotConfig robot = quick_robot();
-  robot.scs_ramp_s = 0;  // switch to the PC at once
+  robot.scs.times = {0, 0, 0};  // switch to the PC at once
   auto c = make_controller("steps:\n  - drive_on\n  - go_open: {type: A, mode: 1}\n  - wait_for_pc\n  - run\n", robot);
   PcResponder pc;
   const float amps = 2.0f;
@@ -68,7 +68,7 @@ TEST(C4gSimModes, Mode1CurrentFromThePcAcceleratesTheAxisAsThePhysicsSays) {
 
 TEST(C4gSimModes, Mode1CurrentIsSaturatedToTheLimit) {
   RobotConfig robot = quick_robot();
-  robot.scs_ramp_s = 0;
+  robot.scs.times = {0, 0, 0};
   auto c = make_controller("steps:\n  - drive_on\n  - go_open: {type: A, mode: 1}\n  - run\n", robot);
   PcResponder pc;
   pc.fill = [&](const P::Packet& req, P::Packet& r) {

@@ -113,7 +113,7 @@ inline RobotConfig quick_robot() {
   RobotConfig r = six_axis_robot();
   r.drive_on_s = 0.02;
   r.drive_off_s = 0.01;
-  r.scs_ramp_s = 0.02;
+  r.scs.times = {0.004, 0.012, 0.004};  // T1 + T2 + T3 = 20 ms
   return r;
 }
 
