@@ -642,10 +642,13 @@ void Controller::advance_modes() {
     }
     if (exit_requested_[arm]) {
       exit_requested_[arm] = false;
+      std::array<bool, P::kMaxAxes> was_exiting{};
+      for (std::size_t i = first; i < first + n; ++i) was_exiting[i] = axes_[i].exit.active;
       start_exit(arm);
       // The standby codes count from the next packet (as when the program starts the exit): the loop
-      // below would otherwise take one tick off at once (and one period off the switch back).
-      for (std::size_t i = first; i < first + n; ++i) axes_[i].exit.remaining += axes_[i].exit.active ? 1 : 0;
+      // below would otherwise take one tick off at once (and one period off the switch back). Only
+      // for exits started now: a PC that keeps asking (it may, every packet) must not stretch them.
+      for (std::size_t i = first; i < first + n; ++i) axes_[i].exit.remaining += axes_[i].exit.active && !was_exiting[i] ? 1 : 0;
     }
     bool any_open = false;
     for (std::size_t i = first; i < first + n; ++i) {
