@@ -9,9 +9,9 @@ namespace axon::fps::host {
 
 std::string CorrectionRound::to_text() const {
   const double tol_um = plan.tolerance_mm * 1000;
-  std::string s = fmt::format("round {} ({}): {} robots, {} within {:g} um, {} to correct, {} unreachable, {} not "
+  std::string s = fmt::format("{} {} ({}): {} robots, {} within {:g} um, {} to correct, {} unreachable, {} not "
                               "measured, {} without position; worst error {:.1f} um\n",
-                              round, source, plan.robots.size(), plan.count(CorrectionStatus::within_tolerance), tol_um,
+                              evaluate_only ? "check" : "round", round, source, plan.robots.size(), plan.count(CorrectionStatus::within_tolerance), tol_um,
                               plan.count(CorrectionStatus::move), plan.count(CorrectionStatus::unreachable),
                               plan.count(CorrectionStatus::not_measured), plan.count(CorrectionStatus::no_position),
                               plan.worst_error_mm() * 1000);
@@ -43,12 +43,13 @@ std::string CorrectionRound::to_text() const {
 asio::awaitable<Result<CorrectionRound>> correction_round(Array& array, const plan::CollisionModel& model,
                                                           std::span<const plan::Target> targets,
                                                           const MeasurementSet& measured,
-                                                          const CorrectionOptions& options, int round) {
+                                                          const CorrectionOptions& options, int round, bool send) {
   if (array.locked())
     co_return make_error(HostErrc::locked, fmt::format("correction round {}: {}", round, array.lock_state().reason));
   CorrectionRound out;
   out.round = round;
   out.source = measured.source;
+  out.evaluate_only = !send;
 
   // The commanded angles of every targeted robot the array knows, read at once.
   std::vector<std::int32_t> ids;
@@ -76,6 +77,10 @@ asio::awaitable<Result<CorrectionRound>> correction_round(Array& array, const pl
     r.detail = e != read_errors.end() ? "position not read: " + e->second : std::string("not known to the array");
   }
 
+  if (!send) {
+    for (const auto& [id, pose] : out.plan.moves()) out.results[id] = "not sent (the last allowed iteration is done)";
+    co_return out;
+  }
   std::map<std::uint16_t, ArmAngles> moves;
   for (const auto& [id, pose] : out.plan.moves()) moves[static_cast<std::uint16_t>(id)] = {pose.alpha_deg, pose.beta_deg};
   out.sent = moves.size();
@@ -135,7 +140,8 @@ asio::awaitable<CorrectionRun> correct_positions(Array& array, const plan::Colli
       break;
     }
     run.verified = true;
-    auto r = co_await correction_round(array, model, targets, *m.value(), options.correction, round);
+    const bool send = corrections < options.iterations;
+    auto r = co_await correction_round(array, model, targets, *m.value(), options.correction, round, send);
     if (!r) {
       run.stopped_by = r.error();
       run.end = fmt::format("stopped in round {}", round);
@@ -144,10 +150,16 @@ asio::awaitable<CorrectionRun> correct_positions(Array& array, const plan::Colli
     run.rounds.push_back(std::move(r).value());
     const CorrectionRound& last = run.rounds.back();
     if (options.on_round) options.on_round(last);
+    const std::string after = fmt::format("{} correction{}", corrections, corrections == 1 ? "" : "s");
     if (last.plan.converged()) {
       run.converged = true;
-      run.end = fmt::format("every robot within {:g} um after {} correction{}", options.correction.tolerance_mm * 1000,
-                            corrections, corrections == 1 ? "" : "s");
+      run.end = fmt::format("every robot within {:g} um after {}", options.correction.tolerance_mm * 1000, after);
+      break;
+    }
+    if (!send) {
+      run.end = fmt::format("{} still outside {:g} um after {} (the most allowed)",
+                            last.plan.robots.size() - last.plan.count(CorrectionStatus::within_tolerance),
+                            options.correction.tolerance_mm * 1000, after);
       break;
     }
     if (last.sent == 0) {
@@ -156,11 +168,6 @@ asio::awaitable<CorrectionRun> correct_positions(Array& array, const plan::Colli
     }
     ++corrections;
     run.verified = false;
-    if (corrections >= options.iterations) {
-      run.end = fmt::format("{} correction{} sent (the most allowed); not verified by a further measurement",
-                            corrections, corrections == 1 ? "" : "s");
-      break;
-    }
   }
   co_return run;
 }

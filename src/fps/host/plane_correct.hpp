@@ -7,8 +7,9 @@
 // one to arrive and report per robot: error before, correction sent, result.
 //
 // correct_positions() repeats rounds, each with the next measurement from a caller-supplied
-// source, until every robot is within tolerance, `iterations` corrections were sent, a round has
-// nothing left to send, or the source has no further measurement.
+// source, until every robot is within tolerance, a round has nothing left to send, or the source
+// has no further measurement. At most `iterations` rounds send corrections; the measurement after
+// the last of them is still read and reported (nothing more is sent).
 #pragma once
 
 #include "fps/host/array.hpp"
@@ -29,6 +30,7 @@ struct CorrectionRound {
   CorrectionPlan plan;
   std::map<std::int32_t, std::string> results; // per robot moved: "arrived" or the error
   std::map<std::int32_t, ArmAngles> reached;   // per robot that arrived
+  bool evaluate_only = false;                  // the check after the last allowed iteration
   std::size_t sent = 0;
   std::size_t arrived = 0;
 
@@ -37,11 +39,13 @@ struct CorrectionRound {
   [[nodiscard]] std::string to_text() const;
 };
 
-// One round. Errors only when nothing could be done (the array is locked).
+// One round. With `send` false the corrections are computed and reported but not sent (the check
+// after the last allowed iteration). Errors only when nothing could be done (the array is locked).
 asio::awaitable<Result<CorrectionRound>> correction_round(Array& array, const plan::CollisionModel& model,
                                                           std::span<const plan::Target> targets,
                                                           const MeasurementSet& measured,
-                                                          const CorrectionOptions& options = {}, int round = 1);
+                                                          const CorrectionOptions& options = {}, int round = 1,
+                                                          bool send = true);
 
 // Gives the measurement for round `round` (1-based); nullopt when there is none (the run ends).
 using MeasurementSource = std::function<asio::awaitable<Result<std::optional<MeasurementSet>>>(int round)>;
