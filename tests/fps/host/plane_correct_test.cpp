@@ -68,7 +68,7 @@ TEST(PlaneCorrect, OneRoundRemovesAKnownAngularOffset) {
       const plan::Vec2 expected =
           model.robot(i).fibre({cmd.alpha_deg + off.alpha_deg, cmd.beta_deg + off.beta_deg}, plan::kBossFibre);
       EXPECT_LT(plan::norm(m.position - expected), 1e-4) << "robot " << m.robot;
-      EXPECT_GT(plan::norm(m.position - targets[i].position.value()), 0.05) << "robot " << m.robot;
+      EXPECT_GT(plan::norm(m.position - targets[i].position.value()), 0.02) << "robot " << m.robot;
     }
 
     CorrectionRunOptions o;
