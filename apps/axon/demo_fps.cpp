@@ -1,11 +1,12 @@
 // `axon demo`, fps section: the default focal plane (500 simulated robots on 24 buses behind 6
 // CAN@net gateway emulators, plus the PLC emulator) driven over loopback TCP by the host: layout
-// check, discovery, status sweep, a fold, then a collision-free random reconfiguration of every
+// check, discovery, the cold policy from the PLC, status sweep, a fold, then a collision-free random reconfiguration of every
 // robot from the path planner, both started by the PLC's sync line, final positions and the
 // simulator's collision count verified, each phase timed against the wire time of its busiest bus.
 // The simulated plane runs on a thread of its own (sim_thread.hpp), the host on the caller's.
 #include "demo_fps.hpp"
 
+#include "fps/host/cold_control.hpp"
 #include "fps/host/focal_plane_array.hpp"
 #include "fps/plan/layout_model.hpp"
 #include "fps/plan/planner.hpp"
@@ -145,6 +146,22 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   fmt::print("   discovery (GET_ID until every robot of the bus answered, then firmware and status of each): "
              "{} robots, {} problems ({:.2f} s)\n",
              found.table.rows.size(), found.problems.size(), phases.back().seconds);
+
+  // The cold policy once, from the PLC's temperatures (speed and holding current are volatile in
+  // the robots, so a host sets them after every power-up).
+  t0 = Clock::now();
+  host::ColdControl cold(*fpa);
+  auto applied = co_await cold.step(true);
+  if (applied) {
+    const auto& rep = applied.value();
+    std::string line = rep.decision.report();
+    line = line.substr(0, line.find('\n'));
+    const std::string why = rep.decision.notes.empty() ? std::string() : " (" + rep.decision.notes.front() + ")";
+    fmt::print("   {}{}: applied to {} robots, {} failed ({:.2f} s)\n", line, why, rep.applied.size(), rep.failed.size(),
+               seconds(Clock::now() - t0));
+  } else {
+    fmt::print("   cold policy not applied: {}\n", applied.error().message());
+  }
 
   // 3. Status sweep (firmware, status, position of every robot).
   bits0 = wire_now();

@@ -1,10 +1,13 @@
 // `axon fps plane ...`: the whole focal plane of a layout at once (every gateway, every bus, the
 // PLC): layout check, status of every robot, a coordinated move of every robot started by
-// broadcast or by the sync line.
+// broadcast or by the sync line, firmware upgrade, the cold policy and correction iterations after
+// a measurement of the fibres.
 #include "commands.hpp"
 #include "fps/host/focal_plane_array.hpp"
 #include "fps/host/cold_control.hpp"
+#include "fps/host/plane_correct.hpp"
 #include "fps/host/plane_upgrade.hpp"
+#include "fps/plan/layout_model.hpp"
 #include "layout_name.hpp"
 #include "net/endpoint.hpp"
 #include "run.hpp"
@@ -13,6 +16,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -39,9 +43,39 @@ struct PlaneArgs {
   bool watch = false;             // cold
   double period_s = 60;           // cold --watch
   double for_s = 0;               // cold --watch: 0 until a signal
+  std::string targets;            // correct
+  std::vector<std::string> measured;  // correct: one file per round
+  double tolerance_um = 5;        // correct
+  int iterations = 3;             // correct
+  double wait_s = 600;            // correct: for each measurement file to appear
 };
 
 Error usage(std::string text) { return Error(CoreErrc::invalid_argument, std::move(text)); }
+
+// Waits (polling) until `path` exists and its size stays the same over two polls (a file still
+// being written is not read), for at most `wait_s` seconds.
+asio::awaitable<Result<void>> wait_for_file(const std::string& path, double wait_s) {
+  namespace fs = std::filesystem;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_s);
+  bool told = false;
+  std::optional<std::uintmax_t> last;
+  for (;;) {
+    std::error_code ec;
+    const bool there = fs::exists(path, ec);
+    if (there) {
+      const auto size = fs::file_size(path, ec);
+      if (!ec && last && *last == size) co_return ok();
+      last = ec ? std::nullopt : std::optional<std::uintmax_t>(size);
+    } else if (!told) {
+      std::fprintf(stderr, "waiting for %s\n", path.c_str());
+      std::fflush(stderr);
+      told = true;
+    }
+    if (std::chrono::steady_clock::now() >= until)
+      co_return Error(CoreErrc::invalid_argument, fmt::format("{}: not there after {:g} s", path, wait_s));
+    co_await core::sleep_for(std::chrono::milliseconds(100));
+  }
+}
 
 std::vector<std::uint8_t> read_image(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -73,6 +107,14 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
         std::fprintf(stderr, "%s\n", p.to_text().c_str());
         std::fflush(stderr);
       };
+    }
+    if (action == "correct") {
+      // The first measurement must be there and readable before anything is connected.
+      const auto model = need(fps::plan::model_from_layout(plane));
+      std::vector<std::int32_t> known;
+      for (const auto& r : model.robots()) known.push_back(r.id());
+      need(host::load_measurements(a.measured.at(0), known));
+      need(fps::plan::load_targets(a.targets));
     }
     auto connected = co_await host::FocalPlaneArray::connect(ex, plane, array_options(a));
     auto fpa = need(std::move(connected));
@@ -157,6 +199,40 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
       }
       set_on_signal([] {});
     }
+    if (action == "correct") {
+      // Correction iterations: each round reads the next --measured file (waiting for it to appear),
+      // corrects the robots outside tolerance and waits for them to arrive.
+      const auto targets = need(fps::plan::load_targets(a.targets));
+      const auto model = need(fps::plan::model_from_layout(plane));
+      std::vector<std::int32_t> known;
+      for (const auto& r : model.robots()) known.push_back(r.id());
+      host::CorrectionRunOptions co;
+      co.iterations = a.iterations;
+      co.correction.tolerance_mm = a.tolerance_um / 1000.0;
+      co.on_round = [](const host::CorrectionRound& r) {
+        std::fputs(r.to_text().c_str(), stdout);
+        std::fflush(stdout);
+      };
+      const auto files = a.measured;
+      const double wait_s = a.wait_s;
+      host::MeasurementSource source =
+          [files, wait_s, known](int round) -> asio::awaitable<Result<std::optional<host::MeasurementSet>>> {
+        if (round > static_cast<int>(files.size())) co_return std::optional<host::MeasurementSet>();
+        const std::string path = files[static_cast<std::size_t>(round - 1)];
+        if (round > 1) {  // the first measurement is there already; later ones follow the moves
+          auto there = co_await wait_for_file(path, wait_s);
+          if (!there) co_return there.error();
+        }
+        auto m = host::load_measurements(path, known);
+        if (!m) co_return m.error();
+        co_return std::optional<host::MeasurementSet>(std::move(m).value());
+      };
+      auto run = co_await host::correct_positions(fpa->array(), model, targets, source, co);
+      const auto& lock = fpa->array().lock_state();
+      if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
+      std::fputs(run.summary().c_str(), stdout);
+      rc = run.ok() ? 0 : 1;
+    }
     if (action == "upgrade") {
       if (!uo.expected_version) std::printf("no --version given: versions are reported, not checked\n");
       auto r = co_await host::upgrade_plane(*fpa, image, uo);
@@ -213,6 +289,20 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
     if (a.plc.empty()) throw Exception(usage("fps plane cold needs --plc"));
     exit_code() = run_plane(a, "cold");
   });
+  auto* cr = p->add_subcommand("correct",
+                               "correction iterations: robots whose measured fibre is outside tolerance get a correction "
+                               "move (GO_TO_ABSOLUTE_POSITION), one round per --measured file");
+  cr->add_option("--targets", a.targets, "target file (.yaml/.csv, docs/fps-plan.md)")->required()->check(CLI::ExistingFile);
+  cr->add_option("--measured", a.measured,
+                 "measured fibre positions, CSV robot,x,y[,fibre] in mm (repeatable, one per round, in order; "
+                 "files after the first are waited for)")
+      ->required();
+  cr->add_option("--tolerance-um", a.tolerance_um, "robots closer than this to their target are left alone (default 5)")
+      ->check(CLI::Range(0.0, 10000.0));
+  cr->add_option("--iterations", a.iterations, "most rounds that send corrections (default 3)")->check(CLI::Range(1, 100));
+  cr->add_option("--wait", a.wait_s, "seconds to wait for each later --measured file to appear (default 600)")
+      ->check(CLI::Range(0.0, 86400.0));
+  cr->callback([] { exit_code() = run_plane(a, "correct"); });
   up->callback([] {
     if (a.plc.empty()) throw Exception(usage("fps plane upgrade needs --plc"));
     exit_code() = run_plane(a, "upgrade");

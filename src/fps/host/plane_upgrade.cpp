@@ -56,6 +56,18 @@ std::string PlaneUpgradeReport::summary() const {
                                 with(PlaneRobotOutcome::not_attempted).size());
   for (const auto& s : sextants) out += "  " + s.to_text() + "\n";
   for (const auto& n : notes) out += "  note: " + n + "\n";
+  if (cold) {
+    // The policy's own report, indented under its heading.
+    out += "  cold policy re-applied after the power cycles:\n";
+    const std::string text = cold->to_text();
+    std::size_t from = 0;
+    while (from < text.size()) {
+      const auto nl = text.find('\n', from);
+      out += "    " + text.substr(from, nl == std::string::npos ? std::string::npos : nl - from) + "\n";
+      if (nl == std::string::npos) break;
+      from = nl + 1;
+    }
+  }
   for (const auto& r : robots) {
     const std::string after = r.after ? r.after->to_string() : std::string("no answer");
     out += fmt::format("  positioner {} (sextant {}): {}, {} attempt{}, runs {}{}{}{}\n", r.id, r.sextant,
@@ -398,6 +410,17 @@ asio::awaitable<Result<PlaneUpgradeReport>> upgrade_plane(FocalPlaneArray& plane
   for (int s : sextants) {
     spdlog::info("fps plane upgrade: sextant {}: {} robots", s, work[s].size());
     co_await upgrade_sextant(run, s, work[s]);
+  }
+  if (options.reapply_cold) {
+    // The robots came back with the firmware's default speed and holding current.
+    ColdControl cold(plane, options.cold_policy);
+    auto applied = co_await cold.step(true);
+    if (applied) {
+      report.cold = std::move(applied).value();
+    } else {
+      report.notes.push_back("cold policy not re-applied after the upgrade: " + applied.error().message() +
+                             "; run `axon fps plane cold`");
+    }
   }
   co_return report;
 }

@@ -14,6 +14,8 @@
 //      came up after a verified transfer).
 // A robot whose transfer stopped part-way is reported `half_written`: the bootloader kept the
 // partial image out of use, so the robot runs its previous firmware and needs another upgrade.
+// At the end the cold policy (speed, holding current) is applied again to every robot, since the
+// power cycles left them at the firmware's volatile defaults (PlaneUpgradeOptions::reapply_cold).
 // Whatever fails, the sextant is always powered back into the application and the sync line left
 // low before the next sextant starts; a PLC that fails stops the whole upgrade and every robot not
 // yet reached is reported `not_attempted` with the reason.
@@ -21,6 +23,7 @@
 
 #include "core/clock.hpp"
 #include "core/error.hpp"
+#include "fps/host/cold_control.hpp"
 #include "fps/host/firmware_upgrade.hpp"
 #include "fps/protocol/firmware_version.hpp"
 
@@ -63,6 +66,11 @@ struct PlaneUpgradeOptions {
   core::Duration poll = 50ms;                  // while waiting for either
   core::Duration progress_interval = 1s;       // progress calls while transferring (0: only at the end)
   std::function<void(const SextantProgress&)> progress;
+  // Speed and holding current are volatile in the robots, so after the power cycles they run the
+  // firmware's defaults: at the end the cold policy is applied again from the PLC's temperatures
+  // (ColdControl::step(true)) unless this is false.
+  bool reapply_cold = true;
+  plc::ColdPolicyConfig cold_policy;
 };
 
 enum class PlaneRobotOutcome : std::uint8_t { ok, failed, not_attempted };
@@ -85,6 +93,7 @@ struct PlaneUpgradeReport {
   std::vector<PlaneRobotReport> robots;      // by sextant, then id
   std::vector<SextantProgress> sextants;     // final figures per sextant
   std::vector<std::string> notes;            // PLC failures, buses that missed an abort, ...
+  std::optional<ColdApplyReport> cold;       // the cold policy applied at the end (reapply_cold)
 
   [[nodiscard]] bool ok() const noexcept;
   [[nodiscard]] std::vector<std::uint16_t> with(PlaneRobotOutcome o) const;

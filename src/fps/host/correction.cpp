@@ -1,0 +1,338 @@
+#include "fps/host/correction.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace axon::fps::host {
+
+namespace {
+
+class CorrectionCategory final : public std::error_category {
+ public:
+  const char* name() const noexcept override { return "axon.fps.correction"; }
+  std::string message(int c) const override {
+    switch (static_cast<CorrectionErrc>(c)) {
+      case CorrectionErrc::cannot_open:
+        return "measurement file cannot be read";
+      case CorrectionErrc::missing_column:
+        return "measurement file lacks a column (the header needs robot, x and y)";
+      case CorrectionErrc::unknown_column:
+        return "measurement file names an unknown column (known: robot, x, y, fibre)";
+      case CorrectionErrc::not_a_number:
+        return "measurement file holds a value that is not a number";
+      case CorrectionErrc::duplicate_robot:
+        return "measurement file lists a robot twice";
+      case CorrectionErrc::unknown_robot:
+        return "measurement file names a robot that is not part of the focal plane";
+    }
+    return "unknown measurement error";
+  }
+};
+
+Error at(CorrectionErrc code, const std::string& name, int line, std::string_view what) {
+  return make_error(code, fmt::format("{}:{}: {}", name, line, what));
+}
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return std::tolower(c); });
+  return out;
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  return s;
+}
+
+std::vector<std::string_view> split(std::string_view line) {
+  std::vector<std::string_view> out;
+  for (;;) {
+    const auto comma = line.find(',');
+    out.push_back(trim(line.substr(0, comma)));
+    if (comma == std::string_view::npos) break;
+    line.remove_prefix(comma + 1);
+  }
+  return out;
+}
+
+template <class T>
+std::optional<T> number(std::string_view s) {
+  T v{};
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
+  if constexpr (std::is_floating_point_v<T>) {
+    if (!std::isfinite(v)) return std::nullopt;
+  }
+  return v;
+}
+
+// Angle difference a - b brought into [-180, 180).
+double angle_diff(double a, double b) noexcept {
+  double d = std::fmod(a - b + 180.0, 360.0);
+  if (d < 0) d += 360.0;
+  return d - 180.0;
+}
+
+}  // namespace
+
+const std::error_category& correction_category() noexcept {
+  static const CorrectionCategory c;
+  return c;
+}
+
+const Measurement* MeasurementSet::find(std::int32_t robot) const noexcept {
+  for (const auto& m : items)
+    if (m.robot == robot) return &m;
+  return nullptr;
+}
+
+Result<MeasurementSet> parse_measurements_csv(std::string_view text, const std::string& name,
+                                              std::span<const std::int32_t> known_robots) {
+  enum Col { robot, x, y, fibre };
+  const std::set<std::int32_t> known(known_robots.begin(), known_robots.end());
+  std::vector<int> columns;
+  std::set<std::int32_t> seen;
+  MeasurementSet out;
+  out.source = name;
+  int line_no = 0;
+  while (!text.empty()) {
+    const auto nl = text.find('\n');
+    std::string_view line = text.substr(0, nl);
+    text.remove_prefix(nl == std::string_view::npos ? text.size() : nl + 1);
+    ++line_no;
+    if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    line = trim(line);
+    if (line.empty()) continue;
+    const auto cells = split(line);
+    if (columns.empty()) {
+      std::vector<bool> have(4, false);
+      for (const auto c : cells) {
+        const std::string l = lower(c);
+        int col = -1;
+        if (l == "robot") col = robot;
+        if (l == "x") col = x;
+        if (l == "y") col = y;
+        if (l == "fibre" || l == "fiber") col = fibre;
+        if (col < 0)
+          return at(CorrectionErrc::unknown_column, name, line_no,
+                    fmt::format("unknown column '{}' (known: robot, x, y, fibre)", c));
+        if (have[static_cast<std::size_t>(col)])
+          return at(CorrectionErrc::unknown_column, name, line_no, fmt::format("column '{}' twice", c));
+        have[static_cast<std::size_t>(col)] = true;
+        columns.push_back(col);
+      }
+      for (auto [col, what] : {std::pair{robot, "robot"}, std::pair{x, "x"}, std::pair{y, "y"}})
+        if (!have[static_cast<std::size_t>(col)])
+          return at(CorrectionErrc::missing_column, name, line_no, fmt::format("the header needs a '{}' column", what));
+      continue;
+    }
+    if (cells.size() != columns.size())
+      return at(CorrectionErrc::missing_column, name, line_no,
+                fmt::format("{} cells, the header has {}", cells.size(), columns.size()));
+    Measurement m;
+    m.line = line_no;
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      const std::string_view c = cells[i];
+      switch (columns[i]) {
+        case robot: {
+          const auto id = number<std::int64_t>(c);
+          if (!id) return at(CorrectionErrc::not_a_number, name, line_no, fmt::format("robot id '{}' is not an integer", c));
+          if (*id < 1 || *id > 2047)
+            return at(CorrectionErrc::unknown_robot, name, line_no, fmt::format("robot id {} out of range 1..2047", *id));
+          m.robot = static_cast<std::int32_t>(*id);
+          break;
+        }
+        case x:
+        case y: {
+          const auto v = number<double>(c);
+          if (!v)
+            return at(CorrectionErrc::not_a_number, name, line_no,
+                      fmt::format("{} '{}' is not a number", columns[i] == x ? "x" : "y", c));
+          (columns[i] == x ? m.position.x : m.position.y) = *v;
+          break;
+        }
+        default:
+          if (!c.empty()) m.fibre = std::string(c);
+      }
+    }
+    if (!known.empty() && !known.contains(m.robot))
+      return at(CorrectionErrc::unknown_robot, name, line_no,
+                fmt::format("robot {} is not part of the focal plane", m.robot));
+    if (!seen.insert(m.robot).second)
+      return at(CorrectionErrc::duplicate_robot, name, line_no, fmt::format("robot {} measured twice", m.robot));
+    out.items.push_back(std::move(m));
+  }
+  if (columns.empty()) return at(CorrectionErrc::missing_column, name, line_no, "no header line (robot,x,y)");
+  return out;
+}
+
+Result<MeasurementSet> load_measurements(const std::string& path, std::span<const std::int32_t> known_robots) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return make_error(CorrectionErrc::cannot_open, fmt::format("{}: cannot open", path));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) return make_error(CorrectionErrc::cannot_open, fmt::format("{}: cannot read", path));
+  return parse_measurements_csv(ss.str(), path, known_robots);
+}
+
+std::string_view to_string(CorrectionStatus s) noexcept {
+  switch (s) {
+    case CorrectionStatus::within_tolerance:
+      return "within tolerance";
+    case CorrectionStatus::move:
+      return "move";
+    case CorrectionStatus::unreachable:
+      return "unreachable";
+    case CorrectionStatus::not_measured:
+      return "not measured";
+    case CorrectionStatus::no_position:
+      return "no position";
+  }
+  return "?";
+}
+
+std::size_t CorrectionPlan::count(CorrectionStatus s) const noexcept {
+  return static_cast<std::size_t>(
+      std::count_if(robots.begin(), robots.end(), [s](const RobotCorrection& r) { return r.status == s; }));
+}
+
+double CorrectionPlan::worst_error_mm() const noexcept {
+  double worst = 0;
+  for (const auto& r : robots)
+    if (r.measured) worst = std::max(worst, r.error_mm);
+  return worst;
+}
+
+bool CorrectionPlan::converged() const noexcept {
+  return !robots.empty() && count(CorrectionStatus::within_tolerance) == robots.size();
+}
+
+const RobotCorrection* CorrectionPlan::find(std::int32_t robot) const noexcept {
+  for (const auto& r : robots)
+    if (r.robot == robot) return &r;
+  return nullptr;
+}
+
+std::map<std::int32_t, plan::Pose> CorrectionPlan::moves() const {
+  std::map<std::int32_t, plan::Pose> out;
+  for (const auto& r : robots)
+    if (r.status == CorrectionStatus::move) out[r.robot] = r.command;
+  return out;
+}
+
+Result<std::pair<plan::Vec2, std::size_t>> target_point(const plan::Positioner& robot, const plan::ArmDesign& design,
+                                                        const plan::Target& t) {
+  const auto fibre = design.fibre_index(t.fibre);
+  if (!fibre) return make_error(plan::PlanErrc::unknown_fibre, fmt::format("fibre '{}'", t.fibre));
+  if (t.position) return std::pair{*t.position, *fibre};
+  return std::pair{robot.fibre(t.pose.value_or(plan::Pose{}), *fibre), *fibre};
+}
+
+plan::Elbow elbow_of(const plan::Positioner& robot, plan::Pose pose, std::size_t fibre) {
+  // Solve for the fibre's own position and keep the branch that gives back the pose.
+  const plan::IkSolutions s = robot.inverse(robot.fibre(pose, fibre), fibre);
+  auto distance = [&](const plan::Pose& p) {
+    return std::abs(angle_diff(p.alpha_deg, pose.alpha_deg)) + std::abs(angle_diff(p.beta_deg, pose.beta_deg));
+  };
+  return distance(s.pose[1]) < distance(s.pose[0]) ? plan::Elbow::cw : plan::Elbow::ccw;
+}
+
+CorrectionPlan plan_corrections(const plan::CollisionModel& model, std::span<const plan::Target> targets,
+                                const MeasurementSet& measured, const std::map<std::int32_t, plan::Pose>& current,
+                                const CorrectionOptions& options) {
+  using S = CorrectionStatus;
+  CorrectionPlan out;
+  out.tolerance_mm = options.tolerance_mm;
+  std::set<std::int32_t> targeted;
+  for (const plan::Target& t : targets) {
+    RobotCorrection r;
+    r.robot = t.robot;
+    r.fibre = t.fibre;
+    targeted.insert(t.robot);
+    const auto index = model.index_of(t.robot);
+    if (!index) {
+      r.status = S::unreachable;
+      r.detail = "not part of the focal plane";
+      out.robots.push_back(std::move(r));
+      continue;
+    }
+    const plan::Positioner& robot = model.robot(*index);
+    auto point = target_point(robot, model.design(), t);
+    if (!point) {
+      r.status = S::unreachable;
+      r.detail = point.error().message();
+      out.robots.push_back(std::move(r));
+      continue;
+    }
+    r.target = point.value().first;
+    const std::size_t fibre = point.value().second;
+    const Measurement* m = measured.find(t.robot);
+    if (const auto c = current.find(t.robot); c != current.end()) r.current = c->second;
+    if (!m) {
+      r.status = S::not_measured;
+      r.detail = fmt::format("not in {}", measured.source);
+      out.robots.push_back(std::move(r));
+      continue;
+    }
+    r.measured = m->position;
+    r.error = m->position - r.target;
+    r.error_mm = plan::norm(r.error);
+    if (m->fibre && lower(*m->fibre) != lower(t.fibre)) {
+      r.status = S::unreachable;
+      r.detail = fmt::format("{}:{}: measured fibre '{}' but the target is for '{}'", measured.source, m->line,
+                             *m->fibre, t.fibre);
+      out.robots.push_back(std::move(r));
+      continue;
+    }
+    if (r.error_mm <= options.tolerance_mm) {
+      r.status = S::within_tolerance;
+      out.robots.push_back(std::move(r));
+      continue;
+    }
+    if (!r.current) {
+      r.status = S::no_position;
+      r.detail = "its current angles are unknown";
+      out.robots.push_back(std::move(r));
+      continue;
+    }
+    r.elbow = elbow_of(robot, *r.current, fibre);
+    auto want = robot.inverse(r.target, fibre, r.elbow);
+    auto got = robot.inverse(m->position, fibre, r.elbow);
+    if (!want || !got) {
+      r.status = S::unreachable;
+      r.detail = fmt::format("{} point: {}", !want ? "target" : "measured", (!want ? want : got).error().message());
+      out.robots.push_back(std::move(r));
+      continue;
+    }
+    r.delta = {angle_diff(want.value().alpha_deg, got.value().alpha_deg),
+               angle_diff(want.value().beta_deg, got.value().beta_deg)};
+    r.command = {r.current->alpha_deg + r.delta.alpha_deg, r.current->beta_deg + r.delta.beta_deg};
+    if (std::max(std::abs(r.delta.alpha_deg), std::abs(r.delta.beta_deg)) > options.max_correction_deg) {
+      r.status = S::unreachable;
+      r.detail = fmt::format("correction alpha {:+.4f} beta {:+.4f} deg exceeds {} deg (wrong fibre identified?)",
+                             r.delta.alpha_deg, r.delta.beta_deg, options.max_correction_deg);
+    } else if (!robot.within_limits(r.command)) {
+      r.status = S::unreachable;
+      r.detail = fmt::format("new command alpha {:.4f} beta {:.4f} deg outside the angle limits", r.command.alpha_deg,
+                             r.command.beta_deg);
+    } else {
+      r.status = S::move;
+    }
+    out.robots.push_back(std::move(r));
+  }
+  for (const auto& m : measured.items)
+    if (!targeted.contains(m.robot))
+      out.notes.push_back(fmt::format("{}:{}: robot {} has no target; left alone", measured.source, m.line, m.robot));
+  return out;
+}
+
+}  // namespace axon::fps::host
