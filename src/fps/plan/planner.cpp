@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <cmath>
 #include <random>
 #include <set>
@@ -211,11 +210,6 @@ void repair_locally(const CollisionModel& model, std::vector<StepperRobot>& robo
     StepperResult r = drive_to_goals(model, sub, so);
     ++runs;
     best.escapes += r.escapes;
-    if (std::getenv("FPS_DEBUG")) {
-      std::size_t na = 0, nb = 0;
-      for (std::size_t i = 0; i < n; ++i) { na += in[i]; nb += border[i]; }
-      fmt::print(stderr, "local {}: patch {} border {} stuck {} -> {} violations {} steps {}\n", k, na, nb, stuck_in(best, in), stuck_in(r, in), r.violations, r.steps);
-    }
     if (r.violations > 0 || stuck_in(r, in) >= stuck_in(best, in)) continue;
     double duration = 0;
     for (std::size_t i = 0; i < n; ++i) {

@@ -1,8 +1,6 @@
 #include "fps/plan/stepper.hpp"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -591,11 +589,6 @@ StepperResult Stepper::run() {
                     std::clamp(g.beta_deg - p.beta_deg, -o_.beta_step_deg, o_.beta_step_deg)};
       const Pose q = apply(p, mv, g);
       feasible(i, q, m_.robot(i).collision_segment(q), travel(i, mv), false, &out.blockers[i]);
-      if (std::getenv("FPS_DEBUG2"))
-        std::fprintf(stderr, "stuck robot %d at (%.2f, %.2f) start (%.2f, %.2f) goal (%.2f, %.2f) obst %zu field %d/%d blockers %zu direct_ok %d\n",
-                     m_.robot(i).id(), p.alpha_deg, p.beta_deg, robots_[i].start.alpha_deg, robots_[i].start.beta_deg, g.alpha_deg, g.beta_deg,
-                     m_.obstacle_pairs_of(i).size(), int(field_tried_[i]), int(!fields_[i].cost.empty()), out.blockers[i].size(),
-                     int(feasible(i, q, m_.robot(i).collision_segment(q), travel(i, mv), false, nullptr).ok));
     }
   }
   out.pair_checks = checks_;
