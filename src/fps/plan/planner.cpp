@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <random>
 #include <set>
 #include <thread>
 
@@ -114,13 +115,16 @@ std::size_t count_unreached(const StepperResult& r) {
   return static_cast<std::size_t>(std::count(r.reached.begin(), r.reached.end(), false));
 }
 
+void repair_locally(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperResult& best,
+                    StepperOptions so, int tries, int rings, double fold_spread, std::size_t& runs);
+
 // One half, re-run while robots get stuck: each retry puts every robot stuck so far in front (it
 // steps first, the others yield to it) and draws a new seed; from the `relax_after`-th retry on, a
 // stuck robot also gives up turning alpha in this half (its goal alpha becomes its start alpha:
 // a pure beta fold), leaving the turn to the other half or to the middle phase. The run with the
 // fewest robots stuck (then the shortest) is kept; `robots` holds the goals of that run.
 StepperResult drive_with_retries(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperOptions so,
-                                 int retries, int relax_after, std::size_t& runs) {
+                                 int retries, int relax_after, int local_tries, int local_rings, double fold_spread, std::size_t& runs) {
   StepperResult best = drive_to_goals(model, robots, so);
   ++runs;
   std::vector<StepperRobot> best_robots = robots;
@@ -144,7 +148,82 @@ StepperResult drive_with_retries(const CollisionModel& model, std::vector<Steppe
     }
   }
   robots = std::move(best_robots);
+  if (local_tries > 0 && count_unreached(best) > 0) {
+    so.seed ^= 0x9e3779b97f4a7c15ULL;
+    repair_locally(model, robots, best, so, local_tries, local_rings, fold_spread, runs);
+  }
   return best;
+}
+
+// Local repair of a half: the robots still stuck and every robot within `rings` neighbour rings of
+// them are planned again from their starts, with new seeds and the stuck robots in front, while
+// the robots bordering that patch follow their paths of `best` (scripted: moving obstacles) and
+// the rest do not matter. A run is taken over when it is clean (no scripted robot had to be run
+// into) and leaves fewer of the patch stuck; its paths replace the patch's paths in `best`.
+void repair_locally(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperResult& best,
+                    StepperOptions so, int tries, int rings, double fold_spread, std::size_t& runs) {
+  const std::size_t n = robots.size();
+  auto stuck_in = [&](const StepperResult& r, const std::vector<bool>& in) {
+    std::size_t c = 0;
+    for (std::size_t i = 0; i < n; ++i) c += (in[i] && !r.reached[i]) ? 1 : 0;
+    return c;
+  };
+  for (int k = 0; k < tries && count_unreached(best) > 0; ++k) {
+    // The patch (recomputed: it grows when a repair leaves robots stuck elsewhere).
+    std::vector<bool> in(n, false), border(n, false);
+    so.first.clear();
+    for (std::size_t i = 0; i < n; ++i)
+      if (!best.reached[i]) {
+        in[i] = true;
+        so.first.push_back(static_cast<std::uint32_t>(i));
+      }
+    for (int ring = 0; ring < rings; ++ring) {
+      std::vector<bool> next = in;
+      for (std::size_t i = 0; i < n; ++i)
+        if (in[i])
+          for (const std::uint32_t j : model.neighbours(i)) next[j] = true;
+      in = std::move(next);
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      if (in[i])
+        for (const std::uint32_t j : model.neighbours(i))
+          if (!in[j]) border[j] = true;
+    std::vector<StepperRobot> sub(n);
+    std::mt19937_64 rng(so.seed);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (robots[i].frozen || in[i]) {
+        sub[i] = robots[i];
+        // Any alpha is a fold: from the second try on, a stuck robot folds towards a random alpha
+        // within `fold_spread` of where it starts (the turn to its other fold happens while folded).
+        if (!robots[i].frozen && !best.reached[i] && k >= 1 && fold_spread > 0) {
+          const AngleLimits& l = model.robot(i).limits();
+          std::uniform_real_distribution<double> d(-fold_spread, fold_spread);
+          sub[i].goal.alpha_deg = std::clamp(robots[i].start.alpha_deg + d(rng), l.alpha_min_deg, l.alpha_max_deg);
+        }
+      } else if (border[i]) {
+        sub[i] = {robots[i].start, robots[i].goal, false, &best.paths[i]};
+      } else {
+        sub[i] = {robots[i].start, robots[i].start, true};
+      }
+    }
+    so.seed = so.seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    StepperResult r = drive_to_goals(model, sub, so);
+    ++runs;
+    best.escapes += r.escapes;
+    if (r.violations > 0 || stuck_in(r, in) >= stuck_in(best, in)) continue;
+    double duration = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (in[i] && !robots[i].frozen) {
+        robots[i].goal = sub[i].goal;
+        best.paths[i] = std::move(r.paths[i]);
+        best.end[i] = r.end[i];
+        best.reached[i] = r.reached[i];
+        best.blockers[i] = std::move(r.blockers[i]);
+      }
+      duration = std::max({duration, best.paths[i].alpha.back().t_s, best.paths[i].beta.back().t_s});
+    }
+    best.duration_s = duration;
+  }
 }
 
 constexpr const char* kReverseStuck = "its target cannot be reached from the fold without a collision";
@@ -303,12 +382,12 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
     const auto t0 = Clock::now();
     std::size_t runs_a = 0, runs_b = 0;
     if (o.parallel) {
-      std::thread worker([&] { ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, runs_a); });
-      rb = drive_with_retries(model, fb, sb, o.half_retries, o.relax_after, runs_b);
+      std::thread worker([&] { ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, runs_a); });
+      rb = drive_with_retries(model, fb, sb, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, runs_b);
       worker.join();
     } else {
-      ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, runs_a);
-      rb = drive_with_retries(model, fb, sb, o.half_retries, o.relax_after, runs_b);
+      ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, runs_a);
+      rb = drive_with_retries(model, fb, sb, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, runs_b);
     }
     // Folds given up by B: A turns those robots to the target alpha instead (one more A run), so
     // that no middle phase is needed for them unless A gives up the turn as well.
@@ -326,7 +405,7 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
     }
     if (rerun_a) {
       sa.seed += 104729;
-      ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, runs_a);
+      ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, runs_a);
       for (std::size_t i = 0; i < n; ++i)
         if (!still[i] && fa[i].goal.alpha_deg == request.current[i].alpha_deg &&
             fb[i].goal.alpha_deg != fa[i].goal.alpha_deg)

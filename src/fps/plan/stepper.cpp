@@ -68,10 +68,23 @@ class Stepper {
     double min_clearance = kInf;  // after the move (exact where it is small)
   };
 
-  [[nodiscard]] double cost(std::size_t i, Pose p) const noexcept {
+  [[nodiscard]] double direct_cost(std::size_t i, Pose p) const noexcept {
     const Pose g = robots_[i].goal;
     return o_.alpha_weight * std::abs(g.alpha_deg - p.alpha_deg) + o_.beta_weight * std::abs(g.beta_deg - p.beta_deg);
   }
+  [[nodiscard]] double cost(std::size_t i, Pose p) const noexcept {
+    return fields_.empty() || fields_[i].cost.empty() ? direct_cost(i, p) : field_cost(i, p);
+  }
+  // Navigation field of one robot: the cost to its goal around the fixed obstacles and the robots
+  // that never move, on a grid of engine steps anchored at the goal (Dijkstra with the cost's
+  // weights). Built when a robot gets stuck next to something fixed; a robot that follows it
+  // downhill cannot get caught in a pocket of fixed obstacles.
+  struct Field {
+    std::vector<float> cost;  // na * nb, +inf where blocked or cut off
+    int na = 0, nb = 0, oa = 0, ob = 0;
+  };
+  [[nodiscard]] double field_cost(std::size_t i, Pose p) const noexcept;
+  bool build_field(std::size_t i);
   [[nodiscard]] double travel(std::size_t i, Move mv) const noexcept {
     const Positioner& r = m_.robot(i);
     return (std::abs(mv.da) * r.reach_mm() + std::abs(mv.db) * r.collision_length_mm()) * kRad;
@@ -84,6 +97,10 @@ class Stepper {
                        std::vector<std::uint32_t>* blockers);
   void step_robot(std::size_t i);
   void record(std::size_t i, double t_s);
+  // With scripts: a planned robot about to stand still checks that no scripted neighbour runs
+  // into it, and otherwise takes the clear move that keeps the most clearance.
+  bool scripted_neighbour_moves(std::size_t i) const noexcept;
+  void hold_or_dodge(std::size_t i);
 
   const CollisionModel& m_;
   std::span<const StepperRobot> robots_;
@@ -97,7 +114,150 @@ class Stepper {
   std::size_t checks_ = 0;
   std::vector<std::uint32_t> rank_;      // priority: higher ranks do not make way for lower
   std::vector<std::uint32_t> blockers_;  // scratch
+  std::vector<bool> is_scripted_;
+  std::vector<Field> fields_;
+  std::vector<bool> field_tried_;
+  bool has_scripts_ = false;
+  std::size_t violations_ = 0;
 };
+
+double Stepper::field_cost(std::size_t i, Pose p) const noexcept {
+  const Field& f = fields_[i];
+  const Pose g = robots_[i].goal;
+  const double fa = (p.alpha_deg - g.alpha_deg) / o_.alpha_step_deg + f.oa;
+  const double fb = (p.beta_deg - g.beta_deg) / o_.beta_step_deg + f.ob;
+  const int ca = static_cast<int>(std::lround(fa)), cb = static_cast<int>(std::lround(fb));
+  double best = kInf;
+  // The cheapest of the nearby cells plus the straight way there: exactly 0 only at the goal.
+  for (int a = ca - 1; a <= ca + 1; ++a)
+    for (int b = cb - 1; b <= cb + 1; ++b) {
+      if (a < 0 || b < 0 || a >= f.na || b >= f.nb) continue;
+      const double c = f.cost[static_cast<std::size_t>(a) * static_cast<std::size_t>(f.nb) + static_cast<std::size_t>(b)];
+      if (!(c < kInf)) continue;
+      best = std::min(best, c + o_.alpha_weight * std::abs(fa - a) * o_.alpha_step_deg +
+                                o_.beta_weight * std::abs(fb - b) * o_.beta_step_deg);
+    }
+  return best < kInf ? best : 1e6 + direct_cost(i, p);
+}
+
+bool Stepper::build_field(std::size_t i) {
+  field_tried_[i] = true;
+  const Positioner& r = m_.robot(i);
+  const AngleLimits& lim = r.limits();
+  const Pose g = robots_[i].goal;
+  const double sa = o_.alpha_step_deg, sb = o_.beta_step_deg;
+  Field f;
+  f.oa = static_cast<int>(std::floor((g.alpha_deg - lim.alpha_min_deg) / sa + 1e-9));
+  f.ob = static_cast<int>(std::floor((g.beta_deg - lim.beta_min_deg) / sb + 1e-9));
+  f.na = f.oa + static_cast<int>(std::floor((lim.alpha_max_deg - g.alpha_deg) / sa + 1e-9)) + 1;
+  f.nb = f.ob + static_cast<int>(std::floor((lim.beta_max_deg - g.beta_deg) / sb + 1e-9)) + 1;
+  if (f.na <= 0 || f.nb <= 0 || static_cast<long>(f.na) * f.nb > 4'000'000) return false;
+  // What is fixed: obstacles and the neighbours that never move.
+  struct Fixed {
+    Segment s;
+    double limit;
+  };
+  std::vector<Fixed> fixed;
+  const auto obstacles = m_.obstacles();
+  const auto opairs = m_.obstacle_pairs();
+  for (const std::uint32_t k : m_.obstacle_pairs_of(i))
+    fixed.push_back({obstacles[opairs[k].obstacle].shape, opairs[k].limit_mm});
+  const auto nb = m_.neighbours(i);
+  const auto pairs = m_.pairs_of(i);
+  const auto all_pairs = m_.robot_pairs();
+  for (std::size_t k = 0; k < nb.size(); ++k)
+    if (robots_[nb[k]].frozen) fixed.push_back({seg_prev_[nb[k]], all_pairs[pairs[k]].limit_mm});
+  if (fixed.empty()) return false;
+  const std::size_t cells = static_cast<std::size_t>(f.na) * static_cast<std::size_t>(f.nb);
+  std::vector<std::uint8_t> blocked(cells, 0);
+  for (int a = 0; a < f.na; ++a)
+    for (int b = 0; b < f.nb; ++b) {
+      const Pose q{g.alpha_deg + (a - f.oa) * sa, g.beta_deg + (b - f.ob) * sb};
+      const Segment sq = r.collision_segment(q);
+      for (const Fixed& x : fixed)
+        if (segment_distance(sq, x.s) < x.limit + o_.margin_mm) {
+          blocked[static_cast<std::size_t>(a) * static_cast<std::size_t>(f.nb) + static_cast<std::size_t>(b)] = 1;
+          break;
+        }
+    }
+  f.cost.assign(cells, std::numeric_limits<float>::infinity());
+  using Item = std::pair<float, std::uint32_t>;
+  std::vector<Item> heap;
+  const std::size_t goal_cell = static_cast<std::size_t>(f.oa) * static_cast<std::size_t>(f.nb) + static_cast<std::size_t>(f.ob);
+  if (blocked[goal_cell]) return false;
+  f.cost[goal_cell] = 0;
+  heap.push_back({0.0f, static_cast<std::uint32_t>(goal_cell)});
+  const float wa = static_cast<float>(o_.alpha_weight * sa), wb = static_cast<float>(o_.beta_weight * sb);
+  auto greater = [](const Item& x, const Item& y) { return x.first > y.first; };
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), greater);
+    const auto [c, cell] = heap.back();
+    heap.pop_back();
+    if (c > f.cost[cell]) continue;
+    const int a = static_cast<int>(cell / static_cast<std::uint32_t>(f.nb)), b = static_cast<int>(cell % static_cast<std::uint32_t>(f.nb));
+    for (int da = -1; da <= 1; ++da)
+      for (int db = -1; db <= 1; ++db) {
+        if (da == 0 && db == 0) continue;
+        const int a2 = a + da, b2 = b + db;
+        if (a2 < 0 || b2 < 0 || a2 >= f.na || b2 >= f.nb) continue;
+        const std::size_t c2 = static_cast<std::size_t>(a2) * static_cast<std::size_t>(f.nb) + static_cast<std::size_t>(b2);
+        if (blocked[c2]) continue;
+        const float nc = c + (da != 0 ? wa : 0.0f) + (db != 0 ? wb : 0.0f);
+        if (nc < f.cost[c2]) {
+          f.cost[c2] = nc;
+          heap.push_back({nc, static_cast<std::uint32_t>(c2)});
+          std::push_heap(heap.begin(), heap.end(), greater);
+        }
+      }
+  }
+  fields_[i] = std::move(f);
+  // Useless when the robot's own cell is cut off from the goal.
+  if (!(field_cost(i, prev_[i]) < 1e6)) {
+    fields_[i] = {};
+    return false;
+  }
+  return true;
+}
+
+bool Stepper::scripted_neighbour_moves(std::size_t i) const noexcept {
+  for (const std::uint32_t j : m_.neighbours(i))
+    if (is_scripted_[j] && cur_[j] != prev_[j]) return true;
+  return false;
+}
+
+void Stepper::hold_or_dodge(std::size_t i) {
+  if (!scripted_neighbour_moves(i)) return;
+  const Pose p = prev_[i];
+  if (feasible(i, p, seg_prev_[i], 0.0, false, nullptr).ok) return;
+  const AngleLimits& lim = m_.robot(i).limits();
+  double best = -kInf;
+  Move chosen{};
+  bool found = false;
+  for (double a : {-o_.alpha_step_deg, 0.0, o_.alpha_step_deg})
+    for (double b : {-o_.beta_step_deg, 0.0, o_.beta_step_deg}) {
+      const Move mv{a, b};
+      if (mv == Move{}) continue;
+      const Pose q{p.alpha_deg + a, p.beta_deg + b};
+      if (q.alpha_deg < lim.alpha_min_deg || q.alpha_deg > lim.alpha_max_deg || q.beta_deg < lim.beta_min_deg ||
+          q.beta_deg > lim.beta_max_deg)
+        continue;
+      const auto f = feasible(i, q, m_.robot(i).collision_segment(q), travel(i, mv), true, nullptr);
+      if (f.ok && f.min_clearance > best) {
+        best = f.min_clearance;
+        chosen = mv;
+        found = true;
+      }
+    }
+  if (!found) {
+    ++violations_;
+    return;
+  }
+  const Pose q{p.alpha_deg + chosen.da, p.beta_deg + chosen.db};
+  cur_[i] = q;
+  seg_cur_[i] = m_.robot(i).collision_segment(q);
+  trav_[i] = travel(i, chosen);
+  st_[i].last = chosen;
+}
 
 bool Stepper::certify(std::size_t i, Pose i0, Pose i1, double c0, double c1, std::size_t j, Pose j0, Pose j1,
                       double limit, double s, int depth) {
@@ -182,7 +342,10 @@ void Stepper::step_robot(std::size_t i) {
   const Pose p = prev_[i];
   const Pose g = r.goal;
   const double now = cost(i, p);
-  if (now == 0 && st.escape_left == 0) return;
+  if (now == 0 && st.escape_left == 0) {
+    if (has_scripts_) hold_or_dodge(i);
+    return;
+  }
   const AngleLimits& lim = m_.robot(i).limits();
 
   const double rem_a = g.alpha_deg - p.alpha_deg, rem_b = g.beta_deg - p.beta_deg;
@@ -257,12 +420,19 @@ void Stepper::step_robot(std::size_t i) {
   seg_cur_[i] = m_.robot(i).collision_segment(q);
   trav_[i] = travel(i, chosen);
   st.last = chosen;
+  if (chosen == Move{} && has_scripts_) hold_or_dodge(i);
   if (escaping) return;
   const double after = cost(i, q);
   if (after < st.best_cost - 1e-9) {
     st.best_cost = after;
     st.stuck = 0;
   } else if (++st.stuck >= o_.stuck_steps) {
+    if (o_.fields && !field_tried_[i] && build_field(i)) {
+      // From now on it follows the field: a fresh start of its progress count.
+      st.stuck = 0;
+      st.best_cost = cost(i, q);
+      return;
+    }
     std::uniform_int_distribution<int> len(o_.escape_min_steps, std::max(o_.escape_min_steps, o_.escape_max_steps));
     st.stuck = 0;
     // Blockers of lower priority make way; only when every blocker ranks higher does this robot
@@ -308,13 +478,28 @@ StepperResult Stepper::run() {
   seg_cur_ = seg_prev_;
   trav_.assign(n, 0.0);
   st_.assign(n, {});
+  fields_.assign(n, {});
+  field_tried_.assign(n, false);
   for (std::size_t i = 0; i < n; ++i) {
     st_[i].alpha.points.push_back({0.0, prev_[i].alpha_deg});
     st_[i].beta.points.push_back({0.0, prev_[i].beta_deg});
   }
-  std::vector<std::uint32_t> order;
-  for (std::size_t i = 0; i < n; ++i)
-    if (!robots_[i].frozen) order.push_back(static_cast<std::uint32_t>(i));
+  std::vector<std::uint32_t> order, scripted;
+  is_scripted_.assign(n, false);
+  double script_end = 0;
+  std::vector<std::pair<AngleCursor, AngleCursor>> cursors;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (robots_[i].frozen) continue;
+    if (const RobotTrajectory* sc = robots_[i].script) {
+      is_scripted_[i] = true;
+      scripted.push_back(static_cast<std::uint32_t>(i));
+      cursors.emplace_back(AngleCursor(sc->alpha), AngleCursor(sc->beta));
+      script_end = std::max({script_end, sc->alpha.back().t_s, sc->beta.back().t_s});
+    } else {
+      order.push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  has_scripts_ = !scripted.empty();
   rank_.resize(n);
   std::iota(rank_.begin(), rank_.end(), 0u);
   std::shuffle(rank_.begin(), rank_.end(), rng_);
@@ -329,7 +514,9 @@ StepperResult Stepper::run() {
   const auto stall_steps = o_.stall_s > 0 ? static_cast<std::size_t>(std::ceil(o_.stall_s / o_.dt_s)) : max_steps;
   std::size_t fewest_away = n + 1, last_arrival = 0;
   for (; step < max_steps; ++step) {
-    bool pending = false;
+    const double t = static_cast<double>(step) * o_.dt_s;
+    const bool scripts_running = t < script_end;
+    bool pending = scripts_running;
     std::size_t away = 0;
     for (const std::uint32_t i : order) {
       if (prev_[i] != robots_[i].goal) ++away;
@@ -339,15 +526,30 @@ StepperResult Stepper::run() {
     if (away < fewest_away) {
       fewest_away = away;
       last_arrival = step;
-    } else if (step - last_arrival > stall_steps) {
+    } else if (step - last_arrival > stall_steps && !scripts_running) {
       break;  // the robots left keep each other stuck
+    }
+    // Scripted robots take their step first: everyone planned checks against it.
+    for (std::size_t k = 0; k < scripted.size(); ++k) {
+      const std::uint32_t j = scripted[k];
+      const double t1 = static_cast<double>(step + 1) * o_.dt_s;
+      const Pose q{cursors[k].first.at(t1), cursors[k].second.at(t1)};
+      cur_[j] = q;
+      seg_cur_[j] = m_.robot(j).collision_segment(q);
+      const Positioner& r = m_.robot(j);
+      trav_[j] = (std::abs(q.alpha_deg - prev_[j].alpha_deg) * r.reach_mm() +
+                  std::abs(q.beta_deg - prev_[j].beta_deg) * r.collision_length_mm()) * kRad;
     }
     std::shuffle(order.begin(), order.end(), rng_);
     if (!o_.first.empty())
       std::stable_partition(order.begin(), order.end(), [&](std::uint32_t i) { return is_first[i]; });
     for (const std::uint32_t i : order) step_robot(i);
     bool moved = false;
-    const double t = static_cast<double>(step) * o_.dt_s;
+    for (const std::uint32_t j : scripted) {
+      prev_[j] = cur_[j];
+      seg_prev_[j] = seg_cur_[j];
+      trav_[j] = 0;
+    }
     for (const std::uint32_t i : order) {
       record(i, t);
       if (cur_[i] != prev_[i]) moved = true;
@@ -358,7 +560,7 @@ StepperResult Stepper::run() {
     if (moved) {
       last_motion = step + 1;
       quiet = 0;
-    } else if (++quiet > 400) {
+    } else if (++quiet > 400 && !scripts_running) {
       break;  // nobody can move at all any more
     }
   }
@@ -379,7 +581,7 @@ StepperResult Stepper::run() {
     };
     out.paths[i].alpha = finish(st_[i].alpha, prev_[i].alpha_deg);
     out.paths[i].beta = finish(st_[i].beta, prev_[i].beta_deg);
-    out.reached[i] = robots_[i].frozen || prev_[i] == robots_[i].goal;
+    out.reached[i] = robots_[i].frozen || is_scripted_[i] || prev_[i] == robots_[i].goal;
     if (!out.reached[i]) {
       // Who stands in the way of the direct move towards the goal.
       const Pose p = prev_[i], g = robots_[i].goal;
@@ -390,6 +592,7 @@ StepperResult Stepper::run() {
     }
   }
   out.pair_checks = checks_;
+  out.violations = violations_;
   return out;
 }
 

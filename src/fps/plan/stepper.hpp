@@ -38,6 +38,11 @@ struct StepperRobot {
   Pose start;
   Pose goal;
   bool frozen = false;  // never moves (held, disabled): an obstacle for the others
+  // Optional: the robot follows this trajectory (times from 0) instead of being planned, a moving
+  // obstacle for the others (a local re-plan inside a half already planned). Its moves are not
+  // checked against each other; every planned robot checks against them, and a planned robot that
+  // a scripted one would run into must dodge (see StepperResult::violations).
+  const RobotTrajectory* script = nullptr;
 };
 
 struct StepperOptions {
@@ -53,6 +58,9 @@ struct StepperOptions {
   int stuck_steps = 6;           // steps without progress before a robot escapes
   int escape_min_steps = 3;
   int escape_max_steps = 15;
+  // A robot stuck next to fixed obstacles (fiducials, robots that never move) switches to a
+  // navigation field: the grid cost to its goal around them (Dijkstra), followed downhill.
+  bool fields = false;
   // Robots (model indices) that rank above every other robot: they step first in every time step
   // (so the others make way) and lower-ranked blockers yield to them. Used to retry a half with
   // the robots that got stuck the last time in front.
@@ -68,6 +76,9 @@ struct StepperResult {
   std::size_t steps = 0;
   std::size_t escapes = 0;              // escape episodes started
   std::size_t pair_checks = 0;          // exact pair certificates evaluated
+  // Steps in which a planned robot could neither stand still nor move clear of a scripted robot:
+  // the result is then not collision-free and must not be used (only possible with scripts).
+  std::size_t violations = 0;
 };
 
 // Robots in model order. A pair that starts in contact cannot be certified, so both robots of it

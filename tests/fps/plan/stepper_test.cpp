@@ -1,0 +1,48 @@
+// The motion engine with scripted robots (the planner's local re-plans): planned robots certify
+// their moves against the scripted ones, and a planned robot that a scripted one would run into
+// is reported (a violation), so that the planner discards that run.
+#include "fps/plan/checker.hpp"
+#include "fps/plan/stepper.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace axon::fps::plan {
+namespace {
+
+CollisionModel two_robots() {
+  const std::vector<RobotSpec> specs{RobotSpec{1, {0, 0}, {}, {}, 2.0}, RobotSpec{2, {22.4, 0}, {}, {}, 2.0}};
+  auto m = CollisionModel::build(specs, ArmDesign{});
+  EXPECT_TRUE(m) << m.error().message();
+  return std::move(m).value();
+}
+
+TEST(StepperScript, ARobotThatCannotGetAwayIsReportedAsAViolation) {
+  // The same swing as fast as a robot can go: robot 1 cannot fold away in time. The engine must
+  // say so (the planner then throws the run away), and the played move indeed touches.
+  const auto m = two_robots();
+  const RobotTrajectory script = RobotTrajectory::linear({0, 0}, {180, 300}, 0, 25);
+  std::vector<StepperRobot> robots{{{0, 60}, {0, 60}, false, nullptr}, {{0, 0}, {180, 300}, false, &script}};
+  const StepperResult r = drive_to_goals(m, robots, StepperOptions{});
+  EXPECT_GT(r.violations, 0u);
+  std::vector<RobotTrajectory> played{r.paths[0], script};
+  TrajectoryChecker checker(m);
+  CheckReport report;
+  ASSERT_TRUE(checker.check(played, CheckOptions{}, report));
+  EXPECT_FALSE(report.ok());
+}
+
+TEST(StepperScript, WithoutScriptsTheSameRobotsNeverMove) {
+  // Control: robot 2 frozen at its start, robot 1 at its goal: nothing to do, nobody moves.
+  const auto m = two_robots();
+  std::vector<StepperRobot> robots{{{0, 60}, {0, 60}, false, nullptr}, {{0, 0}, {0, 0}, true, nullptr}};
+  const StepperResult r = drive_to_goals(m, robots, StepperOptions{});
+  EXPECT_EQ(r.paths[0].alpha.size(), 1u);
+  EXPECT_EQ(r.paths[0].beta.size(), 1u);
+  EXPECT_TRUE(r.reached[0]);
+  EXPECT_EQ(r.violations, 0u);
+}
+
+}  // namespace
+}  // namespace axon::fps::plan
