@@ -6,6 +6,7 @@
 #include "fake_device.hpp"
 #include "rig.hpp"
 
+#include "fps/host/concurrent.hpp"
 #include "fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
@@ -533,4 +534,57 @@ TEST_F(CommandClientTest, DelayedRepliesWithinTheTimeoutAreStillMatched) {
   });
   EXPECT_EQ(client->counters().timeouts, 0u);
   EXPECT_EQ(client->counters().replies, 1u);
+}
+
+// Many robots pipelining at once behind a small bus in-flight bound, with replies coming back after
+// varied delays: every robot must receive its requests in the order of the run (a trajectory point
+// that overtakes the one before it is refused by the robot). A request woken with a freed slot
+// resumes a little later; a later request of the same pipeline must not slip past it meanwhile.
+TEST(CommandClientPipeline, ReachesEachRobotInOrderUnderTheInFlightBound) {
+  constexpr std::uint16_t kRobots = 24;
+  constexpr std::size_t kRequests = 40;
+  std::size_t out_of_order = 0, failed = 0, checked = 0;
+  for (std::uint32_t seed = 1; seed <= 12; ++seed) {
+    Runner runner;
+    auto medium = can::VirtualBus::create(runner.io.get_executor(), "fps0");
+    auto host_bus = medium->attach("host");
+    std::uint32_t x = seed;
+    FakeDevice fake(*medium, [&x](const protocol::Message& m) {
+      x = x * 1664525u + 1013904223u;
+      // Some replies at once, some a little later: completions interleave with slot grants.
+      const auto delay = (x >> 24) % 2 == 0 ? std::chrono::microseconds((x >> 8) % 200) : core::Duration::zero();
+      return std::vector<Outgoing>{{reply_to(m, m.id.positioner), delay}};
+    });
+    ClientOptions o;
+    o.max_in_flight = 4 + seed % 3 * 6;
+    CommandClient client(*host_bus, o);
+    std::vector<std::vector<protocol::Request>> runs(kRobots + 1);
+    for (std::uint16_t id = 1; id <= kRobots; ++id) {
+      for (std::size_t i = 0; i < kRequests; ++i) {
+        // The index travels in the payload, so the order of arrival can be checked.
+        runs[id].push_back({CommandId::send_trajectory_data,
+                            protocol::Payload().put_u32(static_cast<std::uint32_t>(i)).put_u32(0)});
+      }
+    }
+    runner.run([&]() -> asio::awaitable<void> {
+      co_await for_each_concurrently(kRobots, [&](std::size_t k) -> asio::awaitable<void> {
+        const auto id = static_cast<std::uint16_t>(k + 1);
+        auto r = co_await client.pipeline(id, runs[id], 8);
+        failed += r.ok() ? 0 : 1;
+      });
+      co_await client.stop();
+      fake.stop();
+    });
+    std::vector<std::uint32_t> next(kRobots + 1, 0);
+    for (const auto& m : fake.requests()) {
+      if (m.id.command != protocol::number(CommandId::send_trajectory_data)) continue;
+      const std::uint32_t index = m.payload[0] | std::uint32_t{m.payload[1]} << 8 | std::uint32_t{m.payload[2]} << 16;
+      if (index != next[m.id.positioner]) ++out_of_order;
+      next[m.id.positioner] = index + 1;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(failed, 0u);
+  EXPECT_EQ(checked, 12u * kRobots * kRequests);
+  EXPECT_EQ(out_of_order, 0u);
 }
