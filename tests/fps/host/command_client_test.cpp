@@ -588,3 +588,58 @@ TEST(CommandClientPipeline, ReachesEachRobotInOrderUnderTheInFlightBound) {
   EXPECT_EQ(checked, 12u * kRobots * kRequests);
   EXPECT_EQ(out_of_order, 0u);
 }
+
+// The in-flight bound hands a freed slot to the oldest waiting request; that request resumes a
+// little later. A request made meanwhile (here the next trajectory point of the same robot, right
+// after another slot came free) must queue behind it instead of taking the free slot: otherwise
+// the later point reaches the robot first and the robot refuses the earlier one.
+TEST_F(CommandClientTest, AWokenRequestKeepsItsSlotAgainstNewcomers) {
+  std::optional<protocol::Message> held;
+  make(
+      [&held](const protocol::Message& m) {
+        std::vector<Outgoing> out;
+        if (m.id.positioner == 5) {
+          held = m;  // answered together with robot 6's request, in one burst
+        } else if (m.id.positioner == 6) {
+          if (held) out.push_back({reply_to(*held, 5)});
+          out.push_back({reply_to(m, 6)});
+        } else {
+          out.push_back({reply_to(m, m.id.positioner)});
+        }
+        return out;
+      },
+      [] {
+        ClientOptions o;
+        o.max_in_flight = 2;
+        return o;
+      }());
+  auto point = [](std::uint32_t i) { return protocol::Payload().put_u32(i).put_u32(0); };
+  runner.run([&]() -> asio::awaitable<void> {
+    std::size_t done = 0;
+    auto other = [&](std::uint16_t id, bool then_next_point) -> asio::awaitable<void> {
+      auto r = co_await client->request(id, CommandId::get_status);
+      EXPECT_TRUE(r.has_value());
+      if (then_next_point) {
+        const auto p1 = point(1);
+        auto n = co_await client->request(1, CommandId::send_trajectory_data, p1);
+        EXPECT_TRUE(n.has_value());
+      }
+      ++done;
+    };
+    auto first_point = [&]() -> asio::awaitable<void> {
+      const auto p0 = point(0);
+      auto r = co_await client->request(1, CommandId::send_trajectory_data, p0);
+      EXPECT_TRUE(r.has_value());
+      ++done;
+    };
+    asio::co_spawn(runner.io, other(5, false), asio::detached);  // takes slot 1
+    asio::co_spawn(runner.io, other(6, true), asio::detached);   // takes slot 2
+    asio::co_spawn(runner.io, first_point(), asio::detached);    // waits for a slot
+    while (done < 3) co_await core::sleep_for(1ms);
+  });
+  std::vector<std::uint32_t> order;
+  for (const auto& m : fake->requests()) {
+    if (m.id.command == protocol::number(CommandId::send_trajectory_data)) order.push_back(m.payload[0]);
+  }
+  EXPECT_EQ(order, (std::vector<std::uint32_t>{0, 1}));
+}
