@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <span>
 #include <vector>
 
 using namespace axon::can;
@@ -84,4 +86,66 @@ TEST(Wire, ArbitrationOrder) {
   // 0x00400000 has base id 0x001; 0x04000000 has base id 0x100.
   EXPECT_EQ(order, (std::vector<std::string>{"000#", "00400000#", "100#", "100#R", "04000000#", "04000000#R",
                                              "7FF#", "1FFFFFFF#"}));
+}
+
+namespace {
+
+// The frame's bits laid out one per element and stuffed one by one, the plain way the tables in
+// wire.cpp must agree with.
+std::uint32_t reference_total(const Frame& f) {
+  std::vector<std::uint8_t> bits;
+  auto put = [&](std::uint32_t v, int n) {
+    for (int i = n - 1; i >= 0; --i) bits.push_back(static_cast<std::uint8_t>((v >> i) & 1u));
+  };
+  const std::uint32_t rtr = f.is_remote() ? 1 : 0;
+  put(0, 1);
+  if (f.is_extended()) {
+    put(f.id() >> 18, 11);
+    put(3, 2);
+    put(f.id() & 0x3FFFF, 18);
+    put(rtr, 1);
+    put(0, 2);
+  } else {
+    put(f.id(), 11);
+    put(rtr, 1);
+    put(0, 2);
+  }
+  put(f.dlc(), 4);
+  for (auto b : f.payload()) put(b, 8);
+  put(crc15(bits.data(), bits.size()), 15);
+  std::uint32_t stuff = 0;
+  int last = -1, run = 0;
+  for (auto b : bits) {
+    run = b == last ? run + 1 : 1;
+    last = b;
+    if (run == 5) {
+      ++stuff;
+      last ^= 1;
+      run = 1;
+    }
+  }
+  return static_cast<std::uint32_t>(bits.size()) + stuff + 13;
+}
+
+}  // namespace
+
+TEST(Wire, ByteTablesAgreeWithBitByBitCount) {
+  // Random ids, lengths and payloads (fixed seed), both formats, data and remote frames.
+  std::uint32_t x = 12345;
+  auto next = [&] {
+    x = x * 1664525u + 1013904223u;
+    return x >> 8;
+  };
+  for (int i = 0; i < 20000; ++i) {
+    const bool ext = (i & 1) != 0;
+    const std::uint32_t id = ext ? next() & 0x1FFFFFFF : next() & 0x7FF;
+    std::array<std::uint8_t, 8> d{};
+    const std::size_t len = next() % 9;
+    // Runs of equal bytes now and then, where stuffing matters most.
+    for (std::size_t k = 0; k < len; ++k) d[k] = (i % 5 == 0) ? static_cast<std::uint8_t>(i % 3 == 0 ? 0 : 0xFF) : static_cast<std::uint8_t>(next());
+    const Frame f = i % 7 == 3 ? Frame::remote(id, ext ? IdFormat::extended : IdFormat::standard, static_cast<std::uint8_t>(len)).value()
+                  : ext ? Frame::extended(id, std::span<const std::uint8_t>(d.data(), len)).value()
+                        : Frame::standard(id, std::span<const std::uint8_t>(d.data(), len)).value();
+    ASSERT_EQ(frame_bits(f).total, reference_total(f)) << f.to_string();
+  }
 }

@@ -87,6 +87,46 @@ std::uint64_t ClientCounters::errors() const noexcept {
 
 // ---------------------------------------------------------------------------------------------
 
+// The order in which the requests of one pipeline may go out: request i may start taking its uid
+// and its in-flight slot only once request i - 1 has been handed to the bus (or given up before
+// that). Without it, every request of a run competes for those on its own, and one woken with a
+// freed slot resumes a little later than it was woken: meanwhile a later request of the same run
+// could take a slot freed after it and reach the robot first. A robot refuses a trajectory point
+// that is not later than the one it received before.
+struct SendTurns {
+  explicit SendTurns(asio::any_io_executor e) : ex(std::move(e)) {}
+  asio::any_io_executor ex;
+  std::size_t next = 0;                        // the request whose turn it is
+  std::map<std::size_t, core::Wakeup*> waiting;  // requests parked until their turn
+
+  asio::awaitable<void> wait(std::size_t i) {
+    while (next < i) {
+      core::Wakeup w(ex);
+      waiting[i] = &w;
+      core::OnExit unlist{[this, i] { waiting.erase(i); }};
+      co_await w.wait();
+    }
+  }
+  // Request i is on the bus (or will never be): the next one may go.
+  void pass(std::size_t i) {
+    if (i + 1 <= next) return;
+    next = i + 1;
+    if (auto it = waiting.find(next); it != waiting.end()) it->second->notify();
+  }
+};
+
+// A request's place in a SendTurns (none for a lone request).
+struct Turn {
+  SendTurns* turns = nullptr;
+  std::size_t index = 0;
+  bool passed = false;
+  void pass() {
+    if (turns && !passed) turns->pass(index);
+    passed = true;
+  }
+  ~Turn() { pass(); }
+};
+
 class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
  public:
   Impl(can::Bus& b, ClientOptions o) : bus(b), options(std::move(o)), ex(b.get_executor()) {}
@@ -132,7 +172,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
   std::unordered_map<std::uint32_t, PoolEntry> pools;
   std::size_t in_flight = 0;
   std::deque<SlotWaiter*> slot_waiters;
-  std::size_t slot_grants = 0;  // slots handed to waiters that have not resumed yet
+  std::size_t slot_grants = 0;  // slots handed to waiters that have not resumed yet (keeps FIFO order)
   std::unordered_map<std::uint8_t, Collector*> collectors;
   std::unordered_map<std::uint8_t, std::deque<core::Wakeup*>> collector_waiters;
   std::map<std::uint64_t, Handler> subscribers;
@@ -299,8 +339,8 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
   }
 
   asio::awaitable<Result<void>> acquire_slot() {
-    // A slot handed to a waiter that has not resumed yet counts as a waiter: taking a free slot
-    // past it would send this request before an earlier one of the same pipeline (out of order).
+    // A slot handed to a waiter belongs to it even before it resumes: nobody may take a free slot
+    // past it meanwhile.
     if (slot_waiters.empty() && slot_grants == 0 && slot_free()) {
       ++in_flight;
       co_return ok();
@@ -339,7 +379,10 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
   // --- requests ------------------------------------------------------------------------------
 
   asio::awaitable<Result<Reply>> request(std::uint16_t pos, CommandId cmd, protocol::Payload payload,
-                                         RequestOptions ro) {
+                                         RequestOptions ro, Turn* turn = nullptr) {
+    Turn lone;
+    if (turn == nullptr) turn = &lone;
+    if (turn->turns) co_await turn->turns->wait(turn->index);
     const auto& info = protocol::command_info(cmd);
     if (pos == protocol::kBroadcastId) {
       co_return Error(HostErrc::invalid_argument,
@@ -355,7 +398,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
     const auto timeout = ro.timeout.value_or(options.timeout_for(cmd));
     for (unsigned attempt = 0;; ++attempt) {
       if (attempt > 0) ++counters.retries;
-      auto r = co_await attempt_once(pos, cmd, payload, timeout);
+      auto r = co_await attempt_once(pos, cmd, payload, timeout, *turn);
       if (r || r.error() != HostErrc::timeout) co_return r;
       if (attempt + 1 >= attempts) {
         co_return Error(HostErrc::timeout, fmt::format("positioner {} {} on bus {}: no reply within {} ms ({} {})",
@@ -366,7 +409,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
   }
 
   asio::awaitable<Result<Reply>> attempt_once(std::uint16_t pos, CommandId cmd, const protocol::Payload& payload,
-                                              core::Duration timeout) {
+                                              core::Duration timeout, Turn& turn) {
     const std::uint8_t n = protocol::number(cmd);
     if (auto r = check_running(); !r) co_return r.error();
     auto uid_r = co_await acquire_uid(pos, n);
@@ -406,6 +449,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
 
     ++counters.sent;
     auto sent = co_await bus.send(frame.value());
+    turn.pass();  // the frame is with the bus: the next request of the run may go
     if (!sent) {
       ++counters.send_errors;
       co_return Error(sent.error().code, fmt::format("positioner {} {} on bus {}: {}", pos,
@@ -552,16 +596,20 @@ asio::awaitable<Result<Reply>> CommandClient::request(std::uint16_t positioner, 
 namespace {
 
 struct PipeState {
-  explicit PipeState(const asio::any_io_executor& ex, std::size_t n) : wake(ex), done(n, 0) {}
+  explicit PipeState(const asio::any_io_executor& ex, std::size_t n) : wake(ex), turns(ex), done(n, 0) {}
   core::Wakeup wake;
+  SendTurns turns;  // the requests go out in their order
   std::size_t outstanding = 0;
   std::vector<std::uint8_t> done;  // 0 waiting, 1 accepted, 2 failed
   std::map<std::size_t, Error> failures;
 };
 
-asio::awaitable<void> pipe_one(CommandClient* client, PipeState* st, std::uint16_t pos, protocol::Request req,
-                               std::size_t i, RequestOptions options) {
-  auto r = co_await client->request(pos, req.command, req.payload, options);
+asio::awaitable<void> pipe_one(std::shared_ptr<CommandClient::Impl> self, PipeState* st, std::uint16_t pos,
+                               protocol::Request req, std::size_t i, RequestOptions options) {
+  Turn turn{&st->turns, i};
+  const protocol::Payload payload = req.payload;
+  auto r = co_await self->request(pos, req.command, payload, options, &turn);
+  turn.pass();
   if (r) {
     st->done[i] = 1;
   } else {
@@ -586,7 +634,7 @@ asio::awaitable<PipelineResult> CommandClient::pipeline(std::uint16_t positioner
   for (;;) {
     while (st.failures.empty() && next < requests.size() && st.outstanding < window) {
       ++st.outstanding;
-      asio::co_spawn(self->ex, pipe_one(this, &st, positioner, requests[next], next, options), asio::detached);
+      asio::co_spawn(self->ex, pipe_one(self, &st, positioner, requests[next], next, options), asio::detached);
       ++next;
       ++out.issued;
     }

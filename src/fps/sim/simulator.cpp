@@ -1,6 +1,7 @@
 #include "fps/sim/simulator.hpp"
 
 #include "can/error.hpp"
+#include "core/wakeup.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
@@ -51,10 +52,13 @@ Result<void> SimulatorOptions::validate() const {
 
 struct Robot {
   Robot(PositionerModel m, std::unique_ptr<can::Bus> b)
-      : model(std::move(m)), bus(std::move(b)), timer(bus->get_executor()) {}
+      : model(std::move(m)), bus(std::move(b)), idle(bus->get_executor()) {}
   PositionerModel model;
   std::unique_ptr<can::Bus> bus;
-  asio::steady_timer timer;  // the processing delay
+  // The frame being processed (taken from the receive buffer, answered when its processing time
+  // is over), and the robot's serve loop, parked while the robot works through its buffer.
+  std::optional<proto::Message> current;
+  core::Wakeup idle;
   std::deque<can::Frame> outq;
   bool sending = false;
 };
@@ -76,8 +80,21 @@ struct Simulator::State : std::enable_shared_from_this<State> {
   asio::steady_timer tick_timer;
   SimulatorStats stats;
 
+  // Processing times of every robot on one timer: (end of processing, order taken) -> robot. A
+  // timer per command per robot cost a kernel timer update for each of tens of thousands of
+  // frames a second; one heap and one timer for all handle every robot that is due in one go.
+  struct Due {
+    core::TimePoint at;
+    std::uint64_t seq;
+    Robot* robot;
+  };
+  std::vector<Due> due;  // min-heap on (at, seq)
+  std::uint64_t next_due = 0;
+  asio::steady_timer due_timer;
+  core::TimePoint due_armed = core::TimePoint::max();
+
   State(asio::any_io_executor ex, SimulatorOptions o)
-      : executor(ex), options(std::move(o)), faults(options.reply_faults), tick_timer(ex) {
+      : executor(ex), options(std::move(o)), faults(options.reply_faults), tick_timer(ex), due_timer(ex) {
     clock = options.clock != nullptr ? options.clock : &core::SteadyClock::instance();
     start_real = clock->now();
   }
@@ -92,6 +109,11 @@ struct Simulator::State : std::enable_shared_from_this<State> {
   void emit(Robot& r, const Outbox& out, bool from_sync = false);
   void enqueue(Robot& r, const can::Frame& f);
   void spawn(Robot& r);
+  bool start_processing(Robot& r, const can::Frame& f);
+  bool take_next(Robot& r);
+  void schedule(Robot& r, core::TimePoint at);
+  void arm_due(core::TimePoint at);
+  void run_due();
   void step();
   void check_collisions(SimTime t);
 
@@ -137,6 +159,8 @@ void Simulator::State::spawn(Robot& r) {
 }
 
 asio::awaitable<void> Simulator::State::serve(std::shared_ptr<State> self, Robot* r) {
+  // Waits for a frame while the robot is idle; once busy, the robot takes its next frames from the
+  // buffer itself as each processing time ends (run_due), and wakes this loop when it runs dry.
   while (!self->stopped) {
     auto frame = co_await r->bus->receive();
     if (self->stopped) break;
@@ -144,21 +168,64 @@ asio::awaitable<void> Simulator::State::serve(std::shared_ptr<State> self, Robot
       if (frame.error() == can::CanErrc::closed) break;
       continue;
     }
-    auto msg = proto::from_frame(frame.value());
-    if (!msg) {
-      ++self->stats.non_fps_frames;
-      continue;
-    }
-    ++self->stats.frames_processed;
-    const auto delay = writes_flash(msg.value().id.command) ? self->options.flash_delay : self->options.processing_delay;
-    if (delay > core::Duration::zero()) {
-      r->timer.expires_after(delay);
-      boost::system::error_code ec;
-      co_await r->timer.async_wait(asio::redirect_error(asio::use_awaitable, ec));
-      if (self->stopped) break;
-    }
-    self->emit(*r, r->model.handle(msg.value(), self->now()));
+    r->idle.reset();
+    if (!self->start_processing(*r, frame.value()) && !self->take_next(*r)) continue;
+    co_await r->idle.wait();
   }
+}
+
+bool Simulator::State::start_processing(Robot& r, const can::Frame& f) {
+  auto msg = proto::from_frame(f);
+  if (!msg) {
+    ++stats.non_fps_frames;
+    return false;
+  }
+  ++stats.frames_processed;
+  const auto delay = writes_flash(msg.value().id.command) ? options.flash_delay : options.processing_delay;
+  r.current = std::move(msg).value();
+  schedule(r, core::SteadyClock::instance().now() + delay);
+  return true;
+}
+
+bool Simulator::State::take_next(Robot& r) {
+  while (auto f = r.bus->try_receive()) {
+    if (start_processing(r, *f)) return true;
+  }
+  return false;
+}
+
+void Simulator::State::schedule(Robot& r, core::TimePoint at) {
+  const auto later = [](const Due& a, const Due& b) { return a.at != b.at ? a.at > b.at : a.seq > b.seq; };
+  due.push_back(Due{at, next_due++, &r});
+  std::push_heap(due.begin(), due.end(), later);
+  if (at < due_armed) arm_due(at);
+}
+
+void Simulator::State::arm_due(core::TimePoint at) {
+  due_armed = at;
+  due_timer.expires_at(at);  // cancels an earlier wait, whose handler then does nothing
+  due_timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+    if (ec == asio::error::operation_aborted) return;
+    self->run_due();
+  });
+}
+
+void Simulator::State::run_due() {
+  const auto later = [](const Due& a, const Due& b) { return a.at != b.at ? a.at > b.at : a.seq > b.seq; };
+  due_armed = core::TimePoint::max();
+  const auto t = core::SteadyClock::instance().now();
+  while (!stopped && !due.empty() && due.front().at <= t) {
+    std::pop_heap(due.begin(), due.end(), later);
+    Robot& r = *due.back().robot;
+    due.pop_back();
+    if (r.current) {
+      const proto::Message m = *r.current;
+      r.current.reset();
+      emit(r, r.model.handle(m, now()));
+    }
+    if (!take_next(r)) r.idle.notify();
+  }
+  if (!stopped && !due.empty()) arm_due(due.front().at);
 }
 
 void Simulator::State::emit(Robot& r, const Outbox& out, bool from_sync) {
@@ -321,8 +388,9 @@ void Simulator::stop() {
   s.stopped = true;
   s.running = false;
   s.tick_timer.cancel();
+  s.due_timer.cancel();
   for (auto& r : s.robots) {
-    r->timer.cancel();
+    r->idle.abandon();
     r->bus->close();
   }
 }

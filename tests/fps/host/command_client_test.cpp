@@ -6,6 +6,7 @@
 #include "fake_device.hpp"
 #include "rig.hpp"
 
+#include "fps/host/concurrent.hpp"
 #include "fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
@@ -533,4 +534,112 @@ TEST_F(CommandClientTest, DelayedRepliesWithinTheTimeoutAreStillMatched) {
   });
   EXPECT_EQ(client->counters().timeouts, 0u);
   EXPECT_EQ(client->counters().replies, 1u);
+}
+
+// Many robots pipelining at once behind a small bus in-flight bound, with replies coming back after
+// varied delays: every robot must receive its requests in the order of the run (a trajectory point
+// that overtakes the one before it is refused by the robot). A request woken with a freed slot
+// resumes a little later; a later request of the same pipeline must not slip past it meanwhile.
+TEST(CommandClientPipeline, ReachesEachRobotInOrderUnderTheInFlightBound) {
+  constexpr std::uint16_t kRobots = 24;
+  constexpr std::size_t kRequests = 40;
+  std::size_t out_of_order = 0, failed = 0, checked = 0;
+  for (std::uint32_t seed = 1; seed <= 12; ++seed) {
+    Runner runner;
+    auto medium = can::VirtualBus::create(runner.io.get_executor(), "fps0");
+    auto host_bus = medium->attach("host");
+    std::uint32_t x = seed;
+    FakeDevice fake(*medium, [&x](const protocol::Message& m) {
+      x = x * 1664525u + 1013904223u;
+      // Some replies at once, some a little later: completions interleave with slot grants.
+      const auto delay = (x >> 24) % 2 == 0 ? std::chrono::microseconds((x >> 8) % 200) : core::Duration::zero();
+      return std::vector<Outgoing>{{reply_to(m, m.id.positioner), delay}};
+    });
+    ClientOptions o;
+    o.max_in_flight = 4 + seed % 3 * 6;
+    CommandClient client(*host_bus, o);
+    std::vector<std::vector<protocol::Request>> runs(kRobots + 1);
+    for (std::uint16_t id = 1; id <= kRobots; ++id) {
+      for (std::size_t i = 0; i < kRequests; ++i) {
+        // The index travels in the payload, so the order of arrival can be checked.
+        runs[id].push_back({CommandId::send_trajectory_data,
+                            protocol::Payload().put_u32(static_cast<std::uint32_t>(i)).put_u32(0)});
+      }
+    }
+    runner.run([&]() -> asio::awaitable<void> {
+      co_await for_each_concurrently(kRobots, [&](std::size_t k) -> asio::awaitable<void> {
+        const auto id = static_cast<std::uint16_t>(k + 1);
+        auto r = co_await client.pipeline(id, runs[id], 8);
+        failed += r.ok() ? 0 : 1;
+      });
+      co_await client.stop();
+      fake.stop();
+    });
+    std::vector<std::uint32_t> next(kRobots + 1, 0);
+    for (const auto& m : fake.requests()) {
+      if (m.id.command != protocol::number(CommandId::send_trajectory_data)) continue;
+      const std::uint32_t index = m.payload[0] | std::uint32_t{m.payload[1]} << 8 | std::uint32_t{m.payload[2]} << 16;
+      if (index != next[m.id.positioner]) ++out_of_order;
+      next[m.id.positioner] = index + 1;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(failed, 0u);
+  EXPECT_EQ(checked, 12u * kRobots * kRequests);
+  EXPECT_EQ(out_of_order, 0u);
+}
+
+// The in-flight bound hands a freed slot to the oldest waiting request; that request resumes a
+// little later. A request made meanwhile (here the next trajectory point of the same robot, right
+// after another slot came free) must queue behind it instead of taking the free slot: otherwise
+// the later point reaches the robot first and the robot refuses the earlier one.
+TEST_F(CommandClientTest, AWokenRequestKeepsItsSlotAgainstNewcomers) {
+  std::optional<protocol::Message> held;
+  make(
+      [&held](const protocol::Message& m) {
+        std::vector<Outgoing> out;
+        if (m.id.positioner == 5) {
+          held = m;  // answered together with robot 6's request, in one burst
+        } else if (m.id.positioner == 6) {
+          if (held) out.push_back({reply_to(*held, 5)});
+          out.push_back({reply_to(m, 6)});
+        } else {
+          out.push_back({reply_to(m, m.id.positioner)});
+        }
+        return out;
+      },
+      [] {
+        ClientOptions o;
+        o.max_in_flight = 2;
+        return o;
+      }());
+  auto point = [](std::uint32_t i) { return protocol::Payload().put_u32(i).put_u32(0); };
+  runner.run([&]() -> asio::awaitable<void> {
+    std::size_t done = 0;
+    auto other = [&](std::uint16_t id, bool then_next_point) -> asio::awaitable<void> {
+      auto r = co_await client->request(id, CommandId::get_status);
+      EXPECT_TRUE(r.has_value());
+      if (then_next_point) {
+        const auto p1 = point(1);
+        auto n = co_await client->request(1, CommandId::send_trajectory_data, p1);
+        EXPECT_TRUE(n.has_value());
+      }
+      ++done;
+    };
+    auto first_point = [&]() -> asio::awaitable<void> {
+      const auto p0 = point(0);
+      auto r = co_await client->request(1, CommandId::send_trajectory_data, p0);
+      EXPECT_TRUE(r.has_value());
+      ++done;
+    };
+    asio::co_spawn(runner.io, other(5, false), asio::detached);  // takes slot 1
+    asio::co_spawn(runner.io, other(6, true), asio::detached);   // takes slot 2
+    asio::co_spawn(runner.io, first_point(), asio::detached);    // waits for a slot
+    while (done < 3) co_await core::sleep_for(1ms);
+  });
+  std::vector<std::uint32_t> order;
+  for (const auto& m : fake->requests()) {
+    if (m.id.command == protocol::number(CommandId::send_trajectory_data)) order.push_back(m.payload[0]);
+  }
+  EXPECT_EQ(order, (std::vector<std::uint32_t>{0, 1}));
 }
