@@ -116,8 +116,8 @@ struct CanNetGatewayEmulator::Impl : std::enable_shared_from_this<CanNetGatewayE
     if (client) send(*client, line);
   }
 
-  asio::awaitable<void> handle_line(std::shared_ptr<Connection> conn, std::string_view text);
-  asio::awaitable<void> forward(std::shared_ptr<Connection> conn, int channel, Frame frame);
+  asio::awaitable<void> handle_line(const std::shared_ptr<Connection>& conn, std::string_view text);
+  asio::awaitable<void> forward(const std::shared_ptr<Connection>& conn, int channel, Frame frame);
   Line answer(const Line& command);
   ReplyStatus status(int channel) const;
   [[nodiscard]] bool fitted(int channel) const { return chan[static_cast<std::size_t>(channel)].endpoint != nullptr; }
@@ -267,7 +267,7 @@ asio::awaitable<void> CanNetGatewayEmulator::Impl::run_writer(std::shared_ptr<Im
   }
 }
 
-asio::awaitable<void> CanNetGatewayEmulator::Impl::handle_line(std::shared_ptr<Connection> conn, std::string_view text) {
+asio::awaitable<void> CanNetGatewayEmulator::Impl::handle_line(const std::shared_ptr<Connection>& conn, std::string_view text) {
   if (std::all_of(text.begin(), text.end(), [](char c) { return c == ' ' || c == '\t' || c == '\r'; })) co_return;
   auto parsed = parse_line(text);
   if (!parsed) {
@@ -288,7 +288,7 @@ asio::awaitable<void> CanNetGatewayEmulator::Impl::handle_line(std::shared_ptr<C
   send(*conn, reply);
 }
 
-asio::awaitable<void> CanNetGatewayEmulator::Impl::forward(std::shared_ptr<Connection> conn, int channel, Frame frame) {
+asio::awaitable<void> CanNetGatewayEmulator::Impl::forward(const std::shared_ptr<Connection>& conn, int channel, Frame frame) {
   auto& c = chan[static_cast<std::size_t>(channel)];
   if (!c.endpoint || !c.running || c.bus_off) {  // the device discards these without a word
     ++stats.not_running_drops;
