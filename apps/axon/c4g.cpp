@@ -5,6 +5,7 @@
 #include "c4g/apps/app.hpp"
 #include "c4g/apps/correct.hpp"
 #include "c4g/apps/echo.hpp"
+#include "c4g/apps/handover.hpp"
 #include "c4g/apps/moni.hpp"
 #include "c4g/apps/monitor.hpp"
 #include "c4g/apps/pid.hpp"
@@ -47,9 +48,11 @@ struct ServeOptions {
   std::string app;
   // stream / correct / pid
   std::string file;
+  std::string correct_file;
   int mode = 4;
   std::string units;
   bool relative = false;
+  bool rearm = false;
   double start_tolerance_deg = 0.5;
   double max_motor_speed = 100.0;
   std::size_t arm = 1;
@@ -97,23 +100,21 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
   }
   if (o.app == "monitor") return std::make_unique<apps::MonitorApp>();
   if (o.app == "echo") return std::make_unique<apps::EchoApp>();
-  if (o.app == "stream") {
-    if (o.file.empty()) throw bad("--app stream needs --file TRAJECTORY.csv");
+  auto stream_options = [&](const std::string& file) {
     apps::StreamOptions s;
-    s.trajectory = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(o.file, unit)));
+    s.trajectory = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(file, unit)));
     s.mode = o.mode;
     s.arm = o.arm;
     s.relative = o.relative;
     s.start_tolerance_rad = o.start_tolerance_deg * std::numbers::pi / 180.0;
     s.max_motor_speed = o.max_motor_speed;
     s.stop_ramp_s = std::min(o.ramp_s, 0.5);
-    if (o.mode != 4 && o.mode != 5) throw bad("--app stream: --mode must be 4 or 5");
-    return std::make_unique<apps::StreamApp>(std::move(s));
-  }
-  if (o.app == "correct") {
+    return s;
+  };
+  auto correct_options = [&](const std::string& file) {
     apps::CorrectOptions c;
     c.arm = o.arm;
-    if (!o.file.empty()) c.values = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(o.file, unit)));
+    if (!file.empty()) c.values = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(file, unit)));
     if (!o.feed.empty()) {
       apps::SensorFeedOptions f;
       f.listen = need(net::parse_endpoint(o.feed, 0));
@@ -130,7 +131,30 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     c.open_time_s = o.open_time_s;
     c.ramp_s = o.ramp_s;
     c.max_motor_speed = o.max_motor_speed;
+    return c;
+  };
+  if (o.app == "stream") {
+    if (o.file.empty()) throw bad("--app stream needs --file TRAJECTORY.csv");
+    if (o.mode != 4 && o.mode != 5) throw bad("--app stream: --mode must be 4 or 5");
+    auto s = stream_options(o.file);
+    s.rearm = o.rearm;
+    return std::make_unique<apps::StreamApp>(std::move(s));
+  }
+  if (o.app == "correct") {
+    auto c = correct_options(o.file);
+    c.rearm = o.rearm;
     return std::make_unique<apps::CorrectApp>(std::move(c));
+  }
+  if (o.app == "handover") {
+    apps::HandoverOptions h;
+    h.arm = o.arm;
+    h.hold_s = o.open_time_s > 0 ? o.open_time_s : 0.5;
+    if (!o.file.empty()) h.stream = stream_options(o.file);
+    if (!o.correct_file.empty() || !o.feed.empty() || !o.amplitude_deg.empty()) {
+      h.correct = correct_options(o.correct_file);
+      if (h.correct->open_time_s <= 0 && !h.correct->values) h.correct->open_time_s = h.hold_s;
+    }
+    return std::make_unique<apps::HandoverApp>(std::move(h));
   }
   if (o.app == "pid") {
     apps::PidOptions p;
@@ -151,7 +175,7 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     }
     return std::make_unique<apps::PidApp>(std::move(p));
   }
-  throw bad(fmt::format("unknown --app '{}' (monitor, echo, stream, correct, pid)", o.app));
+  throw bad(fmt::format("unknown --app '{}' (monitor, echo, stream, correct, pid, handover)", o.app));
 }
 
 json timing_json(const host::Server& server) {
@@ -355,8 +379,10 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   static ServeOptions so;
   auto* s = c4g->add_subcommand("serve", "serve the controller's packets with a built-in application (docs/c4g-cli.md)");
   s->add_option("--listen", so.listen, "HOST:PORT to serve on (default the manual's 10.2.12.149:1000; port 0: any)");
-  s->add_option("--app", so.app, "monitor (mode 0), echo (0'), stream (4/5), correct (7), pid (1/2)")->required();
+  s->add_option("--app", so.app, "monitor (mode 0), echo (0'), stream (4/5), correct (7), pid (1/2), handover (every open phase: 4/5 and 7)")->required();
   s->add_option("--file", so.file, "stream: trajectory CSV; correct: correction values CSV");
+  s->add_option("--correct-file", so.correct_file, "handover: correction values CSV for mode 7");
+  s->add_flag("--rearm", so.rearm, "stream/correct: serve the mode again each time the program re-enters it (until 504 or Ctrl-C)");
   s->add_option("--mode", so.mode, "stream: 4 (absolute targets) or 5 (increments)");
   s->add_option("--units", so.units, "angles in the CSV: rad or deg (else the file's '# units:' line, else rad)");
   s->add_flag("--relative", so.relative, "stream: the trajectory is offsets from the robot's position at the start");
@@ -365,7 +391,7 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("--arm", so.arm, "the arm the application drives (default 1)")->check(CLI::Range(1, 4));
   s->add_option("--amplitude", so.amplitude_deg, "correct/pid: sine amplitude per axis [deg, link side]")->delimiter(',');
   s->add_option("--frequency", so.frequency_hz, "correct/pid: sine frequency per axis [Hz] (default 0.5)")->delimiter(',');
-  s->add_option("--open-time", so.open_time_s, "correct/pid: leave the open mode after this long [s] (0: until stopped)");
+  s->add_option("--open-time", so.open_time_s, "correct/pid: leave the open mode after this long [s] (0: until stopped); handover: hold / zero-correction / sine time per phase (default 0.5)");
   s->add_option("--ramp", so.ramp_s, "fade in/out time of corrections and sines [s] (default 0.5)");
   s->add_option("--feed", so.feed, "correct: live correction values over UDP on HOST:PORT (one datagram of numbers per measurement)");
   s->add_option("--feed-axes", so.feed_axes, "correct: values per feed datagram (default 6)")->check(CLI::Range(1, 10));

@@ -23,7 +23,7 @@ StreamApp::StreamApp(StreamOptions options) : options_(std::move(options)) {
 }
 
 void StreamApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) {
-  if (phase() == Phase::done || phase() == Phase::refused) return;  // one run per serve
+  if ((phase() == Phase::done && !options_.rearm) || phase() == Phase::refused) return;  // one run per serve
   set_phase(Phase::waiting);
   auto v = make_arm_view(init, axes, options_.arm);
   if (!v) {
@@ -90,6 +90,10 @@ void StreamApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
   for (std::size_t j = 0; j < n; ++j) all_in = all_in && req.axes[first + j].mode == mode;
   const std::int32_t m0 = req.axes[first].mode;
   Phase ph = phase();
+  if (ph == Phase::done && options_.rearm && m0 == code(Mode::mode0)) {
+    set_phase(Phase::waiting);
+    ph = Phase::waiting;
+  }
 
   if (ph == Phase::waiting) {
     if (!all_in || stop_requested()) return;
@@ -121,6 +125,7 @@ void StreamApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
       held_ = 0;
       set_phase(Phase::playing);
       ph = Phase::playing;
+      runs_.fetch_add(1, std::memory_order_relaxed);
       note(kNoteStarted);
     }
   }

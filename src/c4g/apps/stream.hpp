@@ -19,6 +19,8 @@
 //   - a stop request slows the playback down to rest over stop_ramp_s (along the path), then exits
 //     from open the same way.
 // Leaving the mode during the trajectory (drive off, another program) is an error.
+// With `rearm`, every later entry into the mode plays the trajectory again (a robot program that
+// opens the same mode several times; `--app handover` uses it).
 #pragma once
 
 #include "c4g/apps/app.hpp"
@@ -39,6 +41,9 @@ struct StreamOptions {
   double max_motor_speed = 100.0;  // [motor turns/s] continuity limit
   double hold_s = 0.1;
   double stop_ramp_s = 0.3;
+  // Re-arm: once done (the arm back in mode 0), wait for the mode again and play the trajectory
+  // anew from the start (start-point check included); finished() then stays false.
+  bool rearm = false;
 };
 
 class StreamApp final : public App {
@@ -51,7 +56,9 @@ class StreamApp final : public App {
   [[nodiscard]] std::string_view name() const noexcept override { return "stream"; }
   [[nodiscard]] std::string status() const override;
   [[nodiscard]] std::string summary() const override;
-  [[nodiscard]] bool finished() const noexcept override { return phase() == Phase::done; }
+  [[nodiscard]] bool finished() const noexcept override { return !options_.rearm && phase() == Phase::done; }
+  // Runs the trajectory played so far (any thread).
+  [[nodiscard]] std::uint64_t runs() const noexcept { return runs_.load(std::memory_order_relaxed); }
   [[nodiscard]] Phase phase() const noexcept { return phase_.load(std::memory_order_acquire); }
   [[nodiscard]] std::size_t table_rows() const noexcept { return rows_; }
   // Progress through the table in rows (any thread).
@@ -75,6 +82,7 @@ class StreamApp final : public App {
   std::atomic<Phase> phase_{Phase::waiting};
   std::atomic<double> progress_{0};
   std::atomic<double> period_{0.001};  // for status()
+  std::atomic<std::uint64_t> runs_{0};
   // Cycle thread.
   std::array<double, protocol::kAxesPerArm> base_{};  // motor offset: calibration, or start position
   std::array<double, protocol::kAxesPerArm> last_{};  // last commanded motor position
