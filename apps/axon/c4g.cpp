@@ -32,6 +32,7 @@
 #include <iterator>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <thread>
 
 namespace axon::app {
@@ -81,6 +82,31 @@ struct ServeOptions {
   double status_interval_s = 1.0;
   double stop_timeout_s = 5.0;
   bool json = false;
+  // active freezing
+  double freeze_at_s = 0;
+  double freeze_for_s = 0;
+};
+
+// SIGUSR1 asks for active freezing, SIGUSR2 releases it (the main loop reads and clears this).
+std::atomic<int> g_freeze_signal{0};
+void on_freeze_signal(int sig) noexcept { g_freeze_signal.store(sig == SIGUSR1 ? 1 : 2); }
+
+// Installs the SIGUSR1/SIGUSR2 handlers for the server's lifetime.
+struct FreezeSignals {
+  FreezeSignals() {
+    g_freeze_signal.store(0);
+    struct sigaction sa{};
+    sa.sa_handler = &on_freeze_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGUSR1, &sa, nullptr);
+    sigaction(SIGUSR2, &sa, nullptr);
+  }
+  ~FreezeSignals() {
+    std::signal(SIGUSR1, SIG_DFL);
+    std::signal(SIGUSR2, SIG_DFL);
+  }
+  FreezeSignals(const FreezeSignals&) = delete;
+  FreezeSignals& operator=(const FreezeSignals&) = delete;
 };
 
 
@@ -220,6 +246,7 @@ int run_serve(const ServeOptions& o) {
   }
 
   StopSignals signals;
+  FreezeSignals freeze_signals;
 
   auto server = need(host::Server::start(*app, so));
   std::printf("listening c4g %s\n", server->local_address().to_string().c_str());
@@ -242,11 +269,40 @@ int run_serve(const ServeOptions& o) {
                 static_cast<double>(t.worst_cycle_time_ns()) * 1e-3, static_cast<unsigned long long>(t.missed_deadlines()));
   };
 
+  // Active freezing: SIGUSR1 / SIGUSR2, or --freeze-at / --freeze-for; state changes are printed.
+  host::FreezeState shown_freeze = host::FreezeState::off;
+  bool freeze_at_done = o.freeze_at_s <= 0;
+  std::optional<Clock::time_point> frozen_since;
+  auto freeze_control = [&](Clock::time_point now) {
+    const int sig = g_freeze_signal.exchange(0);
+    if (sig == 1) { std::printf("freeze: requested (SIGUSR1)\n"); server->request_freeze(); }
+    if (sig == 2) { std::printf("freeze: released (SIGUSR2)\n"); server->release_freeze(); }
+    if (!freeze_at_done && now - start >= std::chrono::duration<double>(o.freeze_at_s)) {
+      freeze_at_done = true;
+      std::printf("freeze: requested (--freeze-at %.3f s)\n", o.freeze_at_s);
+      server->request_freeze();
+    }
+    const auto st = server->freeze_state();
+    if (st != shown_freeze) {
+      std::printf("freeze: %s\n", std::string(host::to_string(st)).c_str());
+      shown_freeze = st;
+      frozen_since.reset();
+      if (st == host::FreezeState::frozen) frozen_since = now;
+    }
+    if (frozen_since && o.freeze_for_s > 0 && server->freeze_requested() &&
+        now - *frozen_since >= std::chrono::duration<double>(o.freeze_for_s)) {
+      std::printf("freeze: released (--freeze-for %.3f s)\n", o.freeze_for_s);
+      server->release_freeze();
+    }
+    std::fflush(stdout);
+  };
+
   std::string why = "stopped";
   while (true) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     pump();
     const auto now = Clock::now();
+    freeze_control(now);
     if (signals.count() > 0) { why = "signal"; break; }
     if (o.duration_s > 0 && now - start >= std::chrono::duration<double>(o.duration_s)) { why = "duration reached"; break; }
     if (app->finished()) { why = "application finished"; break; }
@@ -266,6 +322,10 @@ int run_serve(const ServeOptions& o) {
   // not come back to mode 0 in time, ask for drive off and give it a moment to obey.
   spdlog::info("c4g serve: stopping ({})", why);
   app->request_stop();
+  if (server->freeze_requested()) {
+    std::printf("freeze: released (stopping)\n");
+    server->release_freeze();
+  }
   auto settled = [&] {
     return app->quiescent() || server->state() == host::ServerState::silent ||
            server->state() == host::ServerState::waiting || app->controller_exited();
@@ -275,6 +335,7 @@ int run_serve(const ServeOptions& o) {
     while (!settled() && Clock::now() < until && signals.count() < 2) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
       pump();
+      freeze_control(Clock::now());
     }
     return settled();
   };
@@ -303,6 +364,8 @@ int run_serve(const ServeOptions& o) {
            {"safe_replies", c.safe_replies.load()},
            {"refused_mode_changes", c.refused_mode_changes.load()},
            {"controller_late", c.controller_late.load()},
+           {"freezes", c.freezes.load()},
+           {"frozen_cycles", c.frozen_cycles.load()},
            {"safety_fault", std::string(host::to_string(server->safety().reason()))},
            {"currents_clamped", server->safety().counters().currents_clamped.load()},
            {"timing", timing_json(*server)}};
@@ -416,6 +479,8 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("--status-interval", so.status_interval_s, "seconds between status lines (0: none; default 1)");
   s->add_option("--stop-timeout", so.stop_timeout_s, "seconds to wait for mode 0 when stopping before drive off (default 5)");
   s->add_flag("--json", so.json, "print the final report as JSON");
+  s->add_option("--freeze-at", so.freeze_at_s, "active freezing (500) from this many seconds after start (also: SIGUSR1 freezes, SIGUSR2 releases)")->check(CLI::Range(0.0, 1e9));
+  s->add_option("--freeze-for", so.freeze_for_s, "release an active freezing this many seconds after the controller shows 500 (0: on SIGUSR2)")->check(CLI::Range(0.0, 1e9));
   s->callback([] { exit_code() = run_serve(so); });
 
   static std::string init_file;
