@@ -50,6 +50,7 @@ struct ServeOptions {
   // stream / correct / pid
   std::string file;
   std::string correct_file;
+  std::vector<std::string> segments;
   int mode = 4;
   std::string units;
   bool relative = false;
@@ -128,7 +129,21 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
   if (o.app == "echo") return std::make_unique<apps::EchoApp>();
   auto stream_options = [&](const std::string& file) {
     apps::StreamOptions s;
-    s.trajectory = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(file, unit)));
+    if (!file.empty() && !o.segments.empty()) throw bad("give --file or --segment, not both");
+    if (!file.empty()) s.trajectory = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(file, unit)));
+    for (const auto& spec : o.segments) {
+      const auto eq = spec.find('=');
+      int type = 0;
+      try {
+        type = eq == std::string::npos ? 0 : std::stoi(spec.substr(0, eq));
+      } catch (const std::exception&) {
+        type = 0;
+      }
+      if (eq == std::string::npos || type < 1 || type > 255 || eq + 1 >= spec.size())
+        throw bad(fmt::format("--segment '{}': expected MOTION_TYPE=FILE.csv with a motion type 1..255", spec));
+      s.segments.push_back({static_cast<std::uint8_t>(type),
+                            std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(spec.substr(eq + 1), unit)))});
+    }
     s.mode = o.mode;
     s.arm = o.arm;
     s.relative = o.relative;
@@ -160,7 +175,7 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     return c;
   };
   if (o.app == "stream") {
-    if (o.file.empty()) throw bad("--app stream needs --file TRAJECTORY.csv");
+    if (o.file.empty() && o.segments.empty()) throw bad("--app stream needs --file TRAJECTORY.csv or --segment N=FILE.csv");
     if (o.mode != 4 && o.mode != 5) throw bad("--app stream: --mode must be 4 or 5");
     auto s = stream_options(o.file);
     s.rearm = o.rearm;
@@ -175,7 +190,7 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     apps::HandoverOptions h;
     h.arm = o.arm;
     h.hold_s = o.open_time_s > 0 ? o.open_time_s : 0.5;
-    if (!o.file.empty()) h.stream = stream_options(o.file);
+    if (!o.file.empty() || !o.segments.empty()) h.stream = stream_options(o.file);
     if (!o.correct_file.empty() || !o.feed.empty() || !o.amplitude_deg.empty()) {
       h.correct = correct_options(o.correct_file);
       if (h.correct->open_time_s <= 0 && !h.correct->values) h.correct->open_time_s = h.hold_s;
@@ -444,6 +459,7 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("--listen", so.listen, "HOST:PORT to serve on (default the manual's 10.2.12.149:1000; port 0: any)");
   s->add_option("--app", so.app, "monitor (mode 0), echo (0'), stream (4/5), correct (7), pid (1/2), handover (every open phase: 4/5 and 7)")->required();
   s->add_option("--file", so.file, "stream: trajectory CSV; correct: correction values CSV");
+  s->add_option("--segment", so.segments, "stream/handover: MOTION_TYPE=FILE.csv, the trajectory for that motion type (CMD byte of the arm); repeatable");
   s->add_option("--correct-file", so.correct_file, "handover: correction values CSV for mode 7");
   s->add_flag("--rearm", so.rearm, "stream/correct: serve the mode again each time the program re-enters it (until 504 or Ctrl-C)");
   s->add_option("--mode", so.mode, "stream: 4 (absolute targets) or 5 (increments)");
