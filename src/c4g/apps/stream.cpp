@@ -147,7 +147,7 @@ double StreamApp::command(std::size_t j, double s) const noexcept {
 }
 
 void StreamApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
-  if (!view_ || rows_ == 0) return;
+  if (!view_ || (rows_ == 0 && phase() != Phase::refused)) return;
   const auto& req = ctx.request;
   const std::size_t n = view_->count, first = view_->first;
   if (first + n > req.count) return;
