@@ -5,6 +5,7 @@
 #include "c4g/apps/app.hpp"
 #include "c4g/apps/correct.hpp"
 #include "c4g/apps/echo.hpp"
+#include "c4g/apps/handover.hpp"
 #include "c4g/apps/moni.hpp"
 #include "c4g/apps/monitor.hpp"
 #include "c4g/apps/pid.hpp"
@@ -31,6 +32,7 @@
 #include <iterator>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <thread>
 
 namespace axon::app {
@@ -47,9 +49,12 @@ struct ServeOptions {
   std::string app;
   // stream / correct / pid
   std::string file;
+  std::string correct_file;
+  std::vector<std::string> segments;
   int mode = 4;
   std::string units;
   bool relative = false;
+  bool rearm = false;
   double start_tolerance_deg = 0.5;
   double max_motor_speed = 100.0;
   std::size_t arm = 1;
@@ -78,6 +83,31 @@ struct ServeOptions {
   double status_interval_s = 1.0;
   double stop_timeout_s = 5.0;
   bool json = false;
+  // active freezing
+  double freeze_at_s = 0;
+  double freeze_for_s = 0;
+};
+
+// SIGUSR1 asks for active freezing, SIGUSR2 releases it (the main loop reads and clears this).
+std::atomic<int> g_freeze_signal{0};
+void on_freeze_signal(int sig) noexcept { g_freeze_signal.store(sig == SIGUSR1 ? 1 : 2); }
+
+// Installs the SIGUSR1/SIGUSR2 handlers for the server's lifetime.
+struct FreezeSignals {
+  FreezeSignals() {
+    g_freeze_signal.store(0);
+    struct sigaction sa{};
+    sa.sa_handler = &on_freeze_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGUSR1, &sa, nullptr);
+    sigaction(SIGUSR2, &sa, nullptr);
+  }
+  ~FreezeSignals() {
+    std::signal(SIGUSR1, SIG_DFL);
+    std::signal(SIGUSR2, SIG_DFL);
+  }
+  FreezeSignals(const FreezeSignals&) = delete;
+  FreezeSignals& operator=(const FreezeSignals&) = delete;
 };
 
 
@@ -97,23 +127,35 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
   }
   if (o.app == "monitor") return std::make_unique<apps::MonitorApp>();
   if (o.app == "echo") return std::make_unique<apps::EchoApp>();
-  if (o.app == "stream") {
-    if (o.file.empty()) throw bad("--app stream needs --file TRAJECTORY.csv");
+  auto stream_options = [&](const std::string& file) {
     apps::StreamOptions s;
-    s.trajectory = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(o.file, unit)));
+    if (!file.empty() && !o.segments.empty()) throw bad("give --file or --segment, not both");
+    if (!file.empty()) s.trajectory = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(file, unit)));
+    for (const auto& spec : o.segments) {
+      const auto eq = spec.find('=');
+      int type = 0;
+      try {
+        type = eq == std::string::npos ? 0 : std::stoi(spec.substr(0, eq));
+      } catch (const std::exception&) {
+        type = 0;
+      }
+      if (eq == std::string::npos || type < 1 || type > 255 || eq + 1 >= spec.size())
+        throw bad(fmt::format("--segment '{}': expected MOTION_TYPE=FILE.csv with a motion type 1..255", spec));
+      s.segments.push_back({static_cast<std::uint8_t>(type),
+                            std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(spec.substr(eq + 1), unit)))});
+    }
     s.mode = o.mode;
     s.arm = o.arm;
     s.relative = o.relative;
     s.start_tolerance_rad = o.start_tolerance_deg * std::numbers::pi / 180.0;
     s.max_motor_speed = o.max_motor_speed;
     s.stop_ramp_s = std::min(o.ramp_s, 0.5);
-    if (o.mode != 4 && o.mode != 5) throw bad("--app stream: --mode must be 4 or 5");
-    return std::make_unique<apps::StreamApp>(std::move(s));
-  }
-  if (o.app == "correct") {
+    return s;
+  };
+  auto correct_options = [&](const std::string& file) {
     apps::CorrectOptions c;
     c.arm = o.arm;
-    if (!o.file.empty()) c.values = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(o.file, unit)));
+    if (!file.empty()) c.values = std::make_shared<apps::Trajectory>(need(apps::Trajectory::load(file, unit)));
     if (!o.feed.empty()) {
       apps::SensorFeedOptions f;
       f.listen = need(net::parse_endpoint(o.feed, 0));
@@ -130,7 +172,30 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     c.open_time_s = o.open_time_s;
     c.ramp_s = o.ramp_s;
     c.max_motor_speed = o.max_motor_speed;
+    return c;
+  };
+  if (o.app == "stream") {
+    if (o.file.empty() && o.segments.empty()) throw bad("--app stream needs --file TRAJECTORY.csv or --segment N=FILE.csv");
+    if (o.mode != 4 && o.mode != 5) throw bad("--app stream: --mode must be 4 or 5");
+    auto s = stream_options(o.file);
+    s.rearm = o.rearm;
+    return std::make_unique<apps::StreamApp>(std::move(s));
+  }
+  if (o.app == "correct") {
+    auto c = correct_options(o.file);
+    c.rearm = o.rearm;
     return std::make_unique<apps::CorrectApp>(std::move(c));
+  }
+  if (o.app == "handover") {
+    apps::HandoverOptions h;
+    h.arm = o.arm;
+    h.hold_s = o.open_time_s > 0 ? o.open_time_s : 0.5;
+    if (!o.file.empty() || !o.segments.empty()) h.stream = stream_options(o.file);
+    if (!o.correct_file.empty() || !o.feed.empty() || !o.amplitude_deg.empty()) {
+      h.correct = correct_options(o.correct_file);
+      if (h.correct->open_time_s <= 0 && !h.correct->values) h.correct->open_time_s = h.hold_s;
+    }
+    return std::make_unique<apps::HandoverApp>(std::move(h));
   }
   if (o.app == "pid") {
     apps::PidOptions p;
@@ -151,7 +216,7 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     }
     return std::make_unique<apps::PidApp>(std::move(p));
   }
-  throw bad(fmt::format("unknown --app '{}' (monitor, echo, stream, correct, pid)", o.app));
+  throw bad(fmt::format("unknown --app '{}' (monitor, echo, stream, correct, pid, handover)", o.app));
 }
 
 json timing_json(const host::Server& server) {
@@ -196,6 +261,7 @@ int run_serve(const ServeOptions& o) {
   }
 
   StopSignals signals;
+  FreezeSignals freeze_signals;
 
   auto server = need(host::Server::start(*app, so));
   std::printf("listening c4g %s\n", server->local_address().to_string().c_str());
@@ -218,11 +284,40 @@ int run_serve(const ServeOptions& o) {
                 static_cast<double>(t.worst_cycle_time_ns()) * 1e-3, static_cast<unsigned long long>(t.missed_deadlines()));
   };
 
+  // Active freezing: SIGUSR1 / SIGUSR2, or --freeze-at / --freeze-for; state changes are printed.
+  host::FreezeState shown_freeze = host::FreezeState::off;
+  bool freeze_at_done = o.freeze_at_s <= 0;
+  std::optional<Clock::time_point> frozen_since;
+  auto freeze_control = [&](Clock::time_point now) {
+    const int sig = g_freeze_signal.exchange(0);
+    if (sig == 1) { std::printf("freeze: requested (SIGUSR1)\n"); server->request_freeze(); }
+    if (sig == 2) { std::printf("freeze: released (SIGUSR2)\n"); server->release_freeze(); }
+    if (!freeze_at_done && now - start >= std::chrono::duration<double>(o.freeze_at_s)) {
+      freeze_at_done = true;
+      std::printf("freeze: requested (--freeze-at %.3f s)\n", o.freeze_at_s);
+      server->request_freeze();
+    }
+    const auto st = server->freeze_state();
+    if (st != shown_freeze) {
+      std::printf("freeze: %s\n", std::string(host::to_string(st)).c_str());
+      shown_freeze = st;
+      frozen_since.reset();
+      if (st == host::FreezeState::frozen) frozen_since = now;
+    }
+    if (frozen_since && o.freeze_for_s > 0 && server->freeze_requested() &&
+        now - *frozen_since >= std::chrono::duration<double>(o.freeze_for_s)) {
+      std::printf("freeze: released (--freeze-for %.3f s)\n", o.freeze_for_s);
+      server->release_freeze();
+    }
+    std::fflush(stdout);
+  };
+
   std::string why = "stopped";
   while (true) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     pump();
     const auto now = Clock::now();
+    freeze_control(now);
     if (signals.count() > 0) { why = "signal"; break; }
     if (o.duration_s > 0 && now - start >= std::chrono::duration<double>(o.duration_s)) { why = "duration reached"; break; }
     if (app->finished()) { why = "application finished"; break; }
@@ -242,6 +337,10 @@ int run_serve(const ServeOptions& o) {
   // not come back to mode 0 in time, ask for drive off and give it a moment to obey.
   spdlog::info("c4g serve: stopping ({})", why);
   app->request_stop();
+  if (server->freeze_requested()) {
+    std::printf("freeze: released (stopping)\n");
+    server->release_freeze();
+  }
   auto settled = [&] {
     return app->quiescent() || server->state() == host::ServerState::silent ||
            server->state() == host::ServerState::waiting || app->controller_exited();
@@ -251,6 +350,7 @@ int run_serve(const ServeOptions& o) {
     while (!settled() && Clock::now() < until && signals.count() < 2) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
       pump();
+      freeze_control(Clock::now());
     }
     return settled();
   };
@@ -279,6 +379,8 @@ int run_serve(const ServeOptions& o) {
            {"safe_replies", c.safe_replies.load()},
            {"refused_mode_changes", c.refused_mode_changes.load()},
            {"controller_late", c.controller_late.load()},
+           {"freezes", c.freezes.load()},
+           {"frozen_cycles", c.frozen_cycles.load()},
            {"safety_fault", std::string(host::to_string(server->safety().reason()))},
            {"currents_clamped", server->safety().counters().currents_clamped.load()},
            {"timing", timing_json(*server)}};
@@ -355,8 +457,11 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   static ServeOptions so;
   auto* s = c4g->add_subcommand("serve", "serve the controller's packets with a built-in application (docs/c4g-cli.md)");
   s->add_option("--listen", so.listen, "HOST:PORT to serve on (default the manual's 10.2.12.149:1000; port 0: any)");
-  s->add_option("--app", so.app, "monitor (mode 0), echo (0'), stream (4/5), correct (7), pid (1/2)")->required();
+  s->add_option("--app", so.app, "monitor (mode 0), echo (0'), stream (4/5), correct (7), pid (1/2), handover (every open phase: 4/5 and 7)")->required();
   s->add_option("--file", so.file, "stream: trajectory CSV; correct: correction values CSV");
+  s->add_option("--segment", so.segments, "stream/handover: MOTION_TYPE=FILE.csv, the trajectory for that motion type (CMD byte of the arm); repeatable");
+  s->add_option("--correct-file", so.correct_file, "handover: correction values CSV for mode 7");
+  s->add_flag("--rearm", so.rearm, "stream/correct: serve the mode again each time the program re-enters it (until 504 or Ctrl-C)");
   s->add_option("--mode", so.mode, "stream: 4 (absolute targets) or 5 (increments)");
   s->add_option("--units", so.units, "angles in the CSV: rad or deg (else the file's '# units:' line, else rad)");
   s->add_flag("--relative", so.relative, "stream: the trajectory is offsets from the robot's position at the start");
@@ -365,7 +470,7 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("--arm", so.arm, "the arm the application drives (default 1)")->check(CLI::Range(1, 4));
   s->add_option("--amplitude", so.amplitude_deg, "correct/pid: sine amplitude per axis [deg, link side]")->delimiter(',');
   s->add_option("--frequency", so.frequency_hz, "correct/pid: sine frequency per axis [Hz] (default 0.5)")->delimiter(',');
-  s->add_option("--open-time", so.open_time_s, "correct/pid: leave the open mode after this long [s] (0: until stopped)");
+  s->add_option("--open-time", so.open_time_s, "correct/pid: leave the open mode after this long [s] (0: until stopped); handover: hold / zero-correction / sine time per phase (default 0.5)");
   s->add_option("--ramp", so.ramp_s, "fade in/out time of corrections and sines [s] (default 0.5)");
   s->add_option("--feed", so.feed, "correct: live correction values over UDP on HOST:PORT (one datagram of numbers per measurement)");
   s->add_option("--feed-axes", so.feed_axes, "correct: values per feed datagram (default 6)")->check(CLI::Range(1, 10));
@@ -390,6 +495,8 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("--status-interval", so.status_interval_s, "seconds between status lines (0: none; default 1)");
   s->add_option("--stop-timeout", so.stop_timeout_s, "seconds to wait for mode 0 when stopping before drive off (default 5)");
   s->add_flag("--json", so.json, "print the final report as JSON");
+  s->add_option("--freeze-at", so.freeze_at_s, "active freezing (500) from this many seconds after start (also: SIGUSR1 freezes, SIGUSR2 releases)")->check(CLI::Range(0.0, 1e9));
+  s->add_option("--freeze-for", so.freeze_for_s, "release an active freezing this many seconds after the controller shows 500 (0: on SIGUSR2)")->check(CLI::Range(0.0, 1e9));
   s->callback([] { exit_code() = run_serve(so); });
 
   static std::string init_file;

@@ -35,4 +35,30 @@ run_sim_c4g "steps:
 wait_serve
 [ "$SERVE_RC" = 1 ] || fail "far start point: serve exit code $SERVE_RC"
 grep -q "start point: axis 1 is at" "$TMP/serve.out" || fail "no start-point message"
+# Segments by motion type: the program sets motion type 1 before opening (out by 4 deg on axis 1),
+# switches to 2 inside the open mode (back, relative to where segment 1 ended), tries 7 (no
+# segment: hold), then clears it (0): exit from open.
+printf '# units: deg\nt,a,b,c,d,e,f\n0,0,0,0,0,0,0\n0.3,4,0,0,0,0,0\n' >"$TMP/seg1.csv"
+printf '# units: deg\nt,a,b,c,d,e,f\n0,0,0,0,0,0,0\n0.3,-4,0,0,0,0,0\n' >"$TMP/seg2.csv"
+start_c4g_serve --app stream --mode 4 --relative --segment "1=$TMP/seg1.csv" --segment "2=$TMP/seg2.csv"
+run_sim_c4g "steps:
+  - drive_on
+  - cmd: {arm: 1, value: 1}
+  - go_open: {type: A, mode: 4, arms: [1]}
+  - delay: 0.5
+  - cmd: {arm: 1, value: 2}
+  - delay: 0.5
+  - cmd: {arm: 1, value: 7}
+  - delay: 0.2
+  - cmd: {arm: 1, value: 0}
+  - wait_for_pc: {timeout: 10}
+  - exit_open"
+[ "$SIM_RC" = 0 ] || { cat "$TMP/sim.err"; fail "segments: simulator exit code $SIM_RC"; }
+wait_serve
+[ "$SERVE_RC" = 0 ] || { cat "$TMP/serve.out"; fail "segments: serve exit code $SERVE_RC"; }
+order=$(grep -oE 'segment for motion type [0-9]+ started|no segment for motion type [0-9]+|motion type 0: the segments are over|stream: done' "$TMP/serve.out" | tr '\n' '|')
+expected='segment for motion type 1 started|segment for motion type 2 started|no segment for motion type 7|motion type 0: the segments are over|stream: done|'
+[ "$order" = "$expected" ] || { cat "$TMP/serve.out"; fail "segments: sequence $order"; }
+grep -q "Safety: none" "$TMP/serve.out" || fail "segments: a safety fault"
+grep -q "open type A (mode 4) ended" "$TMP/sim.err" || { cat "$TMP/sim.err"; fail "segments: open phase not ended by the PC"; }
 echo ok

@@ -101,8 +101,11 @@ class App : public host::Controller {
   [[nodiscard]] std::string error() const;
   [[nodiscard]] bool has_error() const noexcept { return error_set_.load(std::memory_order_acquire); }
 
-  // Events since the last call (CLI thread; single consumer).
-  std::vector<Event> drain_events();
+  // The error text without allocation (empty when none; any thread once has_error()).
+  [[nodiscard]] const char* error_text() const noexcept { return has_error() ? error_.data() : ""; }
+
+  // Events since the last call (CLI thread; single consumer). Composite apps add their parts'.
+  virtual std::vector<Event> drain_events();
   // An event in words, e.g. "axis 1 (arm 1 axis 1): mode 0 -> 4 (mode4)".
   [[nodiscard]] std::string describe(const Event& e) const;
 

@@ -26,7 +26,7 @@ CorrectApp::CorrectApp(CorrectOptions options) : options_(std::move(options)) {
 }
 
 void CorrectApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) {
-  if (phase() == Phase::done || phase() == Phase::refused) return;
+  if ((phase() == Phase::done && !options_.rearm) || phase() == Phase::refused) return;
   set_phase(Phase::waiting);
   auto v = make_arm_view(init, axes, options_.arm);
   if (!v) {
@@ -127,6 +127,11 @@ void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) 
   Phase ph = phase();
   const double period = view_->period_s;
 
+  if (ph == Phase::done && options_.rearm && m0 == code(Mode::mode0)) {
+    set_phase(Phase::waiting);
+    ph = Phase::waiting;
+  }
+
   switch (ph) {
     case Phase::done: return;
     case Phase::refused:
@@ -137,6 +142,8 @@ void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) 
       t_ = 0;
       ticks_ = 0;
       last_ = {};
+      for (auto& a : applied_) a.store(0, std::memory_order_relaxed);
+      runs_.fetch_add(1, std::memory_order_relaxed);
       set_phase(Phase::correcting);
       ph = Phase::correcting;
       note(kNoteStarted);

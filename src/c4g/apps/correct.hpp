@@ -39,6 +39,9 @@ struct CorrectOptions {
   double open_time_s = 0;             // 0: until a stop request (sine) / the file's end
   double ramp_s = 0.5;
   double max_motor_speed = 100.0;     // [motor turns/s]
+  // Re-arm: once done (the arm back in mode 0), wait for mode 7 again and correct anew from zero;
+  // finished() then stays false.
+  bool rearm = false;
 };
 
 class CorrectApp final : public App {
@@ -50,7 +53,9 @@ class CorrectApp final : public App {
   [[nodiscard]] std::string_view name() const noexcept override { return "correct"; }
   [[nodiscard]] std::string status() const override;
   [[nodiscard]] std::string summary() const override;
-  [[nodiscard]] bool finished() const noexcept override { return phase() == Phase::done; }
+  [[nodiscard]] bool finished() const noexcept override { return !options_.rearm && phase() == Phase::done; }
+  // Corrections started so far (any thread).
+  [[nodiscard]] std::uint64_t runs() const noexcept { return runs_.load(std::memory_order_relaxed); }
   [[nodiscard]] Phase phase() const noexcept { return phase_.load(std::memory_order_acquire); }
   // Sum of the increments sent so far on the arm's axis j [motor turns] (any thread, relaxed).
   [[nodiscard]] double applied(std::size_t j) const noexcept { return applied_[j].load(std::memory_order_relaxed); }
@@ -75,6 +80,7 @@ class CorrectApp final : public App {
   std::array<std::atomic<double>, protocol::kAxesPerArm> applied_{};
   std::atomic<double> elapsed_{0};
   std::atomic<std::uint64_t> stale_cycles_{0};
+  std::atomic<std::uint64_t> runs_{0};
   // Cycle thread.
   std::array<double, protocol::kAxesPerArm> amplitude_{}, frequency_{};
   std::array<double, protocol::kAxesPerArm> last_{};  // last motor-side correction
