@@ -3,6 +3,7 @@
 //   init-info  prints an initialization packet from a 1200-byte file or from a capture
 // The ready line `listening c4g HOST:PORT`, events and status lines go to stdout; logs to stderr.
 #include "c4g/apps/app.hpp"
+#include "c4g/apps/contribute.hpp"
 #include "c4g/apps/correct.hpp"
 #include "c4g/apps/echo.hpp"
 #include "c4g/apps/handover.hpp"
@@ -216,7 +217,18 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     }
     return std::make_unique<apps::PidApp>(std::move(p));
   }
-  throw bad(fmt::format("unknown --app '{}' (monitor, echo, stream, correct, pid, handover)", o.app));
+  if (o.app == "contribute") {
+    if (o.mode != 8 && o.mode != 9) throw bad("--app contribute: --mode must be 8 (velocity) or 9 (current)");
+    apps::ContributeOptions c;
+    c.arm = o.arm;
+    c.mode = o.mode;
+    c.amplitude = o.amplitude_deg;  // motor side for this app: turns/s (8) or A (9)
+    c.frequency_hz = o.frequency_hz;
+    c.open_time_s = o.open_time_s;
+    c.ramp_s = o.ramp_s;
+    return std::make_unique<apps::ContributeApp>(std::move(c));
+  }
+  throw bad(fmt::format("unknown --app '{}' (monitor, echo, stream, correct, pid, handover, contribute)", o.app));
 }
 
 json timing_json(const host::Server& server) {
@@ -457,18 +469,18 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   static ServeOptions so;
   auto* s = c4g->add_subcommand("serve", "serve the controller's packets with a built-in application (docs/c4g-cli.md)");
   s->add_option("--listen", so.listen, "HOST:PORT to serve on (default the manual's 10.2.12.149:1000; port 0: any)");
-  s->add_option("--app", so.app, "monitor (mode 0), echo (0'), stream (4/5), correct (7), pid (1/2), handover (every open phase: 4/5 and 7)")->required();
+  s->add_option("--app", so.app, "monitor (mode 0), echo (0'), stream (4/5), correct (7), pid (1/2), handover (every open phase: 4/5 and 7), contribute (8/9)")->required();
   s->add_option("--file", so.file, "stream: trajectory CSV; correct: correction values CSV");
   s->add_option("--segment", so.segments, "stream/handover: MOTION_TYPE=FILE.csv, the trajectory for that motion type (CMD byte of the arm); repeatable");
   s->add_option("--correct-file", so.correct_file, "handover: correction values CSV for mode 7");
   s->add_flag("--rearm", so.rearm, "stream/correct: serve the mode again each time the program re-enters it (until 504 or Ctrl-C)");
-  s->add_option("--mode", so.mode, "stream: 4 (absolute targets) or 5 (increments)");
+  s->add_option("--mode", so.mode, "stream: 4 (absolute targets) or 5 (increments); contribute: 8 (velocity) or 9 (current)");
   s->add_option("--units", so.units, "angles in the CSV: rad or deg (else the file's '# units:' line, else rad)");
   s->add_flag("--relative", so.relative, "stream: the trajectory is offsets from the robot's position at the start");
   s->add_option("--start-tolerance", so.start_tolerance_deg, "stream: start-point tolerance [deg] (default 0.5)");
   s->add_option("--max-motor-speed", so.max_motor_speed, "continuity limit [motor turns/s] (default 100)");
   s->add_option("--arm", so.arm, "the arm the application drives (default 1)")->check(CLI::Range(1, 4));
-  s->add_option("--amplitude", so.amplitude_deg, "correct/pid: sine amplitude per axis [deg, link side]")->delimiter(',');
+  s->add_option("--amplitude", so.amplitude_deg, "correct/pid: sine amplitude per axis [deg, link side]; contribute: [motor turns/s] (mode 8) or [A] (mode 9)")->delimiter(',');
   s->add_option("--frequency", so.frequency_hz, "correct/pid: sine frequency per axis [Hz] (default 0.5)")->delimiter(',');
   s->add_option("--open-time", so.open_time_s, "correct/pid: leave the open mode after this long [s] (0: until stopped); handover: hold / zero-correction / sine time per phase (default 0.5)");
   s->add_option("--ramp", so.ramp_s, "fade in/out time of corrections and sines [s] (default 0.5)");
