@@ -24,6 +24,7 @@ wait_for_line() {
 # start_bridge ARGS...: starts `axon can bridge ARGS` in the background; sets SCD_PORT / CANNET_PORT
 # from its "listening" lines.
 start_bridge() {
+  rm -f "$TMP/bridge.out" "$TMP/bridge.err"  # see start_c4g_serve: never read a previous run's lines
   "$AXON" can bridge "$@" >"$TMP/bridge.out" 2>"$TMP/bridge.err" &
   PIDS+=($!)
   BRIDGE_PID=$!
@@ -39,6 +40,7 @@ start_bridge() {
 # start_sim_fps ARGS...: starts `axon sim fps ARGS` in the background; sets SIM_CANNET_PORT /
 # SIM_SCD_PORT from its "listening" lines (for the servers asked for).
 start_sim_fps() {
+  rm -f "$TMP/sim.out" "$TMP/sim.err"  # see start_c4g_serve: never read a previous run's lines
   "$AXON" sim fps "$@" >"$TMP/sim.out" 2>"$TMP/sim.err" &
   PIDS+=($!)
   SIM_PID=$!
