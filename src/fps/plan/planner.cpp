@@ -351,6 +351,7 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   so.beta_step_deg = o.speed.beta_deg_s * dt;
   so.margin_mm = o.margin_mm;
   so.max_duration_s = o.max_half_s;
+  so.stop_avoid_deg = o.stop_avoid_deg;
 
   StepperResult ra, rb, rm;
   std::vector<StepperRobot> fa(n), fb(n);
