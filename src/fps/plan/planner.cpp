@@ -374,6 +374,12 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
       }
       const double at = target[i].alpha_deg, ac = request.current[i].alpha_deg;
       double f = at + std::clamp(ac - at, -alpha_budget, alpha_budget);
+      if (o.fold_stop_gap_deg > 0) {
+        // A fold alpha right at a stop leaves a robot that must dodge only one way to turn.
+        const AngleLimits& l = model.robot(i).limits();
+        if (l.alpha_max_deg - l.alpha_min_deg > 2 * o.fold_stop_gap_deg)
+          f = std::clamp(f, l.alpha_min_deg + o.fold_stop_gap_deg, l.alpha_max_deg - o.fold_stop_gap_deg);
+      }
       if (relax_b[i]) f = at;
       if (relax_a[i]) f = ac;
       fa[i] = {request.current[i], {f, fold_beta(i)}, false};
