@@ -1,6 +1,7 @@
 #include "fps/plan/planner.hpp"
 
 #include "fps/plan/stepper.hpp"
+#include "fps/plan/untangle.hpp"
 
 #include <fmt/format.h>
 
@@ -124,7 +125,7 @@ void repair_locally(const CollisionModel& model, std::vector<StepperRobot>& robo
 // a pure beta fold), leaving the turn to the other half or to the middle phase. The run with the
 // fewest robots stuck (then the shortest) is kept; `robots` holds the goals of that run.
 StepperResult drive_with_retries(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperOptions so,
-                                 int retries, int relax_after, int local_tries, int local_rings, double fold_spread, std::size_t& runs) {
+                                 int retries, int relax_after, int local_tries, int local_rings, double fold_spread, bool untangle, std::size_t& runs) {
   StepperResult best = drive_to_goals(model, robots, so);
   ++runs;
   std::vector<StepperRobot> best_robots = robots;
@@ -152,6 +153,7 @@ StepperResult drive_with_retries(const CollisionModel& model, std::vector<Steppe
     so.seed ^= 0x9e3779b97f4a7c15ULL;
     repair_locally(model, robots, best, so, local_tries, local_rings, fold_spread, runs);
   }
+  if (untangle && count_unreached(best) > 0) untangle_to_fold(model, robots, best, so);
   return best;
 }
 
@@ -349,6 +351,7 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   so.beta_step_deg = o.speed.beta_deg_s * dt;
   so.margin_mm = o.margin_mm;
   so.max_duration_s = o.max_half_s;
+  so.stop_avoid_deg = o.stop_avoid_deg;
 
   StepperResult ra, rb, rm;
   std::vector<StepperRobot> fa(n), fb(n);
@@ -371,6 +374,12 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
       }
       const double at = target[i].alpha_deg, ac = request.current[i].alpha_deg;
       double f = at + std::clamp(ac - at, -alpha_budget, alpha_budget);
+      if (o.fold_stop_gap_deg > 0) {
+        // A fold alpha right at a stop leaves a robot that must dodge only one way to turn.
+        const AngleLimits& l = model.robot(i).limits();
+        if (l.alpha_max_deg - l.alpha_min_deg > 2 * o.fold_stop_gap_deg)
+          f = std::clamp(f, l.alpha_min_deg + o.fold_stop_gap_deg, l.alpha_max_deg - o.fold_stop_gap_deg);
+      }
       if (relax_b[i]) f = at;
       if (relax_a[i]) f = ac;
       fa[i] = {request.current[i], {f, fold_beta(i)}, false};
@@ -382,12 +391,12 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
     const auto t0 = Clock::now();
     std::size_t runs_a = 0, runs_b = 0;
     if (o.parallel) {
-      std::thread worker([&] { ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, runs_a); });
-      rb = drive_with_retries(model, fb, sb, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, runs_b);
+      std::thread worker([&] { ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, o.untangle, runs_a); });
+      rb = drive_with_retries(model, fb, sb, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, o.untangle, runs_b);
       worker.join();
     } else {
-      ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, runs_a);
-      rb = drive_with_retries(model, fb, sb, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, runs_b);
+      ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, o.untangle, runs_a);
+      rb = drive_with_retries(model, fb, sb, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, o.untangle, runs_b);
     }
     // Folds given up by B: A turns those robots to the target alpha instead (one more A run), so
     // that no middle phase is needed for them unless A gives up the turn as well.
@@ -405,7 +414,7 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
     }
     if (rerun_a) {
       sa.seed += 104729;
-      ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, runs_a);
+      ra = drive_with_retries(model, fa, sa, o.half_retries, o.relax_after, o.local_retries, o.local_rings, o.fold_spread_deg, o.untangle, runs_a);
       for (std::size_t i = 0; i < n; ++i)
         if (!still[i] && fa[i].goal.alpha_deg == request.current[i].alpha_deg &&
             fb[i].goal.alpha_deg != fa[i].goal.alpha_deg)

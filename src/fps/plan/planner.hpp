@@ -49,7 +49,10 @@ struct PlannerOptions {
   int relax_after = 8;            // from this retry on, stuck robots fold without turning alpha (8: never)
   int local_retries = 24;         // then re-plans of only the stuck robots' neighbourhood (new seeds)
   int local_rings = 2;            // neighbour rings around the stuck robots re-planned with them
-  double fold_spread_deg = 90;    // local re-plans: a stuck robot's fold alpha drawn within this of its start
+  double fold_spread_deg = 90;
+  double stop_avoid_deg = 0;      // engine escapes keep away from the alpha stops while unfolded (0: off)
+  double fold_stop_gap_deg = 0;   // fold alphas kept this far from the alpha stops (0: off)
+  bool untangle = true;           // then robots still stuck are planned one at a time to any fold (untangle.hpp)    // local re-plans: a stuck robot's fold alpha drawn within this of its start
   std::size_t max_points = 1023;  // per arm, after the start point (firmware limit)
   bool verify = true;             // run the checker on the result
   CheckOptions check{};           // the checker's settings (full buffer)

@@ -403,7 +403,13 @@ void Stepper::step_robot(std::size_t i) {
       const Segment s1 = m_.robot(i).collision_segment(q);
       const auto f = feasible(i, q, s1, travel(i, cands[k].mv), true, nullptr);
       if (!f.ok) continue;
-      const double score = kClrW * std::min(f.min_clearance, 5.0) + noise(rng_) + (cands[k].mv == st.last ? kKeepW : 0.0);
+      double score = kClrW * std::min(f.min_clearance, 5.0) + noise(rng_) + (cands[k].mv == st.last ? kKeepW : 0.0);
+      // Keep away from the alpha stops while unfolded: a robot pushed against one has only one
+      // way to turn and gets caught in pockets there.
+      if (o_.stop_avoid_deg > 0 && q.beta_deg < 150) {
+        const double to_stop = std::min(q.alpha_deg - lim.alpha_min_deg, lim.alpha_max_deg - q.alpha_deg);
+        if (to_stop < o_.stop_avoid_deg) score -= 2.0 * (1.0 - to_stop / o_.stop_avoid_deg);
+      }
       if (score > best) {
         best = score;
         chosen = cands[k].mv;

@@ -58,6 +58,7 @@ struct StepperOptions {
   int stuck_steps = 6;           // steps without progress before a robot escapes
   int escape_min_steps = 3;
   int escape_max_steps = 15;
+  double stop_avoid_deg = 0;     // escapes keep this far from the alpha stops while unfolded (0: off)
   // A robot stuck next to fixed obstacles (fiducials, robots that never move) switches to a
   // navigation field: the grid cost to its goal around them (Dijkstra), followed downhill.
   bool fields = false;
