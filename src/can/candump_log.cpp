@@ -1,5 +1,7 @@
 #include "can/candump_log.hpp"
 
+#include "core/text.hpp"
+
 #include <fmt/format.h>
 
 #include <array>
@@ -20,13 +22,8 @@ constexpr std::uint64_t kMaxSeconds = 9'000'000'000ULL;
 // plus the interface name).
 constexpr std::size_t kMaxLine = 4096;
 
-bool is_space(char c) noexcept { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
-
-std::string_view trim(std::string_view s) noexcept {
-  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
-  return s;
-}
+using core::is_space;
+using core::trim;
 
 // Splits off the next white-space separated field.
 std::string_view next_field(std::string_view& s) noexcept {

@@ -1,5 +1,7 @@
 #include "blmc/protocol/command.hpp"
 
+#include "core/text.hpp"
+
 #include "blmc/protocol/error.hpp"
 #include "blmc/protocol/q24.hpp"
 
@@ -12,13 +14,7 @@
 namespace axon::blmc::protocol {
 namespace {
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r' || s.back() == '\n')) {
-    s.remove_suffix(1);
-  }
-  return s;
-}
+using core::trim;
 
 // Parses all of `s` as a number (strtod: decimal or exponent form; inf/nan parse here and are
 // rejected later by the Q24 range check).

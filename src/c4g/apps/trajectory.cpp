@@ -1,5 +1,7 @@
 #include "c4g/apps/trajectory.hpp"
 
+#include "core/text.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -12,31 +14,6 @@
 namespace axon::c4g::apps {
 
 namespace {
-
-std::string_view trim(std::string_view s) noexcept {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
-std::vector<std::string_view> split(std::string_view line) {
-  std::vector<std::string_view> out;
-  while (true) {
-    const auto comma = line.find(',');
-    out.push_back(trim(line.substr(0, comma)));
-    if (comma == std::string_view::npos) break;
-    line.remove_prefix(comma + 1);
-  }
-  return out;
-}
-
-std::optional<double> parse_number(std::string_view s) noexcept {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  double v = 0;
-  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc{} || p != s.data() + s.size() || s.empty()) return std::nullopt;
-  return v;
-}
 
 Error parse_error(std::string_view source, std::size_t line, std::string_view what) {
   return Error(CoreErrc::invalid_argument, fmt::format("{}:{}: {}", source, line, what));
@@ -60,12 +37,12 @@ Result<Trajectory> Trajectory::parse(std::string_view text, std::string_view sou
     const std::string_view raw = text.substr(0, nl);
     text.remove_prefix(nl == std::string_view::npos ? text.size() : nl + 1);
     ++line_no;
-    const std::string_view line = trim(raw);
+    const std::string_view line = core::trim(raw);
     if (line.empty()) continue;
     if (line.front() == '#') {
-      std::string_view body = trim(line.substr(1));
+      std::string_view body = core::trim(line.substr(1));
       if (body.starts_with("units:") || body.starts_with("unit:")) {
-        const auto u = parse_angle_unit(trim(body.substr(body.find(':') + 1)));
+        const auto u = parse_angle_unit(core::trim(body.substr(body.find(':') + 1)));
         if (!u) return parse_error(source, line_no, "units must be rad or deg");
         if (have_header) return parse_error(source, line_no, "the units directive must come before the header");
         if (unit && *u != *unit)
@@ -76,10 +53,10 @@ Result<Trajectory> Trajectory::parse(std::string_view text, std::string_view sou
       }
       continue;
     }
-    const auto fields = split(line);
+    const auto fields = core::split_fields(line);
     if (!have_header) {
       if (fields.size() < 2) return parse_error(source, line_no, "header needs a time column and at least one axis");
-      if (parse_number(fields[0]))
+      if (core::parse_number<double>(fields[0]))
         return parse_error(source, line_no, "expected a header line (e.g. t,j1,j2,...) before the data");
       for (const auto& f : fields)
         if (f.empty()) return parse_error(source, line_no, "empty column name in the header");
@@ -90,7 +67,7 @@ Result<Trajectory> Trajectory::parse(std::string_view text, std::string_view sou
     if (fields.size() != t.axes_ + 1)
       return parse_error(source, line_no, fmt::format("expected {} fields (time and {} axes), got {}", t.axes_ + 1, t.axes_,
                                                       fields.size()));
-    const auto time = parse_number(fields[0]);
+    const auto time = core::parse_number<double>(fields[0]);
     if (!time || !std::isfinite(*time)) return parse_error(source, line_no, fmt::format("bad time '{}'", fields[0]));
     if (*time < 0) return parse_error(source, line_no, "time must not be negative");
     if (!t.times_.empty() && !(*time > t.times_.back()))
@@ -98,7 +75,7 @@ Result<Trajectory> Trajectory::parse(std::string_view text, std::string_view sou
                          fmt::format("time {} does not increase (previous row {})", *time, t.times_.back()));
     const double scale = t.unit_ == AngleUnit::deg ? std::numbers::pi / 180.0 : 1.0;
     for (std::size_t i = 1; i < fields.size(); ++i) {
-      const auto v = parse_number(fields[i]);
+      const auto v = core::parse_number<double>(fields[i]);
       if (!v || !std::isfinite(*v))
         return parse_error(source, line_no, fmt::format("bad value '{}' in column {}", fields[i], i + 1));
       t.values_.push_back(*v * scale);

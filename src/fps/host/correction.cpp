@@ -1,5 +1,7 @@
 #include "fps/host/correction.hpp"
 
+#include "core/text.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -46,35 +48,6 @@ std::string lower(std::string_view s) {
   return out;
 }
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
-  return s;
-}
-
-std::vector<std::string_view> split(std::string_view line) {
-  std::vector<std::string_view> out;
-  for (;;) {
-    const auto comma = line.find(',');
-    out.push_back(trim(line.substr(0, comma)));
-    if (comma == std::string_view::npos) break;
-    line.remove_prefix(comma + 1);
-  }
-  return out;
-}
-
-template <class T>
-std::optional<T> number(std::string_view s) {
-  T v{};
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
-  if constexpr (std::is_floating_point_v<T>) {
-    if (!std::isfinite(v)) return std::nullopt;
-  }
-  return v;
-}
-
 // Angle difference a - b brought into [-180, 180).
 double angle_diff(double a, double b) noexcept {
   double d = std::fmod(a - b + 180.0, 360.0);
@@ -110,9 +83,9 @@ Result<MeasurementSet> parse_measurements_csv(std::string_view text, const std::
     text.remove_prefix(nl == std::string_view::npos ? text.size() : nl + 1);
     ++line_no;
     if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-    line = trim(line);
+    line = core::trim(line);
     if (line.empty()) continue;
-    const auto cells = split(line);
+    const auto cells = core::split_fields(line);
     if (columns.empty()) {
       std::vector<bool> have(4, false);
       for (const auto c : cells) {
@@ -144,7 +117,7 @@ Result<MeasurementSet> parse_measurements_csv(std::string_view text, const std::
       const std::string_view c = cells[i];
       switch (columns[i]) {
         case robot: {
-          const auto id = number<std::int64_t>(c);
+          const auto id = core::parse_number<std::int64_t>(c);
           if (!id) return at(CorrectionErrc::not_a_number, name, line_no, fmt::format("robot id '{}' is not an integer", c));
           if (*id < 1 || *id > 2047)
             return at(CorrectionErrc::unknown_robot, name, line_no, fmt::format("robot id {} out of range 1..2047", *id));
@@ -153,8 +126,8 @@ Result<MeasurementSet> parse_measurements_csv(std::string_view text, const std::
         }
         case x:
         case y: {
-          const auto v = number<double>(c);
-          if (!v)
+          const auto v = core::parse_number<double>(c);
+          if (!v || !std::isfinite(*v))
             return at(CorrectionErrc::not_a_number, name, line_no,
                       fmt::format("{} '{}' is not a number", columns[i] == x ? "x" : "y", c));
           (columns[i] == x ? m.position.x : m.position.y) = *v;

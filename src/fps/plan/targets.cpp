@@ -1,5 +1,7 @@
 #include "fps/plan/targets.hpp"
 
+#include "core/text.hpp"
+
 #include "core/config.hpp"
 
 #include <fmt/format.h>
@@ -69,32 +71,6 @@ Result<Target> make_target(const Fields& f, const std::string& name, int line) {
   return t;
 }
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
-  return s;
-}
-
-std::vector<std::string_view> split(std::string_view line) {
-  std::vector<std::string_view> out;
-  for (;;) {
-    const auto comma = line.find(',');
-    out.push_back(trim(line.substr(0, comma)));
-    if (comma == std::string_view::npos) break;
-    line.remove_prefix(comma + 1);
-  }
-  return out;
-}
-
-template <class T>
-std::optional<T> number(std::string_view s) {
-  T v{};
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
-  return v;
-}
-
 }  // namespace
 
 Result<std::vector<Target>> parse_targets_yaml(std::string_view text, const std::string& name) {
@@ -156,9 +132,9 @@ Result<std::vector<Target>> parse_targets_csv(std::string_view text, const std::
     text.remove_prefix(nl == std::string_view::npos ? text.size() : nl + 1);
     ++line_no;
     if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-    line = trim(line);
+    line = core::trim(line);
     if (line.empty()) continue;
-    const auto cells = split(line);
+    const auto cells = core::split_fields(line);
     if (columns.empty()) {
       std::vector<bool> seen(7, false);
       for (const auto c : cells) {
@@ -182,10 +158,10 @@ Result<std::vector<Target>> parse_targets_csv(std::string_view text, const std::
       if (c.empty()) continue;
       const int field = columns[i];
       if (field == 0) {
-        f.robot = number<std::int64_t>(c);
+        f.robot = core::parse_number<std::int64_t>(c);
         if (!f.robot) return file_error(name, line_no, fmt::format("robot id '{}' is not an integer", c));
       } else if (field <= 4) {
-        const auto v = number<double>(c);
+        const auto v = core::parse_number<double>(c);
         if (!v) return file_error(name, line_no, fmt::format("'{}' is not a number", c));
         std::optional<double>* slots[] = {&f.alpha, &f.beta, &f.x, &f.y};
         *slots[field - 1] = v;
