@@ -1,10 +1,7 @@
 // The whole focal plane at once: a small layout (2 sextants, 2 gateways, 4 buses, 12 robots)
 // simulated by FocalPlaneSimulator behind CAN@net gateway emulators and the PLC emulator, driven by
 // a FocalPlaneArray over real TCP on loopback (same process, separate sockets).
-#include "sim_rig.hpp"
-
-#include "fps/host/focal_plane_array.hpp"
-#include "fps/sim/focal_plane_sim.hpp"
+#include "plane_rig.hpp"
 
 #include <boost/asio/detached.hpp>
 #include <gtest/gtest.h>
@@ -17,26 +14,6 @@ using namespace axon::fps::host;
 using namespace axon::fps::host::testing;
 
 namespace {
-
-// Robots 1-6 in sextant 1 (gateway 1: bus 1 ids 1-3, bus 2 ids 4-6), 7-12 in sextant 2 (gateway 2),
-// two rows of the hexagonal grid apart.
-FocalPlane small_plane() {
-  FocalPlaneSpec spec;
-  spec.name = "two-sextants";
-  spec.gateways = {GatewaySite{1, "127.0.0.1:1", 1, 4}, GatewaySite{2, "127.0.0.1:1", 2, 4}};
-  for (std::uint16_t id = 1; id <= 12; ++id) {
-    RobotSite r;
-    r.id = id;
-    const int k = (id - 1) % 6;
-    r.x_mm = 22.4 * k;
-    r.y_mm = id <= 6 ? 0.0 : 38.8;
-    r.sextant = id <= 6 ? 1 : 2;
-    r.bus = BusRef{static_cast<std::uint16_t>(id <= 6 ? 1 : 2), static_cast<std::uint8_t>(k < 3 ? 1 : 2)};
-    r.fibres = {Fibre::boss};
-    spec.robots.push_back(r);
-  }
-  return FocalPlane::build(spec).value();
-}
 
 std::vector<std::uint16_t> ids_of(const std::vector<Misplaced>& v) {
   std::vector<std::uint16_t> out;
@@ -54,45 +31,14 @@ protocol::Trajectory straight(ArmAngles from, ArmAngles to, int points, double d
   return protocol::Trajectory::from_physical(a, b).value();
 }
 
-struct PlaneRig {
-  Runner runner;
-  FocalPlane plane = small_plane();
-  std::unique_ptr<sim::FocalPlaneSimulator> sim;
-  std::unique_ptr<FocalPlaneArray> fpa;
-
-  explicit PlaneRig(sim::Scenario scenario = {}) {
-    sim::FocalPlaneSimOptions so;
-    so.simulator.time_scale = 20;
-    so.random_start = false;
-    so.scenario = std::move(scenario);
-    sim = sim::FocalPlaneSimulator::start(runner.io.get_executor(), plane, so).value();
-    runner.on_stop([this]() -> asio::awaitable<void> {
-      if (fpa) co_await fpa->close();
-      sim->stop();
-    });
+// Every simulated robot of the plane from the fold to `to` in a straight line.
+std::map<std::uint16_t, protocol::Trajectory> everyone_to(PlaneRig& rig, ArmAngles to, int points = 10, double s = 4.0) {
+  std::map<std::uint16_t, protocol::Trajectory> t;
+  for (auto id : rig.fpa->array().ids()) {
+    if (rig.sim->simulator().find(id) != nullptr) t.emplace(id, straight({0, 180}, to, points, s));
   }
-
-  // Connects the array (inside a test body).
-  asio::awaitable<void> connect() {
-    FocalPlaneArrayOptions o;
-    o.array = fast_array();
-    o.check_window = 300ms;
-    for (const auto& g : sim->gateways()) o.addresses[g.id] = g.endpoint;
-    o.plc = sim->plc()->endpoint();
-    o.sync_hold = 20ms;
-    auto r = co_await FocalPlaneArray::connect(runner.io.get_executor(), plane, o);
-    EXPECT_TRUE(r.has_value()) << r.error().message();
-    if (r) fpa = std::move(r).value();
-  }
-
-  std::map<std::uint16_t, protocol::Trajectory> everyone_to(ArmAngles to, int points = 10, double s = 4.0) {
-    std::map<std::uint16_t, protocol::Trajectory> t;
-    for (auto id : fpa->array().ids()) {
-      if (sim->simulator().find(id) != nullptr) t.emplace(id, straight({0, 180}, to, points, s));
-    }
-    return t;
-  }
-};
+  return t;
+}
 
 }  // namespace
 
@@ -100,7 +46,7 @@ TEST(FocalPlaneArray, LayoutCheckFindsMissingAndExtraRobots) {
   sim::Scenario sc;
   sc.absent = {5};
   sc.extra[900] = BusRef{2, 1};
-  PlaneRig rig(sc);
+  PlaneRig rig(plane_sim_options(sc));
   rig.runner.run([&]() -> asio::awaitable<void> {
     co_await rig.connect();
     if (!rig.fpa) co_return;
@@ -146,7 +92,7 @@ TEST(FocalPlaneArray, SyncLineStartReachesEveryBus) {
   rig.runner.run([&]() -> asio::awaitable<void> {
     co_await rig.connect();
     if (!rig.fpa) co_return;
-    auto r = co_await rig.fpa->run_trajectories(rig.everyone_to({30, 170}), {}, true);
+    auto r = co_await rig.fpa->run_trajectories(everyone_to(rig, {30, 170}), {}, true);
     EXPECT_TRUE(r.has_value());
     if (!r) co_return;
     const auto& rep = r.value();
@@ -168,11 +114,11 @@ TEST(FocalPlaneArray, SyncLineStartReachesEveryBus) {
 TEST(FocalPlaneArray, CollisionOnOneBusStopsEveryBus) {
   sim::Scenario sc;
   sc.collide_on_move = {8};  // gateway 2, bus 1
-  PlaneRig rig(sc);
+  PlaneRig rig(plane_sim_options(sc));
   rig.runner.run([&]() -> asio::awaitable<void> {
     co_await rig.connect();
     if (!rig.fpa) co_return;
-    auto r = co_await rig.fpa->run_trajectories(rig.everyone_to({90, 120}, 10, 40.0), {}, true);
+    auto r = co_await rig.fpa->run_trajectories(everyone_to(rig, {90, 120}, 10, 40.0), {}, true);
     EXPECT_TRUE(r.has_value());
     if (!r) co_return;
     const auto& rep = r.value();
@@ -208,7 +154,7 @@ TEST(FocalPlaneArray, GatewayLostDuringUploadStartsNothingAndSaysWhatEachRobotHo
           (void)rig.sim->set_gateway_power(2, false);
         },
         asio::detached);
-    auto r = co_await rig.fpa->run_trajectories(rig.everyone_to({30, 170}, 200, 10.0), {}, true);
+    auto r = co_await rig.fpa->run_trajectories(everyone_to(rig, {30, 170}, 200, 10.0), {}, true);
     EXPECT_TRUE(r.has_value());
     if (!r) co_return;
     const auto& rep = r.value();
