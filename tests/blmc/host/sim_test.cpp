@@ -60,6 +60,16 @@ struct SimRig {
   }
 };
 
+// The limits these tests run with: the defaults, except the stale-data limit. The simulator shares
+// the io thread with the test and a loaded (or sanitized) machine can hold it for more than the
+// real 10 ms; a test about another fault must not end in stale data. The stall test's gap (2.5 s)
+// is far beyond this limit.
+SafetyLimits test_limits() {
+  SafetyLimits lim;
+  lim.stale_after = 250ms;
+  return lim;
+}
+
 LoopOptions loop_options() {
   LoopOptions o;
   o.realtime = false;
@@ -233,7 +243,7 @@ TEST(BlmcHostSim, BoardErrorDuringControlStopsAndIsNamed) {
       }
       return false;
     };
-    auto f = co_await run_loop(board, ctl, SafetyLimits{}, 5.0, inject);
+    auto f = co_await run_loop(board, ctl, test_limits(), 5.0, inject);
     CO_ASSERT(f.has_value());
     EXPECT_EQ(f->fault.board_error, proto::ErrorCode::encoder) << f->fault.describe();
     EXPECT_NE(f->fault.describe().find("ENCODER"), std::string::npos) << f->fault.describe();
@@ -249,7 +259,7 @@ TEST(BlmcHostSim, StalledBoardIsStaleDataOnTheHost) {
     auto r = co_await board.enable();
     CO_ASSERT(r);
     FunctionController ctl([](const ControlInput&, std::span<MotorPair> out) { out[0] = {}; });
-    auto f = co_await run_loop(board, ctl, SafetyLimits{}, 5.0);
+    auto f = co_await run_loop(board, ctl, test_limits(), 5.0);
     CO_ASSERT(f.has_value());
     EXPECT_EQ(f->fault.kind, FaultKind::stale_data) << f->fault.describe();
     EXPECT_EQ(f->fault.board_error, proto::ErrorCode::none);
@@ -267,7 +277,7 @@ TEST(BlmcHostSim, PositionLimitTripsAndDisables) {
     auto r = co_await board.enable();
     CO_ASSERT(r);
     FunctionController ctl([](const ControlInput&, std::span<MotorPair> out) { out[0] = {0.3, 0.0}; });
-    SafetyLimits lim;
+    SafetyLimits lim = test_limits();
     lim.position[0] = {true, -0.5, 0.5};
     auto f = co_await run_loop(board, ctl, lim, 10.0);
     CO_ASSERT(f.has_value());
@@ -286,7 +296,7 @@ TEST(BlmcHostSim, VelocityLimitCutsTheCurrent) {
     auto r = co_await board.enable();
     CO_ASSERT(r);
     FunctionController ctl([](const ControlInput&, std::span<MotorPair> out) { out[0] = {0.5, 0.0}; });
-    SafetyLimits lim;
+    SafetyLimits lim = test_limits();
     lim.max_velocity_krpm = 0.3;  // 5 rev/s
     std::uint64_t limited = 0;
     auto f = co_await run_loop(board, ctl, lim, 1.0, {}, nullptr, &limited);
@@ -312,7 +322,7 @@ TEST(BlmcHostSim, HomingFindsTheIndex) {
     ho.speed_rev_s = 1.0;
     HomingController homing(1, ho);
     const std::function<bool()> done = [&] { return homing.done(); };
-    auto f = co_await run_loop(board, homing, SafetyLimits{}, 10.0, done);
+    auto f = co_await run_loop(board, homing, test_limits(), 10.0, done);
     EXPECT_FALSE(f.has_value()) << f->fault.describe();
     CO_ASSERT(homing.done());
     EXPECT_TRUE(homing.all_found());
@@ -338,7 +348,7 @@ TEST(BlmcHostSim, PdTracksASineWithinTolerance) {
     PdTarget sine{true, 0.5, 1.0, 0.0};
     PdController pd(1, {10.0, 0.1}, {sine, sine}, 300ms);
     LoopStats stats;
-    auto f = co_await run_loop(board, pd, SafetyLimits{}, 2.5, {}, &stats);
+    auto f = co_await run_loop(board, pd, test_limits(), 2.5, {}, &stats);
     EXPECT_FALSE(f.has_value()) << f->fault.describe();
     for (int k = 0; k < 2; ++k) {
       const auto& t = pd.tracking(0, k);
