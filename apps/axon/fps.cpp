@@ -109,7 +109,6 @@ FpsOptions* g_options = nullptr;
 // What a subcommand does once the robots are known. Returns the exit code.
 using Job = std::function<asio::awaitable<int>(host::Array&, const host::DiscoveryReport&)>;
 
-Error usage(std::string text) { return Error(CoreErrc::invalid_argument, std::move(text)); }
 
 void print_json(const json& j) {
   std::fputs(j.dump(2).c_str(), stdout);

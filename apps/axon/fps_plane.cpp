@@ -50,7 +50,6 @@ struct PlaneArgs {
   double wait_s = 600;            // correct: for each measurement file to appear
 };
 
-Error usage(std::string text) { return Error(CoreErrc::invalid_argument, std::move(text)); }
 
 // Waits (polling) until `path` exists and its size stays the same over two polls (a file still
 // being written is not read), for at most `wait_s` seconds.

@@ -15,10 +15,14 @@
 #include <csignal>
 #include <exception>
 #include <functional>
+#include <string>
 
 namespace axon::app {
 
 namespace asio = boost::asio;
+
+// A command-line mistake (bad option value, missing file): reported to the user as such.
+inline Error usage(std::string text) { return Error(CoreErrc::invalid_argument, std::move(text)); }
 
 // Runs `body` to completion and returns its exit code; exceptions thrown inside are rethrown here
 // (axon::Exception becomes "axon: error: ..." in main). SIGINT/SIGTERM call `on_signal` (which

@@ -13,6 +13,9 @@ using TimePoint = std::chrono::steady_clock::time_point;
 // Wall-clock time as nanoseconds since the Unix epoch: what log files and capture formats store.
 using WallTime = std::chrono::nanoseconds;
 
+// The process's monotonic time (std::chrono::steady_clock), for code that measures without a Clock.
+inline TimePoint steady_now() noexcept { return std::chrono::steady_clock::now(); }
+
 class Clock {
  public:
   virtual ~Clock() = default;

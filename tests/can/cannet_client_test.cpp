@@ -5,6 +5,7 @@
 #include "can/virtual_bus.hpp"
 
 #include "can/cannet_harness.hpp"
+#include "frame_text.hpp"
 
 #include <boost/asio/detached.hpp>
 #include <boost/asio/post.hpp>
@@ -20,17 +21,17 @@ using namespace axon::can::test;
 
 namespace {
 
-Frame F(const char* text) { return Frame::parse(text).value(); }
+using axon::can::test::F;
 
 // Two virtual buses ("can0" behind gateway channel 1, "can1" behind channel 2), an emulator on an
 // ephemeral loopback port, and an observer node on each bus.
-struct Bench {
+struct ClientBench {
   asio::io_context io;
   VirtualBusRegistry registry{io.get_executor()};
   std::unique_ptr<CanNetGatewayEmulator> emulator;
   std::unique_ptr<Bus> can0, can1;
 
-  explicit Bench(WireModel wire = {}, CanNetEmulatorOptions options = {}) {
+  explicit ClientBench(WireModel wire = {}, CanNetEmulatorOptions options = {}) {
     (void)registry.add("can0", wire).value();
     (void)registry.add("can1", wire).value();
     options.port = 0;
@@ -56,7 +57,7 @@ struct Bench {
 }  // namespace
 
 TEST(CanNetClient, SetsUpEveryChannelAndQueriesTheGateway) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto gw = co_await b.connect(1, 2);
     CO_ASSERT_TRUE(gw);
@@ -85,7 +86,7 @@ TEST(CanNetClient, SetsUpEveryChannelAndQueriesTheGateway) {
 }
 
 TEST(CanNetClient, FramesBothWaysOnTwoChannels) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto gw = co_await b.connect(1, 2);
     CO_ASSERT_TRUE(gw);
@@ -133,7 +134,7 @@ TEST(CanNetClient, FramesBothWaysOnTwoChannels) {
 }
 
 TEST(CanNetClient, BusPerChannelRules) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto gw = co_await b.connect(2);
     CO_ASSERT_TRUE(gw);
@@ -161,7 +162,7 @@ TEST(CanNetClient, BusPerChannelRules) {
 }
 
 TEST(CanNetClient, EventsChangeTheBusState) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto gw = co_await b.connect(1, 2);
     CO_ASSERT_TRUE(gw);
@@ -198,7 +199,7 @@ TEST(CanNetClient, EventsChangeTheBusState) {
 }
 
 TEST(CanNetClient, StateReportedBeforeTheBusWasOpenedIsKept) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto gw = co_await b.connect(1);
     CO_ASSERT_TRUE(gw);
@@ -212,7 +213,7 @@ TEST(CanNetClient, StateReportedBeforeTheBusWasOpenedIsKept) {
 }
 
 TEST(CanNetClient, MalformedLinesAreCountedAndTheConnectionKept) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto gw = co_await b.connect(1);
     CO_ASSERT_TRUE(gw);
@@ -242,7 +243,7 @@ TEST(CanNetClient, MalformedLinesAreCountedAndTheConnectionKept) {
 }
 
 TEST(CanNetClient, ANewClientReplacesTheOldOneWhoseBusesClose) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto old_gw = co_await b.connect(1);
     CO_ASSERT_TRUE(old_gw);
@@ -273,7 +274,7 @@ TEST(CanNetClient, ANewClientReplacesTheOldOneWhoseBusesClose) {
 }
 
 TEST(CanNetClient, ConnectionLossClosesBusesAfterQueuedFrames) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto gw = co_await b.connect(1);
     CO_ASSERT_TRUE(gw);
@@ -293,7 +294,7 @@ TEST(CanNetClient, ConnectionLossClosesBusesAfterQueuedFrames) {
 }
 
 TEST(CanNetClient, ClosingTheGatewayClosesItsBuses) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto gw = co_await b.connect(1, 2);
     CO_ASSERT_TRUE(gw);
@@ -310,7 +311,7 @@ TEST(CanNetClient, ClosingTheGatewayClosesItsBuses) {
 }
 
 TEST(CanNetClient, RefusedInitIsADeviceError) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     CanNetOptions o;
     o.bitrate_kbit = 333;
@@ -323,7 +324,7 @@ TEST(CanNetClient, RefusedInitIsADeviceError) {
 }
 
 TEST(CanNetClient, ChannelWithoutABusIsADeviceError) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto gw = co_await b.connect(1, 4);
     CO_ASSERT_TRUE(!gw);
@@ -333,7 +334,7 @@ TEST(CanNetClient, ChannelWithoutABusIsADeviceError) {
 }
 
 TEST(CanNetClient, RejectsBadArguments) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     EXPECT_EQ((co_await b.connect()).error(), CanErrc::bad_spec);
     EXPECT_EQ((co_await b.connect(5)).error(), CanErrc::bad_spec);
@@ -378,7 +379,7 @@ TEST(CanNetClient, SilentGatewayTimesOut) {
 }
 
 TEST(CanNetClient, CommandsFromSeveralCoroutinesGetTheirOwnReplies) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto gw = co_await b.connect(1, 2);
     CO_ASSERT_TRUE(gw);
@@ -413,7 +414,7 @@ TEST(CanNetClient, TransmitFifoOverflowIsReportedNotSilent) {
   paced.enabled = true;
   paced.pace_realtime = true;
   paced.bitrate = 125'000;  // about 1 ms per frame: 1000 frames at once far outrun the wire
-  Bench b(paced);
+  ClientBench b(paced);
   run(b.io, [&]() -> asio::awaitable<void> {
     CanNetOptions o;
     o.bitrate_kbit = 125;
@@ -463,7 +464,7 @@ TEST(CanNetClient, FifoOverflowCanBeSilentLikeTheDevice) {
   paced.bitrate = 125'000;
   CanNetEmulatorOptions eo;
   eo.report_tx_overflow = false;
-  Bench b(paced, eo);
+  ClientBench b(paced, eo);
   run(b.io, [&]() -> asio::awaitable<void> {
     CanNetOptions o;
     o.bitrate_kbit = 125;

@@ -4,6 +4,7 @@
 #include "can/virtual_bus.hpp"
 
 #include "can/cannet_harness.hpp"
+#include "frame_text.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -17,17 +18,17 @@ using namespace axon::can::test;
 
 namespace {
 
-Frame F(const char* text) { return Frame::parse(text).value(); }
+using axon::can::test::F;
 
 // Two virtual buses behind an emulator listening on an ephemeral loopback port, plus an observer
 // node on each bus.
-struct Bench {
+struct EmulatorBench {
   asio::io_context io;
   VirtualBusRegistry registry{io.get_executor()};
   std::unique_ptr<CanNetGatewayEmulator> emulator;
   std::unique_ptr<Bus> can0, can1;  // observers on the two buses
 
-  explicit Bench(CanNetEmulatorOptions options = {}) {
+  explicit EmulatorBench(CanNetEmulatorOptions options = {}) {
     (void)registry.add("can0").value();
     (void)registry.add("can1").value();
     options.port = 0;
@@ -54,7 +55,7 @@ asio::awaitable<bool> set_up(LineClient& c, int channel) {
 }  // namespace
 
 TEST(CanNetEmulator, AnswersIdentifyVersionAndStatus) {
-  Bench b;
+  EmulatorBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     LineClient c(b.io.get_executor());
     CO_ASSERT_TRUE(co_await c.connect(b.emulator->local_endpoint()));
@@ -73,7 +74,7 @@ TEST(CanNetEmulator, OwnTextsFromOptions) {
   CanNetEmulatorOptions o;
   o.identify = "CAN@net NT 420 (axon)";
   o.version = "V9.9.9";
-  Bench b(o);
+  EmulatorBench b(o);
   run(b.io, [&]() -> asio::awaitable<void> {
     LineClient c(b.io.get_executor());
     CO_ASSERT_TRUE(co_await c.connect(b.emulator->local_endpoint()));
@@ -83,7 +84,7 @@ TEST(CanNetEmulator, OwnTextsFromOptions) {
 }
 
 TEST(CanNetEmulator, RefusesBadCommandsAndKeepsTheConnection) {
-  Bench b;
+  EmulatorBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     LineClient c(b.io.get_executor());
     CO_ASSERT_TRUE(co_await c.connect(b.emulator->local_endpoint()));
@@ -104,7 +105,7 @@ TEST(CanNetEmulator, RefusesBadCommandsAndKeepsTheConnection) {
 }
 
 TEST(CanNetEmulator, BlankLinesAreIgnored) {
-  Bench b;
+  EmulatorBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     LineClient c(b.io.get_executor());
     CO_ASSERT_TRUE(co_await c.connect(b.emulator->local_endpoint()));
@@ -115,7 +116,7 @@ TEST(CanNetEmulator, BlankLinesAreIgnored) {
 }
 
 TEST(CanNetEmulator, AcceptsCrLfLineEndings) {
-  Bench b;
+  EmulatorBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     LineClient c(b.io.get_executor());
     CO_ASSERT_TRUE(co_await c.connect(b.emulator->local_endpoint()));
@@ -124,7 +125,7 @@ TEST(CanNetEmulator, AcceptsCrLfLineEndings) {
 }
 
 TEST(CanNetEmulator, ForwardsFramesOnlyOnStartedChannels) {
-  Bench b;
+  EmulatorBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     LineClient c(b.io.get_executor());
     CO_ASSERT_TRUE(co_await c.connect(b.emulator->local_endpoint()));
@@ -155,7 +156,7 @@ TEST(CanNetEmulator, ForwardsFramesOnlyOnStartedChannels) {
 }
 
 TEST(CanNetEmulator, FiltersKeepTheirIdFormat) {
-  Bench b;
+  EmulatorBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     LineClient c(b.io.get_executor());
     CO_ASSERT_TRUE(co_await c.connect(b.emulator->local_endpoint()));
@@ -171,7 +172,7 @@ TEST(CanNetEmulator, FiltersKeepTheirIdFormat) {
 }
 
 TEST(CanNetEmulator, NewConnectionReplacesTheOldOneAndResetsState) {
-  Bench b;
+  EmulatorBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     LineClient first(b.io.get_executor());
     CO_ASSERT_TRUE(co_await first.connect(b.emulator->local_endpoint()));
@@ -190,7 +191,7 @@ TEST(CanNetEmulator, NewConnectionReplacesTheOldOneAndResetsState) {
 }
 
 TEST(CanNetEmulator, FaultHooksSendEventsAndHoldTheChannel) {
-  Bench b;
+  EmulatorBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     LineClient c(b.io.get_executor());
     CO_ASSERT_TRUE(co_await c.connect(b.emulator->local_endpoint()));
@@ -218,7 +219,7 @@ TEST(CanNetEmulator, FaultHooksSendEventsAndHoldTheChannel) {
 }
 
 TEST(CanNetEmulator, SendsRawLinesForFaultTests) {
-  Bench b;
+  EmulatorBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     LineClient c(b.io.get_executor());
     CO_ASSERT_TRUE(co_await c.connect(b.emulator->local_endpoint()));

@@ -1,6 +1,7 @@
 // Fault plans: reading them from YAML (with errors that point at the offending line) and the
 // injector's decisions, frame by frame.
 #include "can/fault_plan.hpp"
+#include "frame_text.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +13,7 @@ using namespace axon::can;
 
 namespace {
 
-Frame F(const char* text) { return Frame::parse(text).value(); }
+using axon::can::test::F;
 
 FaultRule rule(FaultRule::Action action) {
   FaultRule r;

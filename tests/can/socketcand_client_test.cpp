@@ -5,6 +5,7 @@
 #include "can/socketcand_server.hpp"
 #include "can/virtual_bus.hpp"
 #include "socketcand_test_util.hpp"
+#include "frame_text.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -17,7 +18,7 @@ namespace {
 using namespace std::chrono_literals;
 using testing::TextPeer;
 
-Frame F(const char* text) { return Frame::parse(text).value(); }
+using axon::can::test::F;
 
 class SocketcandClientTest : public ::testing::Test {
  protected:

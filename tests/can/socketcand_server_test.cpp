@@ -4,6 +4,7 @@
 #include "can/socketcand_codec.hpp"
 #include "can/virtual_bus.hpp"
 #include "socketcand_test_util.hpp"
+#include "frame_text.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +20,7 @@ using namespace std::chrono_literals;
 using testing::TextPeer;
 namespace sc = socketcand;
 
-Frame F(const char* text) { return Frame::parse(text).value(); }
+using axon::can::test::F;
 
 // The frame a `< frame ... >` / `< rtr ... >` message carries (fails the test if it is not one).
 Frame frame_of(const std::string& text) {

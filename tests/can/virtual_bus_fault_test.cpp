@@ -1,5 +1,6 @@
 // A fault plan applied by the virtual bus: what the receivers get and what the medium counts.
 #include "can/virtual_bus.hpp"
+#include "frame_text.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
@@ -16,7 +17,7 @@ namespace {
 
 using Strings = std::vector<std::string>;
 
-Frame F(const char* text) { return Frame::parse(text).value(); }
+using axon::can::test::F;
 
 FaultPlan one_rule(FaultRule::Action action, std::uint32_t id, core::Duration delay = {}) {
   FaultRule r;

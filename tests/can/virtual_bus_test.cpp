@@ -1,6 +1,7 @@
 // The virtual bus as its users see it: who receives what, in which order, and what happens when
 // queues overflow or nodes go away.
 #include "can/virtual_bus.hpp"
+#include "frame_text.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
@@ -16,7 +17,7 @@ using namespace axon::can;
 
 namespace {
 
-Frame F(const char* text) { return Frame::parse(text).value(); }
+using axon::can::test::F;
 
 // Runs `body` as a coroutine on `io`, then runs `io` until nothing is left to do.
 void run(asio::io_context& io, std::function<asio::awaitable<void>()> body) {

@@ -1,6 +1,7 @@
 // The virtual bus's wire model: exact bit accounting, real-time pacing and its effect on senders.
 // No upper bounds on time anywhere: the machine may be slow, it can never be faster than the wire.
 #include "can/virtual_bus.hpp"
+#include "frame_text.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
@@ -18,7 +19,7 @@ using namespace axon::can;
 
 namespace {
 
-Frame F(const char* text) { return Frame::parse(text).value(); }
+using axon::can::test::F;
 
 // A mix of shapes: best case, heavy stuffing, extended, remote, empty.
 std::vector<Frame> mix() {

@@ -1,6 +1,7 @@
 // Frame lengths on the wire. Expected values were worked out bit by bit (the simple cases by hand
 // in the comments, the rest with an independent polynomial-division CRC and stuffing count).
 #include "can/wire.hpp"
+#include "frame_text.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +13,7 @@
 using namespace axon::can;
 
 namespace {
-Frame F(const char* text) { return Frame::parse(text).value(); }
+using axon::can::test::F;
 }  // namespace
 
 TEST(Wire, AllDominantEmptyFrame) {

@@ -1,4 +1,5 @@
 #include "c4g/host/cycle_thread.hpp"
+#include "core/counter.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -24,7 +25,7 @@ void prefault_stack() noexcept {
   for (std::size_t i = 0; i < sizeof block; i += 4096) block[i] = 0;
 }
 
-void bump(std::atomic<std::uint64_t>& a) noexcept { a.fetch_add(1, std::memory_order_relaxed); }
+using core::bump;
 
 }  // namespace
 

@@ -1,6 +1,7 @@
 #include "c4g/host/server.hpp"
 
 #include "c4g/protocol/mode.hpp"
+#include "core/counter.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -43,7 +44,7 @@ std::int64_t steady_ns() noexcept {
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
-void bump(std::atomic<std::uint64_t>& a) noexcept { a.fetch_add(1, std::memory_order_relaxed); }
+using core::bump;
 
 bool every_axis_in(const protocol::Packet& p, std::int32_t mode) noexcept {
   for (std::size_t i = 0; i < p.count; ++i)

@@ -17,8 +17,6 @@ using protocol::PositionerStatus;
 
 namespace {
 
-core::TimePoint now() noexcept { return std::chrono::steady_clock::now(); }
-
 // Why a robot may not take a trajectory now ("" when it may).
 std::string not_ready_reason(const PositionerStatus& st) {
   if (st.collided()) {
@@ -60,9 +58,9 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
   if (auto g = may_move(rep.robots.front().id); !g) co_return g.error();
   const std::size_t n = rep.robots.size();
   const auto involved = buses_of(rep);
-  auto phase_start = now();
+  auto phase_start = core::steady_now();
   auto phase_end = [&](core::Duration& slot, std::string_view name) {
-    const auto t = now();
+    const auto t = core::steady_now();
     slot = std::chrono::duration_cast<core::Duration>(t - phase_start);
     phase_start = t;
     if (o.on_phase) o.on_phase(name);
@@ -226,7 +224,7 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
   }
 
   // 6. Wait for every robot to finish, then check where each one ended.
-  const auto started_at = now();
+  const auto started_at = core::steady_now();
   co_await for_each_concurrently(n, [&](std::size_t i) -> asio::awaitable<void> {
     auto& r = rep.robots[i];
     Positioner* p = find(r.id);
@@ -238,7 +236,7 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
         seen_moving = true;
         return false;
       }
-      return seen_moving || now() - started_at >= duration;
+      return seen_moving || core::steady_now() - started_at >= duration;
     };
     auto st = co_await p->wait_for(done, duration + o.end_margin, "trajectory");
     if (!st) {

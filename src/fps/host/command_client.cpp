@@ -21,8 +21,6 @@ using protocol::CommandId;
 
 namespace {
 
-core::TimePoint now() noexcept { return std::chrono::steady_clock::now(); }
-
 constexpr std::uint32_t pending_key(std::uint16_t pos, std::uint8_t cmd, std::uint8_t uid) noexcept {
   return (std::uint32_t{pos} << 16) | (std::uint32_t{cmd} << 8) | uid;
 }
@@ -239,7 +237,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
       return;
     }
     if (auto it = pools.find(pool_key(id.positioner, id.command));
-        it != pools.end() && it->second.pool.take_late_reply(id.uid, now())) {
+        it != pools.end() && it->second.pool.take_late_reply(id.uid, core::steady_now())) {
       ++counters.late;
       spdlog::debug("fps client on {}: late reply {}", bus.name(), protocol::to_string(m.value()));
       grant_uids(it->second);
@@ -288,7 +286,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
   // Hands free uids to waiters, first come first served.
   void grant_uids(PoolEntry& e) {
     while (!e.waiters.empty()) {
-      auto u = e.pool.acquire(now());
+      auto u = e.pool.acquire(core::steady_now());
       if (!u) return;
       UidWaiter* w = e.waiters.front();
       e.waiters.pop_front();
@@ -307,7 +305,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
   asio::awaitable<Result<std::uint8_t>> acquire_uid(std::uint16_t pos, std::uint8_t cmd) {
     PoolEntry& e = pools[pool_key(pos, cmd)];  // references into unordered_map stay valid
     if (e.waiters.empty() && e.grants == 0) {
-      if (auto u = e.pool.acquire(now())) co_return *u;
+      if (auto u = e.pool.acquire(core::steady_now())) co_return *u;
     }
     ++counters.uid_waits;
     UidWaiter w(ex);
@@ -325,10 +323,10 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
       if (auto r = check_running(); !r) co_return r.error();
       // A quarantine may have run out meanwhile.
       if (e.waiters.front() == &w) {
-        if (auto u = e.pool.acquire(now())) co_return *u;
+        if (auto u = e.pool.acquire(core::steady_now())) co_return *u;
       }
       w.wake.reset();
-      co_await w.wake.wait_until(e.pool.next_release(now()));
+      co_await w.wake.wait_until(e.pool.next_release(core::steady_now()));
     }
   }
 
@@ -455,7 +453,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
       co_return Error(sent.error().code, fmt::format("positioner {} {} on bus {}: {}", pos,
                                                      protocol::command_name(cmd), bus.name(), sent.error().detail));
     }
-    const auto deadline = now() + timeout;
+    const auto deadline = core::steady_now() + timeout;
     while (!p.reply && !stopping && !closed) {
       if (!co_await p.wake.wait_until(deadline)) break;
       p.wake.reset();
@@ -467,7 +465,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
     if (auto r = check_running(); !r) co_return r.error();
     ++counters.timeouts;
     uid_guard.held = false;
-    pools[pool_key(pos, n)].pool.quarantine(uid, now() + options.late_window);
+    pools[pool_key(pos, n)].pool.quarantine(uid, core::steady_now() + options.late_window);
     co_return Error(HostErrc::timeout, fmt::format("positioner {} {} uid {}", pos, protocol::command_name(cmd), uid));
   }
 
@@ -523,7 +521,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
     ++counters.broadcasts;
     if ((bo.expected && c.result.replies.size() >= *bo.expected) || (c.waiting && c.waiting->empty()))
       c.result.complete = true;
-    const auto deadline = now() + bo.window.value_or(options.broadcast_window);
+    const auto deadline = core::steady_now() + bo.window.value_or(options.broadcast_window);
     while (!c.result.complete && !stopping && !closed) {
       if (!co_await c.wake.wait_until(deadline)) break;
       c.wake.reset();

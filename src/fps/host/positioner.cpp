@@ -16,8 +16,6 @@ using protocol::StatusBit;
 
 namespace {
 
-core::TimePoint now() noexcept { return std::chrono::steady_clock::now(); }
-
 double seconds(core::Duration d) { return std::chrono::duration<double>(d).count(); }
 
 ArmAngles from_wire(const protocol::ArmPositions& p) { return {p.alpha.degrees(), p.beta.degrees()}; }
@@ -317,7 +315,7 @@ asio::awaitable<Result<MoveResult>> Positioner::move(ArmAngles value, bool relat
   auto eta = co_await start_goto(value, relative);
   if (!eta) co_return eta.error();
   out.eta = eta.value();
-  const auto started = now();
+  const auto started = core::steady_now();
   const auto eta_d = std::chrono::duration_cast<core::Duration>(
       std::chrono::duration<double>(std::max(out.eta.alpha.seconds(), out.eta.beta.seconds())));
   // The move has finished once the robot reports DISPLACEMENT_COMPLETED after having been seen
@@ -328,7 +326,7 @@ asio::awaitable<Result<MoveResult>> Positioner::move(ArmAngles value, bool relat
       seen_moving = true;
       return false;
     }
-    return seen_moving || now() - started >= eta_d;
+    return seen_moving || core::steady_now() - started >= eta_d;
   };
   auto st = co_await wait_for(done, eta_d + options_.move_margin, relative ? "relative move" : "absolute move");
   if (!st) co_return st.error();
@@ -352,7 +350,7 @@ asio::awaitable<Result<PositionerStatus>> Positioner::wait_until_idle(core::Dura
 
 asio::awaitable<Result<PositionerStatus>> Positioner::wait_for(std::function<bool(const PositionerStatus&)> done,
                                                                core::Duration timeout, std::string what, bool motion) {
-  const auto deadline = now() + timeout;
+  const auto deadline = core::steady_now() + timeout;
   for (;;) {
     if (motion) {
       if (auto g = check_gate(); !g) co_return g.error();
@@ -365,7 +363,7 @@ asio::awaitable<Result<PositionerStatus>> Positioner::wait_for(std::function<boo
                       fmt::format("positioner {} during {}: {}", id_, what, st.value().to_string()));
     }
     if (done(st.value())) co_return st.value();
-    const auto t = now();
+    const auto t = core::steady_now();
     if (t >= deadline) {
       co_return Error(HostErrc::timeout, fmt::format("positioner {}: {} not finished after {:.1f} s (status {})", id_,
                                                      what, seconds(timeout), st.value().to_string()));

@@ -11,8 +11,6 @@ namespace axon::fps::plan {
 
 namespace {
 
-constexpr double kRad = std::numbers::pi / 180.0;
-
 void merge(PairOutcome& into, const PairOutcome& from) {
   if (from.collided && (!into.collided || from.first_collision_s < into.first_collision_s)) {
     into.collided = true;

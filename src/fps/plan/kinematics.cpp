@@ -11,8 +11,6 @@ namespace axon::fps::plan {
 
 namespace {
 
-constexpr double kRad = std::numbers::pi / 180.0;
-constexpr double kDeg = 180.0 / std::numbers::pi;
 // Slack for angles and radii computed in floating point (well below any mechanical figure).
 constexpr double kEpsDeg = 1e-9;
 constexpr double kEpsMm = 1e-9;

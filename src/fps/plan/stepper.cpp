@@ -12,7 +12,6 @@ namespace axon::fps::plan {
 
 namespace {
 
-constexpr double kRad = std::numbers::pi / 180.0;
 constexpr double kTiny = 1e-4;        // mm: the certificate keeps this much above zero
 constexpr double kResolution = 0.01;  // mm: bound below which a sub-step counts as resolved
 constexpr int kMaxDepth = 8;          // halvings per step and pair

@@ -11,7 +11,6 @@ namespace axon::fps::plan {
 
 namespace {
 
-constexpr double kRad = std::numbers::pi / 180.0;
 constexpr double kTiny = 1e-4;        // mm: the certificate keeps this much above zero
 constexpr double kResolution = 0.01;  // mm: as the engine (stepper.cpp)
 

@@ -7,8 +7,13 @@
 #include <Eigen/Core>
 
 #include <cmath>
+#include <numbers>
 
 namespace axon::fps::plan {
+
+// Degrees to radians (multiply by kRad) and back (kDeg).
+inline constexpr double kRad = std::numbers::pi / 180.0;
+inline constexpr double kDeg = 180.0 / std::numbers::pi;
 
 struct Vec2 {
   double x = 0;

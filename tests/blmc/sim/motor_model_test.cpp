@@ -7,6 +7,7 @@
 #include <cmath>
 
 using namespace axon::blmc::sim;
+using axon::blmc::protocol::kTwoPi;
 
 namespace {
 
@@ -18,8 +19,6 @@ MotorConfig frictionless() {
   c.encoder_counts_per_rev = 0;
   return c;
 }
-
-constexpr double kTwoPi = axon::blmc::protocol::kTwoPi;
 
 }  // namespace
 

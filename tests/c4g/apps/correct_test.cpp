@@ -11,7 +11,6 @@ using protocol::code;
 using protocol::Mode;
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 // Motor-side correction (linear part) of a link-side correction on axis `axis` only.
 double motor_of(const Harness& h, std::size_t axis, double link_rad, std::size_t motor_axis) {

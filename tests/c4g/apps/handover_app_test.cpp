@@ -11,8 +11,6 @@ using protocol::Mode;
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
 // Runs cycles in the current modes until the app asks for exit (or max); cycles run.
 int until_exit(App& app, Harness& h, int max = 2000) {
   for (int k = 0; k < max; ++k) {

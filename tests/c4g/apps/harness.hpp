@@ -11,9 +11,13 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <numbers>
 #include <vector>
 
 namespace axon::c4g::apps::test {
+
+// One degree in radians.
+inline constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct Harness {
   protocol::InitPacket init = protocol::test::manual_example_init();  // six axes on arm 1, 2 ms
@@ -33,6 +37,12 @@ struct Harness {
   }
   [[nodiscard]] protocol::ArmTransform transform() const { return protocol::ArmTransform::from_init(init, 1).value(); }
   [[nodiscard]] double period() const { return init.period_ms * 1e-3; }
+  // Axis 1's motor position when axis 1 is at `link_rad` and every other axis at 0.
+  [[nodiscard]] double motor_axis1(double link_rad) const {
+    protocol::ArmTransform::Vector q = protocol::ArmTransform::Vector::Zero(6);
+    q[0] = link_rad;
+    return transform().motor_position(q)[0];
+  }
 
   void set_modes(std::int32_t mode) {
     for (std::size_t i = 0; i < req.count; ++i) req.axes[i].mode = mode;

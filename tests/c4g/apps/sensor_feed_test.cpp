@@ -21,7 +21,6 @@ using protocol::Mode;
 using namespace std::chrono_literals;
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 TEST(SensorFeedParse, AcceptsSpacesCommasSemicolonsAndDegrees) {
   std::array<double, 3> v{};

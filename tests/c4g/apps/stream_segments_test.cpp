@@ -13,8 +13,6 @@ using protocol::Mode;
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
 // Axis 1 by `deg` over 0.1 s (50 cycles at 2 ms), relative.
 std::shared_ptr<const Trajectory> move(double deg) {
   return std::make_shared<Trajectory>(
@@ -29,11 +27,6 @@ StreamOptions segments(int mode) {
   return o;
 }
 
-double motor_axis1(const Harness& h, double link_rad) {
-  protocol::ArmTransform::Vector q = protocol::ArmTransform::Vector::Zero(6);
-  q[0] = link_rad;
-  return h.transform().motor_position(q)[0];
-}
 
 void set_type(Harness& h, std::uint8_t type) { h.req.cmd = protocol::with_arm_byte(h.req.cmd, 1, type); }
 
@@ -52,14 +45,14 @@ TEST(StreamSegments, MotionTypePicksTheSegmentAndSegmentsChain) {
   EXPECT_FALSE(h.exit_requested());
   EXPECT_EQ(app.segment(), 1);
   const double out = h.rep.axes[0].d1;
-  EXPECT_NEAR(out - start, motor_axis1(h, 4 * kDeg) - motor_axis1(h, 0), 1e-4);
+  EXPECT_NEAR(out - start, h.motor_axis1(4 * kDeg) - h.motor_axis1(0), 1e-4);
   // Motion type 2: the next segment starts from the last command (the robot has not followed here).
   set_type(h, 2);
   h.run(app);
   EXPECT_EQ(app.phase(), StreamApp::Phase::playing);
   EXPECT_EQ(app.segment(), 2);
   // Continuous: the first cycle moves one row of segment 2 away from where segment 1 ended.
-  const double row = motor_axis1(h, 4 * kDeg * 0.02) - motor_axis1(h, 0);
+  const double row = h.motor_axis1(4 * kDeg * 0.02) - h.motor_axis1(0);
   EXPECT_NEAR(h.rep.axes[0].d1 - out, -row, std::fabs(0.1 * row));
   for (int k = 0; k < 60; ++k) h.run(app);
   EXPECT_NEAR(h.rep.axes[0].d1, start, 1e-4);  // back where it began

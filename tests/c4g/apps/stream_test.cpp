@@ -12,8 +12,6 @@ using protocol::Mode;
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
 // Axis 1 from 0 to 10 deg over 1 s, then back to 5 deg at 1.5 s; the others at 0 (wrist at 0).
 std::shared_ptr<const Trajectory> ramp() {
   return std::make_shared<Trajectory>(
@@ -28,11 +26,6 @@ StreamOptions options(int mode, std::shared_ptr<const Trajectory> t = ramp()) {
   return o;
 }
 
-double motor_axis1(const Harness& h, double link_rad) {
-  protocol::ArmTransform::Vector q = protocol::ArmTransform::Vector::Zero(6);
-  q[0] = link_rad;
-  return h.transform().motor_position(q)[0];
-}
 
 // Runs the app in `mode` until it asks to leave the open mode (or max cycles); returns cycles run.
 int run_until_exit(StreamApp& app, Harness& h, int max_cycles = 2000) {
@@ -57,20 +50,20 @@ TEST(StreamApp, Mode4StreamsAbsoluteMotorTargetsThenExits) {
   h.set_modes(code(Mode::mode4));
   h.run(app);  // starts: row 0, then advances to row 1
   EXPECT_EQ(app.phase(), StreamApp::Phase::playing);
-  EXPECT_NEAR(h.rep.axes[0].d1, motor_axis1(h, 10 * kDeg * 0.002), 1e-4);
+  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(10 * kDeg * 0.002), 1e-4);
   for (int k = 0; k < 249; ++k) h.run(app);  // row 250: t = 0.5 s
-  EXPECT_NEAR(h.rep.axes[0].d1, motor_axis1(h, 5 * kDeg), 1e-4);
+  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(5 * kDeg), 1e-4);
   // D2 is the change per cycle (delta motor turns): 10 deg/s on the link.
-  EXPECT_NEAR(h.rep.axes[0].d2, motor_axis1(h, 10 * kDeg * 0.002) - motor_axis1(h, 0), 1e-5);
+  EXPECT_NEAR(h.rep.axes[0].d2, h.motor_axis1(10 * kDeg * 0.002) - h.motor_axis1(0), 1e-5);
   // Axis 2 did not move.
   EXPECT_NEAR(h.rep.axes[1].d1, h.transform().calibration()[1], 1e-6);
   const int more = run_until_exit(app, h);
   EXPECT_EQ(more, 500 + 5);  // the rest of the table, then hold_s (5 cycles)
-  EXPECT_NEAR(h.rep.axes[0].d1, motor_axis1(h, 5 * kDeg), 1e-4);
+  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(5 * kDeg), 1e-4);
   // 4': the last target is held; then mode 0 finishes.
   h.set_modes(code(Mode::mode4_standby));
   h.run(app);
-  EXPECT_NEAR(h.rep.axes[0].d1, motor_axis1(h, 5 * kDeg), 1e-4);
+  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(5 * kDeg), 1e-4);
   EXPECT_FALSE(app.finished());
   h.set_modes(code(Mode::mode0));
   h.run(app);
@@ -96,8 +89,8 @@ TEST(StreamApp, Mode5IncrementsAddUpToTheTrajectory) {
     if (k == 499) peak = sum;
   }
   EXPECT_TRUE(h.exit_requested());
-  EXPECT_NEAR(peak, motor_axis1(h, 10 * kDeg) - motor_axis1(h, 0), 1e-3);
-  EXPECT_NEAR(sum, motor_axis1(h, 5 * kDeg) - motor_axis1(h, 0), 1e-3);
+  EXPECT_NEAR(peak, h.motor_axis1(10 * kDeg) - h.motor_axis1(0), 1e-3);
+  EXPECT_NEAR(sum, h.motor_axis1(5 * kDeg) - h.motor_axis1(0), 1e-3);
 }
 
 TEST(StreamApp, RefusesAStartPointAwayFromTheRobot) {
@@ -125,7 +118,7 @@ TEST(StreamApp, RelativeTrajectoryStartsWhereTheRobotIs) {
   h.set_modes(code(Mode::mode4));
   for (int k = 0; k < 500; ++k) h.run(app);
   EXPECT_FALSE(app.has_error());
-  EXPECT_NEAR(h.rep.axes[0].d1, start1 + motor_axis1(h, 10 * kDeg) - motor_axis1(h, 0), 1e-3);
+  EXPECT_NEAR(h.rep.axes[0].d1, start1 + h.motor_axis1(10 * kDeg) - h.motor_axis1(0), 1e-3);
   EXPECT_NEAR(h.rep.axes[1].d1, start2, 1e-4);
 }
 
@@ -169,8 +162,8 @@ TEST(StreamApp, StopRequestSlowsDownAlongThePathAndExits) {
     ++cycles;
     EXPECT_LE(std::fabs(h.rep.axes[0].d2), std::fabs(last_step) + 1e-6);  // never faster
     last_step = h.rep.axes[0].d2;
-    EXPECT_GE(h.rep.axes[0].d1 * std::copysign(1.0, motor_axis1(h, 1) - motor_axis1(h, 0)),
-              last * std::copysign(1.0, motor_axis1(h, 1) - motor_axis1(h, 0)) - 1e-6);  // onward along the path
+    EXPECT_GE(h.rep.axes[0].d1 * std::copysign(1.0, h.motor_axis1(1) - h.motor_axis1(0)),
+              last * std::copysign(1.0, h.motor_axis1(1) - h.motor_axis1(0)) - 1e-6);  // onward along the path
     last = h.rep.axes[0].d1;
   }
   EXPECT_EQ(cycles, 50);  // 0.1 s ramp at 2 ms

@@ -1,5 +1,6 @@
 // The dense-sampling checker: collisions that only happen mid-move, clearances, sampling step.
 #include "fps/plan/checker.hpp"
+#include "model_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,18 +12,8 @@
 namespace axon::fps::plan {
 namespace {
 
-CollisionModel build(std::vector<RobotSpec> robots, std::vector<FiducialSpec> fids = {}) {
-  auto m = CollisionModel::build(robots, ArmDesign{}, fids);
-  EXPECT_TRUE(m) << m.error().message();
-  return std::move(m).value();
-}
-
-double static_clearance(const CollisionModel& m, const std::vector<Pose>& poses) {
-  std::vector<Segment> s(m.size());
-  m.segments(poses, s);
-  std::vector<Contact> c;
-  return m.find_contacts(s, c);
-}
+using test::build;
+using test::static_clearance;
 
 // Robot 1 at the origin sweeps alpha from -60 to +60 deg in 10 s (12 deg/s) with beta 0.
 // Robot 2 at (24, 0) holds alpha 90, beta 0: its segment runs up from (24, 7.4) to (24, 22.1).

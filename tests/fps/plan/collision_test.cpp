@@ -1,5 +1,6 @@
 // The collision model: neighbour pairs and clearances in configurations worked out by hand.
 #include "fps/plan/collision.hpp"
+#include "model_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,14 +11,9 @@
 namespace axon::fps::plan {
 namespace {
 
-RobotSpec robot(std::int32_t id, Vec2 c) { return RobotSpec{id, c, {}, {}, 2.0}; }
+using test::build;
 
-CollisionModel build(std::vector<RobotSpec> robots, std::vector<FiducialSpec> fids = {},
-                     std::vector<ObstacleSpec> obs = {}) {
-  auto m = CollisionModel::build(robots, ArmDesign{}, fids, obs);
-  EXPECT_TRUE(m) << m.error().message();
-  return std::move(m).value();
-}
+RobotSpec robot(std::int32_t id, Vec2 c) { return RobotSpec{id, c, {}, {}, 2.0}; }
 
 std::vector<Segment> segs_of(const CollisionModel& m, const std::vector<Pose>& poses) {
   std::vector<Segment> s(m.size());

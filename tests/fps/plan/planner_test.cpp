@@ -3,6 +3,7 @@
 // that cannot reach their targets are reported with a reason, never dropped.
 #include "fps/plan/planner.hpp"
 #include "fps/plan/problems.hpp"
+#include "model_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,11 +15,8 @@
 namespace axon::fps::plan {
 namespace {
 
-CollisionModel build(std::vector<RobotSpec> robots, std::vector<FiducialSpec> fids = {}) {
-  auto m = CollisionModel::build(robots, ArmDesign{}, fids);
-  EXPECT_TRUE(m) << m.error().message();
-  return std::move(m).value();
-}
+using test::build;
+using test::static_clearance;
 
 RobotSpec at(std::int32_t id, double x, double y) { return RobotSpec{id, {x, y}, {}, {}, 2.0}; }
 
@@ -33,13 +31,6 @@ std::vector<RobotSpec> hex_patch(int rings) {
       if (std::abs(i) <= rings && std::abs(j) <= rings && std::abs(i + j) <= rings) out.push_back(at(id++, x, y));
     }
   return out;
-}
-
-double static_clearance(const CollisionModel& m, const std::vector<Pose>& poses) {
-  std::vector<Segment> s(m.size());
-  m.segments(poses, s);
-  std::vector<Contact> c;
-  return m.find_contacts(s, c);
 }
 
 // What every plan must satisfy, checked independently of the planner's own report.

@@ -3,6 +3,7 @@
 // is reported (a violation), so that the planner discards that run.
 #include "fps/plan/checker.hpp"
 #include "fps/plan/stepper.hpp"
+#include "model_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,12 +12,7 @@
 namespace axon::fps::plan {
 namespace {
 
-CollisionModel two_robots() {
-  const std::vector<RobotSpec> specs{RobotSpec{1, {0, 0}, {}, {}, 2.0}, RobotSpec{2, {22.4, 0}, {}, {}, 2.0}};
-  auto m = CollisionModel::build(specs, ArmDesign{});
-  EXPECT_TRUE(m) << m.error().message();
-  return std::move(m).value();
-}
+using test::two_robots;
 
 TEST(StepperScript, ARobotThatCannotGetAwayIsReportedAsAViolation) {
   // The same swing as fast as a robot can go: robot 1 cannot fold away in time. The engine must

@@ -2,6 +2,7 @@
 // move it gets is clear (independent checker) and ends folded.
 #include "fps/plan/checker.hpp"
 #include "fps/plan/untangle.hpp"
+#include "model_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,12 +11,7 @@
 namespace axon::fps::plan {
 namespace {
 
-CollisionModel two_robots() {
-  const std::vector<RobotSpec> specs{RobotSpec{1, {0, 0}, {}, {}, 2.0}, RobotSpec{2, {22.4, 0}, {}, {}, 2.0}};
-  auto m = CollisionModel::build(specs, ArmDesign{});
-  EXPECT_TRUE(m) << m.error().message();
-  return std::move(m).value();
-}
+using test::two_robots;
 
 StepperResult stuck_result(const std::vector<StepperRobot>& robots, std::vector<bool> reached) {
   StepperResult r;

@@ -29,6 +29,8 @@ inline Payload positions(double alpha_deg, double beta_deg) {
                                 protocol::Angle::from_degrees(beta_deg).value()}
       .encode();
 }
+// The two arm values a reply carries (a bad payload fails the test).
+inline protocol::ArmValues values(const Message& m) { return protocol::ArmValues::decode(m.payload.span()).value(); }
 inline Payload two_u32(std::uint32_t a, std::uint32_t b) { return Payload().put_u32(a).put_u32(b); }
 inline Payload two_i32(std::int32_t a, std::int32_t b) { return Payload().put_i32(a).put_i32(b); }
 inline Payload point(double deg, double seconds) {

@@ -8,7 +8,6 @@ using namespace axon::fps::sim;
 using namespace axon::fps::sim::testing;
 
 namespace {
-protocol::ArmValues values(const Message& m) { return protocol::ArmValues::decode(m.payload.span()).value(); }
 protocol::PositionAndValue pos_value(const Message& m) {
   return protocol::PositionAndValue::decode(m.payload.span()).value();
 }

@@ -1,0 +1,34 @@
+// Small collision models the planner tests build by hand, and the clearance of a static pose.
+#pragma once
+
+#include "fps/plan/collision.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace axon::fps::plan::test {
+
+// The model of `robots` (and fiducials, obstacles) with the default arm design; a model that
+// cannot be built fails the test.
+inline CollisionModel build(std::vector<RobotSpec> robots, std::vector<FiducialSpec> fids = {},
+                            std::vector<ObstacleSpec> obs = {}) {
+  auto m = CollisionModel::build(robots, ArmDesign{}, fids, obs);
+  EXPECT_TRUE(m) << m.error().message();
+  return std::move(m).value();
+}
+
+// Two robots one pitch (22.4 mm) apart on the x axis, 2 mm buffers.
+inline CollisionModel two_robots() {
+  return build({RobotSpec{1, {0, 0}, {}, {}, 2.0}, RobotSpec{2, {22.4, 0}, {}, {}, 2.0}});
+}
+
+// The smallest clearance over every pair when the robots stand at `poses` (negative: contact).
+inline double static_clearance(const CollisionModel& m, const std::vector<Pose>& poses) {
+  std::vector<Segment> s(m.size());
+  m.segments(poses, s);
+  std::vector<Contact> c;
+  return m.find_contacts(s, c);
+}
+
+}  // namespace axon::fps::plan::test
