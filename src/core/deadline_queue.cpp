@@ -43,7 +43,7 @@ void DeadlineQueue::arm(DeadlineClient& c, TimePoint at) {
   heap_.push_back(Entry{at, next_seq_++, c.generation_, &c});
   std::push_heap(heap_.begin(), heap_.end(), later);
   // While firing, the loop itself looks at the new deadline (and arms the timer at the end).
-  if (!firing_ && at < waiting_for_) wait_for(at);
+  if (!firing_ && at < waiting_for_ - slack_) wait_for(at);
 }
 
 void DeadlineQueue::disarm(DeadlineClient& c) noexcept {
@@ -63,9 +63,10 @@ void DeadlineQueue::forget(DeadlineClient& c) noexcept {
 
 void DeadlineQueue::wait_for(TimePoint at) {
   if (!timer_) return;
-  waiting_for_ = at;
+  const TimePoint until = at < TimePoint::max() - slack_ ? at + slack_ : TimePoint::max();
+  waiting_for_ = until;
   ++waits_;
-  timer_->expires_at(at);  // cancels an earlier wait, whose handler then does nothing
+  timer_->expires_at(until);  // cancels an earlier wait, whose handler then does nothing
   timer_->async_wait([this](const boost::system::error_code& ec) {
     if (ec == asio::error::operation_aborted) return;
     fire();

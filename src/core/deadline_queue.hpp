@@ -75,6 +75,14 @@ class DeadlineQueue final : public boost::asio::execution_context::service {
   // Removes the client's pending deadline.
   void disarm(DeadlineClient& c) noexcept;
 
+  // Timer slack: how much later than a deadline the queue may call its client, so that one
+  // kernel timer wake-up serves deadlines that lie close together (the wait runs until the
+  // earliest deadline plus the slack, and an earlier deadline armed while waiting does not move
+  // the wait unless the wait would end more than the slack after it). Clients are never called
+  // early. Default 0: every deadline is waited for exactly.
+  void set_slack(Duration slack) noexcept { slack_ = slack; }
+  [[nodiscard]] Duration slack() const noexcept { return slack_; }
+
   // Deadlines pending (stale entries of re-armed clients included until they come up).
   [[nodiscard]] std::size_t size() const noexcept { return heap_.size(); }
   // Kernel timer waits started (for benches and tests).
@@ -101,6 +109,7 @@ class DeadlineQueue final : public boost::asio::execution_context::service {
   std::uint64_t next_seq_ = 0;
   std::uint64_t waits_ = 0;
   bool firing_ = false;
+  Duration slack_{0};
 };
 
 }  // namespace axon::core

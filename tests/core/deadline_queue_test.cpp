@@ -128,3 +128,24 @@ TEST(DeadlineQueue, AClientMayDestroyAnotherFromItsCall) {
   io.run();
   EXPECT_EQ(log, (std::vector<std::string>{"killer"}));
 }
+
+TEST(DeadlineQueue, SlackLetsOneWakeUpServeCloseDeadlinesButNeverCallsEarly) {
+  asio::io_context io;
+  auto& q = core::DeadlineQueue::of(io.get_executor());
+  q.set_slack(std::chrono::milliseconds(50));
+  std::vector<std::string> log;
+  Recorder x, y;
+  x.name = "x", y.name = "y";
+  x.log = y.log = &log;
+  const auto t0 = std::chrono::steady_clock::now();
+  q.arm(x, t0 + std::chrono::milliseconds(3));
+  const auto waits = q.timer_waits();
+  q.arm(y, t0 + std::chrono::milliseconds(4));  // x's wait ends within y's slack: no new wait
+  EXPECT_EQ(q.timer_waits(), waits);
+  io.run();
+  EXPECT_EQ(log, (std::vector<std::string>{"x", "y"}));
+  EXPECT_EQ(q.timer_waits(), waits);
+  // Both in the one wake-up, which came no earlier than the first deadline plus the slack.
+  EXPECT_GE(x.called_at.at(0), t0 + std::chrono::milliseconds(3) + std::chrono::milliseconds(50));
+  EXPECT_GE(y.called_at.at(0), t0 + std::chrono::milliseconds(4));
+}
