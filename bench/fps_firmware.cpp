@@ -30,51 +30,41 @@ int main() {
   fps::host::UpgradeOptions uo;
   uo.verify_poll = std::chrono::milliseconds(5);
   std::size_t failures = 0;
-  double best = 0, floor_s = 0;
-  bench::BusWire busiest;
-  const auto host_cpu0 = bench::thread_cpu_seconds();
-  const auto sim_cpu0 = rig.sim_cpu_seconds();
+  bench::FpsRig::Round best;
+  std::uint64_t frames = 0;
+  const bench::FpsRig::Cpu cpu(rig);
   for (int round = 0; round < 2; ++round) {
-    const auto before = rig.wire();
-    const auto t0 = std::chrono::steady_clock::now();
-    rig.run([&]() -> bench::asio::awaitable<void> {
-      auto r = co_await array.upgrade_firmware(ids, image, uo);
-      if (!r) {
-        std::fprintf(stderr, "upgrade: %s\n", r.error().message().c_str());
-        failures = ids.size();
-        co_return;
-      }
-      for (const auto& rr : r.value().robots) {
-        if (rr.outcome == fps::host::UpgradeOutcome::ok) continue;
-        if (failures++ < 5) std::fprintf(stderr, "robot %u: %s\n", unsigned{rr.id}, rr.reason.c_str());
-      }
+    const auto r = rig.measure([&] {
+      rig.run([&]() -> bench::asio::awaitable<void> {
+        auto u = co_await array.upgrade_firmware(ids, image, uo);
+        if (!u) {
+          std::fprintf(stderr, "upgrade: %s\n", u.error().message().c_str());
+          failures = ids.size();
+          co_return;
+        }
+        for (const auto& rr : u.value().robots) {
+          if (rr.outcome == fps::host::UpgradeOutcome::ok) continue;
+          if (failures++ < 5) std::fprintf(stderr, "robot %u: %s\n", unsigned{rr.id}, rr.reason.c_str());
+        }
+      });
     });
-    const double achieved = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const auto after = rig.wire();
-    const auto [w, f] = bench::FpsRig::floor(before, after);
+    frames += r.frames;
     std::printf("round %d: %.3f s, busiest bus %llu frames %.4f s wire (ratio %.2f); %.1f kB/s per bus; simulator "
                 "lateness %.2f ms mean, %.1f ms max\n",
-                round, achieved, static_cast<unsigned long long>(w.frames), f, achieved / f,
-                static_cast<double>(image.size()) * static_cast<double>(ids.size()) / 4.0 / achieved / 1e3,
-                bench::FpsRig::mean_lateness_ms(before, after),
-                std::chrono::duration<double, std::milli>(w.max_lateness).count());
-    if (round == 0 || achieved / f < best / floor_s) {
-      best = achieved;
-      floor_s = f;
-      busiest = w;
-    }
+                round, r.achieved_s, static_cast<unsigned long long>(r.busiest.frames), r.floor_s, r.ratio(),
+                static_cast<double>(image.size()) * static_cast<double>(ids.size()) / 4.0 / r.achieved_s / 1e3,
+                r.lateness_ms, std::chrono::duration<double, std::milli>(r.busiest.max_lateness).count());
+    if (round == 0 || r.ratio() < best.ratio()) best = r;
   }
-  const auto host_cpu = bench::thread_cpu_seconds() - host_cpu0;
-  const auto sim_cpu = rig.sim_cpu_seconds() - sim_cpu0;
   const auto totals = array.client_totals();
   const auto overflows = rig.in_sim([&] { return rig.sim->simulator().receive_overflows(); });
-  std::printf("2 rounds: host %.2f s CPU, simulator %.2f s CPU, peak RSS %ld kB; %llu timeouts, %llu receive overflows\n",
-              host_cpu, sim_cpu, bench::peak_rss_kb(), static_cast<unsigned long long>(totals.timeouts),
+  std::printf("2 rounds: %s, peak RSS %ld kB; %llu timeouts, %llu receive overflows\n", cpu.report(frames).c_str(),
+              bench::peak_rss_kb(), static_cast<unsigned long long>(totals.timeouts),
               static_cast<unsigned long long>(overflows));
   rig.stop();
   std::printf("BENCH fps_firmware robots=%zu image_bytes=%zu busiest_frames=%llu failures=%zu floor_s=%.4f "
               "achieved_s=%.4f ratio=%.3f\n",
-              ids.size(), image.size(), static_cast<unsigned long long>(busiest.frames), failures, floor_s, best,
-              best / floor_s);
+              ids.size(), image.size(), static_cast<unsigned long long>(best.busiest.frames), failures, best.floor_s,
+              best.achieved_s, best.ratio());
   return failures == 0 ? 0 : 1;
 }

@@ -13,6 +13,7 @@
 
 #include "fps/host/focal_plane_array.hpp"
 #include "fps/layout/layout_generator.hpp"
+#include "core/deadline_queue.hpp"
 #include "fps/sim/focal_plane_sim.hpp"
 
 #include <boost/asio/co_spawn.hpp>
@@ -26,6 +27,8 @@
 #include <time.h>
 
 #include <chrono>
+#include <string>
+#include <tuple>
 #include <cstdlib>
 #include <future>
 #include <map>
@@ -74,6 +77,7 @@ struct FpsRig {
     fps::sim::FocalPlaneSimOptions so;
     so.random_start = false;
     so.plc = false;
+    if (const char* v = std::getenv("FPS_BENCH_SLACK_US")) so.timer_slack = std::chrono::microseconds(std::strtoul(v, nullptr, 10));
     sim_work = std::make_unique<asio::executor_work_guard<asio::io_context::executor_type>>(sim_io.get_executor());
     sim_thread = std::thread([this] { sim_io.run(); });
     sim = in_sim([&] { return fps::sim::FocalPlaneSimulator::start(sim_io.get_executor(), plane, so).value(); });
@@ -138,6 +142,64 @@ struct FpsRig {
     }
     return frames > 0 ? late / frames : 0.0;
   }
+
+  // Frames on all buses between two snapshots.
+  static std::uint64_t total_frames(const std::map<fps::BusRef, BusWire>& before, const std::map<fps::BusRef, BusWire>& after) {
+    std::uint64_t n = 0;
+    for (const auto& [b, w] : after) n += w.frames - before.at(b).frames;
+    return n;
+  }
+
+  // One measured round of an operation: what measure() returns.
+  struct Round {
+    double achieved_s = 0;
+    BusWire busiest;       // the busiest bus's frames and bits in this round
+    double floor_s = 0;    // its wire time at 1 Mbit/s
+    double lateness_ms = 0;  // mean_lateness_ms over all buses
+    std::uint64_t frames = 0;  // frames on all buses
+    [[nodiscard]] double ratio() const { return achieved_s / floor_s; }
+  };
+
+  // Runs body() (which drives the host's io_context, e.g. with run()) and measures it against the
+  // wire.
+  template <class F>
+  Round measure(F body) {
+    const auto before = wire();
+    const auto t0 = std::chrono::steady_clock::now();
+    body();
+    Round r;
+    r.achieved_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const auto after = wire();
+    std::tie(r.busiest, r.floor_s) = floor(before, after);
+    r.lateness_ms = mean_lateness_ms(before, after);
+    r.frames = total_frames(before, after);
+    return r;
+  }
+
+  // Kernel timer waits the simulator's thread started for its deadlines (pacing, processing).
+  std::uint64_t sim_timer_waits() {
+    return in_sim([&] { return core::DeadlineQueue::of(sim_io.get_executor()).timer_waits(); });
+  }
+
+  // CPU of both threads from construction (start of the measurement) to report().
+  struct Cpu {
+    explicit Cpu(FpsRig& rig)
+        : rig_(rig), host0_(thread_cpu_seconds()), sim0_(rig.sim_cpu_seconds()), waits0_(rig.sim_timer_waits()) {}
+    // "host X s CPU (Y us/frame), simulator ..." over `frames` frames (all buses, all rounds).
+    [[nodiscard]] std::string report(std::uint64_t frames) const {
+      const double host = thread_cpu_seconds() - host0_, sim = rig_.sim_cpu_seconds() - sim0_;
+      const double n = frames > 0 ? static_cast<double>(frames) : 1.0;
+      const double waits = static_cast<double>(rig_.sim_timer_waits() - waits0_);
+      return fmt::format("host {:.2f} s CPU ({:.2f} us/frame), simulator {:.2f} s CPU ({:.2f} us/frame) for {} frames, "
+                         "{:.2f} simulator timer waits per frame",
+                         host, host / n * 1e6, sim, sim / n * 1e6, frames, waits / n);
+    }
+
+   private:
+    FpsRig& rig_;
+    double host0_, sim0_;
+    std::uint64_t waits0_;
+  };
 
   void stop() {
     run([&]() -> asio::awaitable<void> { co_await fpa->close(); });

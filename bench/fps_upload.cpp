@@ -32,43 +32,36 @@ int main() {
   auto& array = rig.fpa->array();
   const auto ids = array.ids();
   std::size_t failures = 0;
-  double best = 0, floor_s = 0;
-  bench::BusWire busiest;
-  const auto host_cpu0 = bench::thread_cpu_seconds();
-  const auto sim_cpu0 = rig.sim_cpu_seconds();
+  bench::FpsRig::Round best;
+  std::uint64_t frames = 0;
+  const bench::FpsRig::Cpu cpu(rig);
   for (int round = 0; round < 3; ++round) {
-    const auto before = rig.wire();
-    const auto t0 = std::chrono::steady_clock::now();
-    rig.run([&]() -> bench::asio::awaitable<void> {
-      co_await fps::host::for_each_concurrently(ids.size(), [&](std::size_t i) -> bench::asio::awaitable<void> {
-        auto r = co_await array.find(ids[i])->upload_trajectory(traj);
-        if (!r.ok()) {
-          if (failures++ < 5) std::fprintf(stderr, "robot %u: %s\n", unsigned{ids[i]}, r.describe().c_str());
-        }
+    const auto r = rig.measure([&] {
+      rig.run([&]() -> bench::asio::awaitable<void> {
+        co_await fps::host::for_each_concurrently(ids.size(), [&](std::size_t i) -> bench::asio::awaitable<void> {
+          auto u = co_await array.find(ids[i])->upload_trajectory(traj);
+          if (!u.ok()) {
+            if (failures++ < 5) std::fprintf(stderr, "robot %u: %s\n", unsigned{ids[i]}, u.describe().c_str());
+          }
+        });
       });
     });
-    const double achieved = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const auto after = rig.wire();
-    const auto [w, f] = bench::FpsRig::floor(before, after);
-    std::printf("round %d: %.3f s, busiest bus %llu frames %.4f s wire (ratio %.2f); simulator lateness %.2f ms mean, %.1f ms max\n",
-                round, achieved, static_cast<unsigned long long>(w.frames), f, achieved / f,
-                bench::FpsRig::mean_lateness_ms(before, after),
-                std::chrono::duration<double, std::milli>(w.max_lateness).count());
-    if (round == 0 || achieved / f < best / floor_s) {
-      best = achieved;
-      floor_s = f;
-      busiest = w;
-    }
+    frames += r.frames;
+    std::printf("round %d: %.3f s, busiest bus %llu frames %.4f s wire (ratio %.2f), %llu frames on all buses; simulator "
+                "lateness %.2f ms mean, %.1f ms max\n",
+                round, r.achieved_s, static_cast<unsigned long long>(r.busiest.frames), r.floor_s, r.ratio(),
+                static_cast<unsigned long long>(r.frames), r.lateness_ms,
+                std::chrono::duration<double, std::milli>(r.busiest.max_lateness).count());
+    if (round == 0 || r.ratio() < best.ratio()) best = r;
   }
-  const auto host_cpu = bench::thread_cpu_seconds() - host_cpu0;
-  const auto sim_cpu = rig.sim_cpu_seconds() - sim_cpu0;
   const auto totals = array.client_totals();
   const auto overflows = rig.in_sim([&] { return rig.sim->simulator().receive_overflows(); });
-  std::printf("3 rounds: host %.2f s CPU, simulator %.2f s CPU, peak RSS %ld kB; %llu timeouts, %llu retries, %llu receive overflows\n",
-              host_cpu, sim_cpu, bench::peak_rss_kb(), static_cast<unsigned long long>(totals.timeouts),
+  std::printf("3 rounds: %s, peak RSS %ld kB; %llu timeouts, %llu retries, %llu receive overflows\n",
+              cpu.report(frames).c_str(), bench::peak_rss_kb(), static_cast<unsigned long long>(totals.timeouts),
               static_cast<unsigned long long>(totals.retries), static_cast<unsigned long long>(overflows));
   rig.stop();
   std::printf("BENCH fps_upload robots=%zu points_per_arm=20 busiest_frames=%llu failures=%zu floor_s=%.4f achieved_s=%.4f ratio=%.3f\n",
-              ids.size(), static_cast<unsigned long long>(busiest.frames), failures, floor_s, best, best / floor_s);
+              ids.size(), static_cast<unsigned long long>(best.busiest.frames), failures, best.floor_s, best.achieved_s,
+              best.ratio());
   return failures == 0 ? 0 : 1;
 }

@@ -72,9 +72,19 @@ struct CanNetGateway::Impl : std::enable_shared_from_this<CanNetGateway::Impl> {
   bool protocol_error_logged = false;
   std::array<Channel, kMaxChannel + 1> chan{};  // indexed by channel number
 
+  // A frame line whose sender waits for room in `out` (more than kOutputHighWater queued). The
+  // writer moves waiting lines into `out` itself, oldest first, as room appears, and new frames
+  // queue behind waiting ones: frames go out in the order send() was called, always.
+  struct SpaceWaiter {
+    explicit SpaceWaiter(const asio::any_io_executor& ex, std::string_view l) : wake(ex), line(l) {}
+    core::Wakeup wake;
+    std::string line;
+    bool queued = false;
+  };
+
   std::string out;                  // lines waiting for the writer
   core::Wakeup* writer_idle = nullptr;    // the writer, when it has nothing to write
-  std::vector<core::Wakeup*> space_waiters;
+  std::deque<SpaceWaiter*> space_waiters;  // in order of their send() calls
 
   bool command_busy = false;        // a command is in flight (or being sent)
   std::deque<core::Wakeup*> command_queue;
@@ -96,10 +106,23 @@ struct CanNetGateway::Impl : std::enable_shared_from_this<CanNetGateway::Impl> {
     ++stats.lines_out;
     if (writer_idle) writer_idle->notify();
   }
-  asio::awaitable<Result<void>> write_bounded(std::string line);
+  // A frame line can go straight into `out`: nothing waits for room and there is room.
+  [[nodiscard]] bool room_now() const noexcept { return space_waiters.empty() && out.size() < kOutputHighWater; }
+  // Waits (in turn) until the writer has moved the line into `out`.
+  asio::awaitable<Result<void>> queue_in_turn(std::string_view line);
+  // After a write: moves waiting lines into `out` while there is room, oldest first.
+  void admit_waiters() {
+    while (!space_waiters.empty() && out.size() < kOutputHighWater) {
+      SpaceWaiter* w = space_waiters.front();
+      space_waiters.pop_front();
+      queue_line(w->line);
+      w->queued = true;
+      w->wake.notify();
+    }
+  }
   // Lines queued or being written (0 once the writer is idle with nothing queued).
   [[nodiscard]] std::size_t output_pending() const noexcept {
-    const auto lines = static_cast<std::size_t>(std::count(out.begin(), out.end(), '\n'));
+    const auto lines = static_cast<std::size_t>(std::count(out.begin(), out.end(), '\n')) + space_waiters.size();
     return connected && writer_idle == nullptr ? lines + 1 : lines;
   }
 
@@ -135,8 +158,14 @@ class CanNetBus final : public Bus {
     if (!is_open()) co_return Error(CanErrc::closed, name());
     if (state() == BusState::bus_off)
       co_return Error(CanErrc::bus_off, fmt::format("{}: the channel is bus-off; restart it first", name()));
-    auto r = co_await impl_->write_bounded(format_frame(channel_, frame));
-    if (!r) co_return r.error();
+    cannet::FrameLineBuffer text;
+    const std::string_view line = format_frame_to(text, channel_, frame);
+    if (impl_->room_now()) {
+      impl_->queue_line(line);
+    } else {
+      auto r = co_await impl_->queue_in_turn(line);
+      if (!r) co_return r.error();
+    }
     count_sent(frame);
     co_return ok();
   }
@@ -249,7 +278,7 @@ asio::awaitable<void> CanNetGateway::Impl::run_writer(std::shared_ptr<Impl> self
       s.connection_down(Error(CanErrc::io, fmt::format("{}: write failed: {}", s.where, ec.message())));
       co_return;
     }
-    for (auto* w : s.space_waiters) w->notify();
+    s.admit_waiters();
   }
 }
 
@@ -265,23 +294,23 @@ void CanNetGateway::Impl::connection_down(Error why) {
   socket.shutdown(tcp::socket::shutdown_both, ignored);
   socket.close(ignored);
   if (writer_idle) writer_idle->notify();
-  for (auto* w : space_waiters) w->notify();
+  for (auto* w : space_waiters) w->wake.abandon();
   for (auto* w : command_queue) w->abandon();  // woken without being granted the turn
   if (pending) pending->waiter.abandon();
   for (auto& c : chan)
     if (c.bus) c.bus->on_connection_down();
 }
 
-asio::awaitable<Result<void>> CanNetGateway::Impl::write_bounded(std::string line) {
+asio::awaitable<Result<void>> CanNetGateway::Impl::queue_in_turn(std::string_view line) {
   auto self = shared_from_this();
-  while (connected && out.size() >= kOutputHighWater) {
-    core::Wakeup room(executor);
-    space_waiters.push_back(&room);
-    core::OnExit remove{[this, &room] { space_waiters.erase(std::remove(space_waiters.begin(), space_waiters.end(), &room), space_waiters.end()); }};
-    co_await room.wait();
-  }
-  if (!connected) co_return down_error;
-  queue_line(line);
+  SpaceWaiter w(executor, line);  // the line is copied before the first suspension
+  space_waiters.push_back(&w);
+  core::OnExit remove{[this, &w] {
+    space_waiters.erase(std::remove(space_waiters.begin(), space_waiters.end(), &w), space_waiters.end());
+  }};
+  if (writer_idle) writer_idle->notify();  // let the writer make room (it normally is busy already)
+  while (!w.queued && connected) (void)co_await w.wake.wait();
+  if (!w.queued) co_return down_error;
   co_return ok();
 }
 

@@ -38,15 +38,32 @@ struct Token {
   std::size_t offset = 0;  // where it starts in the line
 };
 
-std::vector<Token> split(std::string_view line) {
-  std::vector<Token> tokens;
+// The tokens of a line without allocating: the first kMaxTokens are kept, all are counted. No line
+// the parser accepts has more than 12; the count alone is enough to reject longer ones.
+struct Tokens {
+  static constexpr std::size_t kMaxTokens = 16;
+  std::array<Token, kMaxTokens> kept{};
+  std::size_t count = 0;
+
+  [[nodiscard]] std::size_t size() const noexcept { return count; }
+  [[nodiscard]] bool empty() const noexcept { return count == 0; }
+  // Tokens beyond the kept ones read as empty (only ever asked for to quote them in a message).
+  const Token& operator[](std::size_t i) const noexcept {
+    static const Token none{};
+    return i < kMaxTokens ? kept[i] : none;
+  }
+};
+
+Tokens split(std::string_view line) {
+  Tokens tokens;
   std::size_t i = 0;
   while (i < line.size()) {
     while (i < line.size() && is_space(line[i])) ++i;
     if (i == line.size()) break;
     const std::size_t start = i;
     while (i < line.size() && !is_space(line[i])) ++i;
-    tokens.push_back({line.substr(start, i - start), start});
+    if (tokens.count < Tokens::kMaxTokens) tokens.kept[tokens.count] = Token{line.substr(start, i - start), start};
+    ++tokens.count;
   }
   return tokens;
 }
@@ -306,7 +323,7 @@ class Parser {
   }
 
   std::string_view line_;
-  std::vector<Token> tokens_;
+  Tokens tokens_;
 };
 
 template <class... F>
@@ -348,21 +365,35 @@ Result<void> check_channel(int channel) {
   return ok();
 }
 
-std::string format_frame(int channel, const Frame& frame) {
-  std::string out;
-  out.reserve(40);
+std::string_view format_frame_to(FrameLineBuffer& out, int channel, const Frame& frame) noexcept {
+  constexpr char kHex[] = "0123456789ABCDEF";
+  char* p = out.data();
+  *p++ = 'M';
+  *p++ = ' ';
+  p = std::to_chars(p, p + 12, channel).ptr;  // 12 characters hold any int
   const bool ext = frame.is_extended();
-  fmt::format_to(std::back_inserter(out), "M {} C{}{} ", channel, ext ? 'E' : 'S', frame.is_remote() ? 'R' : 'D');
-  if (ext)
-    fmt::format_to(std::back_inserter(out), "{:08X}", frame.id());
-  else
-    fmt::format_to(std::back_inserter(out), "{:03X}", frame.id());
+  *p++ = ' ';
+  *p++ = 'C';
+  *p++ = ext ? 'E' : 'S';
+  *p++ = frame.is_remote() ? 'R' : 'D';
+  *p++ = ' ';
+  for (int shift = ext ? 28 : 8; shift >= 0; shift -= 4) *p++ = kHex[(frame.id() >> shift) & 0xF];
   if (frame.is_remote()) {
-    fmt::format_to(std::back_inserter(out), " dlc={}", frame.dlc());
+    for (const char c : std::string_view(" dlc=")) *p++ = c;
+    p = std::to_chars(p, p + 3, unsigned{frame.dlc()}).ptr;
   } else {
-    for (const std::uint8_t b : frame.payload()) fmt::format_to(std::back_inserter(out), " {:02X}", b);
+    for (const std::uint8_t b : frame.payload()) {
+      *p++ = ' ';
+      *p++ = kHex[b >> 4];
+      *p++ = kHex[b & 0xF];
+    }
   }
-  return out;
+  return std::string_view(out.data(), static_cast<std::size_t>(p - out.data()));
+}
+
+std::string format_frame(int channel, const Frame& frame) {
+  FrameLineBuffer buf;
+  return std::string(format_frame_to(buf, channel, frame));
 }
 
 std::string format_line(const Line& line) {
@@ -433,7 +464,7 @@ std::optional<LineSplitter::Piece> LineSplitter::next() {
     const std::size_t start = head_;
     head_ = nl + 1;
     if (len > max_) return Piece{{}, true};
-    return Piece{buf_.substr(start, len), false};
+    return Piece{std::string_view(buf_).substr(start, len), false};
   }
 }
 

@@ -22,6 +22,7 @@
 
 #include "can/frame.hpp"
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -157,6 +158,10 @@ std::string format_line(const Line& line);
 
 // format_line(FrameMessage{channel, frame}) without building the variant.
 std::string format_frame(int channel, const Frame& frame);
+// The same text written into a caller's buffer, without allocating (the per-frame path of the
+// client and the emulator); the view points into `out`. Any int channel fits.
+using FrameLineBuffer = std::array<char, 64>;
+std::string_view format_frame_to(FrameLineBuffer& out, int channel, const Frame& frame) noexcept;
 
 // "1000", "83.3" for 1'000'000 and 83'300 bit/s.
 std::string format_kbit(std::uint32_t bitrate);
@@ -172,7 +177,9 @@ Result<void> check_channel(int channel);
 class LineSplitter {
  public:
   struct Piece {
-    std::string text;  // without the '\n' (a '\r' before it is left for parse_line)
+    // Without the '\n' (a '\r' before it is left for parse_line). Points into the splitter's
+    // buffer: valid until the next call to next() or append().
+    std::string_view text;
     bool overlong = false;
   };
   explicit LineSplitter(std::size_t max_length = kMaxLineLength + 1) : max_(max_length) {}

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <optional>
 
 namespace axon::can {
 
@@ -116,8 +117,13 @@ struct CanNetGatewayEmulator::Impl : std::enable_shared_from_this<CanNetGatewayE
     if (client) send(*client, line);
   }
 
-  asio::awaitable<void> handle_line(const std::shared_ptr<Connection>& conn, std::string_view text);
-  asio::awaitable<void> forward(const std::shared_ptr<Connection>& conn, int channel, Frame frame);
+  // Handles a command line (answering it) or a bad one; returns the frame of a frame line for the
+  // reader to forward (the only kind of line that may have to wait).
+  std::optional<FrameMessage> handle_line(Connection& conn, std::string_view text);
+  // Forwarding a client frame to its channel's bus: whether the channel takes frames now (else
+  // the frame is discarded and counted), and the bookkeeping once the bus has answered.
+  bool accepts_frames(int channel);
+  void sent_to_bus(Connection& conn, int channel, const Result<void>& sent);
   Line answer(const Line& command);
   ReplyStatus status(int channel) const;
   [[nodiscard]] bool fitted(int channel) const { return chan[static_cast<std::size_t>(channel)].endpoint != nullptr; }
@@ -240,7 +246,18 @@ asio::awaitable<void> CanNetGatewayEmulator::Impl::run_reader(std::shared_ptr<Im
         s.send(*conn, refuse(kErrSyntax, fmt::format("line longer than {} characters", kMaxLineLength)));
         continue;
       }
-      co_await s.handle_line(conn, piece->text);
+      auto m = s.handle_line(*conn, piece->text);
+      if (!m || !s.accepts_frames(m->channel)) continue;
+      // The frame is forwarded here rather than in a coroutine of its own: one coroutine frame
+      // less per frame, and the reader keeps the client's order by waiting for each.
+      auto& c = s.chan[static_cast<std::size_t>(m->channel)];
+      // A full FIFO: first let the medium take what it can right now (an unpaced bus empties it
+      // at once; a paced one only as fast as its wire).
+      if (c.endpoint->tx_pending() >= s.options.tx_fifo) co_await asio::post(s.executor, asio::use_awaitable);
+      if (!c.endpoint) continue;
+      const Frame frame = m->frame;
+      auto sent = co_await c.endpoint->send(frame);
+      s.sent_to_bus(*conn, m->channel, sent);
     }
   }
 }
@@ -267,46 +284,43 @@ asio::awaitable<void> CanNetGatewayEmulator::Impl::run_writer(std::shared_ptr<Im
   }
 }
 
-asio::awaitable<void> CanNetGatewayEmulator::Impl::handle_line(const std::shared_ptr<Connection>& conn, std::string_view text) {
-  if (std::all_of(text.begin(), text.end(), [](char c) { return c == ' ' || c == '\t' || c == '\r'; })) co_return;
+std::optional<FrameMessage> CanNetGatewayEmulator::Impl::handle_line(Connection& conn, std::string_view text) {
+  if (std::all_of(text.begin(), text.end(), [](char c) { return c == ' ' || c == '\t' || c == '\r'; })) return std::nullopt;
   auto parsed = parse_line(text);
   if (!parsed) {
     ++stats.commands;
     ++stats.error_replies;
-    send(*conn, refuse(kErrSyntax, parsed.error().detail));
-    co_return;
+    send(conn, refuse(kErrSyntax, parsed.error().detail));
+    return std::nullopt;
   }
   const Line& line = parsed.value();
-  if (const auto* m = std::get_if<FrameMessage>(&line)) {
-    co_await forward(conn, m->channel, m->frame);
-    co_return;
-  }
+  if (const auto* m = std::get_if<FrameMessage>(&line)) return *m;
   ++stats.commands;
   Line reply = is_host_command(line) ? answer(line)
                                      : refuse(kErrNotCommand, fmt::format("'{}' is not a host command", format_line(line)));
   if (std::holds_alternative<ReplyError>(reply)) ++stats.error_replies;
-  send(*conn, reply);
+  send(conn, reply);
+  return std::nullopt;
 }
 
-asio::awaitable<void> CanNetGatewayEmulator::Impl::forward(const std::shared_ptr<Connection>& conn, int channel, Frame frame) {
-  auto& c = chan[static_cast<std::size_t>(channel)];
+bool CanNetGatewayEmulator::Impl::accepts_frames(int channel) {
+  const auto& c = chan[static_cast<std::size_t>(channel)];
   if (!c.endpoint || !c.running || c.bus_off) {  // the device discards these without a word
     ++stats.not_running_drops;
-    co_return;
+    return false;
   }
-  // A full FIFO: first let the medium take what it can right now (an unpaced bus empties it at
-  // once; a paced one only as fast as its wire).
-  if (c.endpoint->tx_pending() >= options.tx_fifo) co_await asio::post(executor, asio::use_awaitable);
-  if (!c.endpoint) co_return;
-  auto sent = co_await c.endpoint->send(frame);
+  return true;
+}
+
+void CanNetGatewayEmulator::Impl::sent_to_bus(Connection& conn, int channel, const Result<void>& sent) {
   if (sent) {
     ++stats.frames_to_bus;
-    co_return;
+    return;
   }
   if (sent.error() == CanErrc::tx_overflow) {
     ++stats.tx_overflow_drops;
-    if (options.report_tx_overflow) send(*conn, Line{Event{channel, EventKind::tx_overflow, true, 1}});
-    co_return;
+    if (options.report_tx_overflow) send(conn, Line{Event{channel, EventKind::tx_overflow, true, 1}});
+    return;
   }
   ++stats.not_running_drops;
   spdlog::debug("CAN@net emulator: channel {}: frame not sent: {}", channel, sent.error().message());
@@ -332,7 +346,8 @@ asio::awaitable<void> CanNetGatewayEmulator::Impl::run_pump(std::shared_ptr<Impl
       c.overrun = true;
       continue;
     }
-    s.send(*conn, std::string_view(format_frame(channel, frame.value())));
+    FrameLineBuffer text;
+    s.send(*conn, format_frame_to(text, channel, frame.value()));
     ++s.stats.frames_to_client;
   }
 }

@@ -1,5 +1,7 @@
 #include "can/virtual_bus.hpp"
 
+#include "core/deadline_queue.hpp"
+
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <fmt/format.h>
@@ -60,9 +62,12 @@ class VirtualNode final : public Bus {
 }  // namespace
 
 // The medium. Everything runs on `executor`; nothing here is touched from another thread.
-struct VirtualBus::Impl {
+// Pacing uses the execution context's DeadlineQueue (one timer for every medium and simulator on
+// that thread) rather than a timer of its own.
+struct VirtualBus::Impl final : core::DeadlineClient {
   Impl(asio::any_io_executor ex, std::string n, WireModel w)
-      : executor(std::move(ex)), name(std::move(n)), wire(w), wire_timer(executor), delay_timer(executor) {
+      : executor(std::move(ex)), name(std::move(n)), wire(w), deadlines(&core::DeadlineQueue::of(executor)),
+        delay_timer(executor) {
     stats.created = core::SteadyClock::instance().now();
   }
 
@@ -97,7 +102,7 @@ struct VirtualBus::Impl {
   bool active = false;  // a run is scheduled or a frame is on the wire
 
   OnWire on_wire;
-  asio::steady_timer wire_timer;
+  core::DeadlineQueue* deadlines;  // pacing: ends the frame on the wire (on_deadline)
   core::TimePoint wire_free{};    // pacing: when the last frame ends (or ended) on the schedule
 
   std::vector<Delayed> delayed;  // min-heap on (due, seq)
@@ -241,20 +246,23 @@ struct VirtualBus::Impl {
   // machine, a descheduled thread) delivers what the wire would have carried meanwhile, and no
   // more, since no frame starts before it was queued or before the previous one ended. So wake-up
   // latency neither piles up over a burst nor lets the medium carry more than a real bus would.
+  //
+  // The deadline queue calls on_deadline() at the end; when the process woke up late, the frames
+  // whose ends have passed meanwhile are all handed over in that one wake-up (their deadlines lie
+  // in the past, so the queue calls again at once), each still ending at its schedule's time.
   void hold_wire() {
     wire_free = on_wire.start + bits_to_time(on_wire.bits, wire.bitrate);
-    wire_timer.expires_at(wire_free);
-    wire_timer.async_wait([s = self()](const boost::system::error_code& ec) {
-      if (ec == asio::error::operation_aborted) return;
-      auto& m = *s->impl_;
-      m.note_lateness();
-      if (m.finish_copy()) {
-        m.on_wire.start = m.wire_free;  // the duplicate follows at once
-        m.hold_wire();
-        return;
-      }
-      m.start_next();
-    });
+    deadlines->arm(*this, wire_free);
+  }
+
+  void on_deadline() override {
+    note_lateness();
+    if (finish_copy()) {
+      on_wire.start = wire_free;  // the duplicate follows at once
+      hold_wire();
+      return;
+    }
+    start_next();
   }
 
   // How late (process latency) the frame that has just ended is handed over.

@@ -9,6 +9,8 @@
 
 #include <boost/asio/detached.hpp>
 #include <boost/asio/post.hpp>
+#include <boost/asio/this_coro.hpp>
+#include <boost/asio/use_awaitable.hpp>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -482,4 +484,59 @@ TEST(CanNetClient, FifoOverflowCanBeSilentLikeTheDevice) {
     gw.value()->close();
   });
   EXPECT_GT(b.emulator->stats().tx_overflow_drops, 0u);
+}
+
+// Frames leave in the order send() was called, also when more than the client's output buffer
+// (64 kB) is queued and senders have to wait for the socket: a sender that comes along while
+// others wait queues behind them instead of slipping in while the writer makes room. Several
+// coroutines send at once, each numbering its frame at the call; the bus must see the numbers in
+// ascending order, none missing.
+TEST(CanNetClient, FramesKeepTheirOrderWhenTheOutputBufferIsFull) {
+  Bench b;
+  run(b.io, [&]() -> asio::awaitable<void> {
+    auto gw = co_await b.connect(1);
+    CO_ASSERT_TRUE(gw);
+    auto bus = gw.value()->bus(1);
+    CO_ASSERT_TRUE(bus);
+    auto& ch1 = *bus.value();
+    constexpr std::uint32_t kFrames = 12000;  // about 430 kB of lines: the buffer fills many times
+    constexpr int kSenders = 6;
+    std::uint32_t next = 0;
+    int finished = 0;
+    bool send_failed = false;
+    auto ex = co_await asio::this_coro::executor;
+    for (int s = 0; s < kSenders; ++s) {
+      asio::co_spawn(ex, [&, s]() -> asio::awaitable<void> {
+        for (int i = 0; next < kFrames; ++i) {
+          const std::uint32_t n = next++;
+          const std::uint8_t bytes[8] = {static_cast<std::uint8_t>(n >> 24), static_cast<std::uint8_t>(n >> 16),
+                                         static_cast<std::uint8_t>(n >> 8),  static_cast<std::uint8_t>(n),
+                                         0xAA, 0x55, static_cast<std::uint8_t>(s), 0};
+          auto sent = co_await ch1.send(Frame::standard(0x123, bytes).value());
+          if (!sent) send_failed = true;
+          // The first sender runs on until the buffer is full; the others yield after every frame,
+          // so they come back while the writer is busy and the first one waits for room.
+          if (s > 0) co_await asio::post(ex, asio::use_awaitable);
+        }
+        ++finished;
+      }, asio::detached);
+    }
+    std::uint32_t received = 0, out_of_order = 0, expected = 0;
+    const auto give_up = std::chrono::steady_clock::now() + 20s;
+    while (received < kFrames && std::chrono::steady_clock::now() < give_up) {
+      auto f = co_await b.can0->receive(100ms);
+      if (!f) continue;
+      const auto p = f.value().payload();
+      const std::uint32_t n = std::uint32_t{p[0]} << 24 | std::uint32_t{p[1]} << 16 | std::uint32_t{p[2]} << 8 | p[3];
+      if (n != expected) ++out_of_order;
+      expected = n + 1;
+      ++received;
+    }
+    EXPECT_FALSE(send_failed);
+    EXPECT_EQ(finished, kSenders);
+    EXPECT_EQ(received, kFrames);
+    EXPECT_EQ(out_of_order, 0u);
+    EXPECT_EQ(ch1.stats().frames_out, kFrames);
+    gw.value()->close();
+  });
 }

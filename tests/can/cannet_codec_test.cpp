@@ -249,16 +249,45 @@ TEST(CanNetCodec, FormatFrameMatchesFormatLine) {
   EXPECT_EQ(format_frame(2, f), format_line(FrameMessage{2, f}));
 }
 
+// The allocation-free formatter writes exactly what the string one does, for every shape.
+TEST(CanNetCodec, FormatFrameToMatchesFormatFrame) {
+  const std::vector<Frame> frames = {
+      Frame::parse("000#").value(),          Frame::parse("7FF#FFFFFFFFFFFFFFFF").value(),
+      Frame::parse("1FFFFFFF#00").value(),    Frame::parse("00000001#0102030405060708").value(),
+      Frame::parse("123#R").value(),          Frame::parse("1ABCDEF0#R8").value(),
+      Frame::parse("0AB#DEADBEEF").value(),
+  };
+  const std::vector<std::string> expected = {
+      "M 1 CSD 000",          "M 1 CSD 7FF FF FF FF FF FF FF FF FF", "M 1 CED 1FFFFFFF 00",
+      "M 1 CED 00000001 01 02 03 04 05 06 07 08", "M 1 CSR 123 dlc=0", "M 1 CER 1ABCDEF0 dlc=8",
+      "M 1 CSD 0AB DE AD BE EF",
+  };
+  FrameLineBuffer buf;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(format_frame_to(buf, 1, frames[i]), expected[i]);
+    for (int ch = 1; ch <= 4; ++ch) EXPECT_EQ(format_frame_to(buf, ch, frames[i]), format_line(FrameMessage{ch, frames[i]}));
+    auto back = parse_line(format_frame_to(buf, 3, frames[i]));
+    ASSERT_TRUE(back.has_value());
+    EXPECT_EQ(back.value(), (Line{FrameMessage{3, frames[i]}}));
+  }
+}
+
 }  // namespace
 }  // namespace axon::can::cannet
 
 namespace axon::can::cannet {
 namespace {
 
-std::vector<LineSplitter::Piece> feed(LineSplitter& s, std::string_view bytes) {
+// A piece's text points into the splitter, valid until its next call: kept as copies here.
+struct Kept {
+  std::string text;
+  bool overlong = false;
+};
+
+std::vector<Kept> feed(LineSplitter& s, std::string_view bytes) {
   s.append(bytes);
-  std::vector<LineSplitter::Piece> out;
-  while (auto p = s.next()) out.push_back(std::move(*p));
+  std::vector<Kept> out;
+  while (auto p = s.next()) out.push_back(Kept{std::string(p->text), p->overlong});
   return out;
 }
 

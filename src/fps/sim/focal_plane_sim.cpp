@@ -1,5 +1,6 @@
 #include "fps/sim/focal_plane_sim.hpp"
 
+#include "core/deadline_queue.hpp"
 #include "core/error.hpp"
 #include "fps/sim/simulator_config.hpp"
 
@@ -204,6 +205,7 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
       return Error(CoreErrc::invalid_argument, fmt::format("scenario: extra robot {}: no bus {}", id, bus.to_string()));
   }
 
+  core::DeadlineQueue::of(executor).set_slack(o.timer_slack);
   // One medium per bus of every gateway channel the layout uses (or an extra robot uses).
   can::WireModel wire;
   wire.enabled = true;

@@ -1,6 +1,7 @@
 #include "fps/sim/simulator.hpp"
 
 #include "can/error.hpp"
+#include "core/deadline_queue.hpp"
 #include "core/wakeup.hpp"
 
 #include <boost/asio/co_spawn.hpp>
@@ -63,7 +64,7 @@ struct Robot {
   bool sending = false;
 };
 
-struct Simulator::State : std::enable_shared_from_this<State> {
+struct Simulator::State final : std::enable_shared_from_this<State>, core::DeadlineClient {
   asio::any_io_executor executor;
   SimulatorOptions options;
   const core::Clock* clock = nullptr;
@@ -80,9 +81,10 @@ struct Simulator::State : std::enable_shared_from_this<State> {
   asio::steady_timer tick_timer;
   SimulatorStats stats;
 
-  // Processing times of every robot on one timer: (end of processing, order taken) -> robot. A
+  // Processing times of every robot in one heap: (end of processing, order taken) -> robot. A
   // timer per command per robot cost a kernel timer update for each of tens of thousands of
-  // frames a second; one heap and one timer for all handle every robot that is due in one go.
+  // frames a second; one heap, woken by the executor's DeadlineQueue (shared with the paced
+  // buses), handles every robot that is due in one go.
   struct Due {
     core::TimePoint at;
     std::uint64_t seq;
@@ -90,11 +92,11 @@ struct Simulator::State : std::enable_shared_from_this<State> {
   };
   std::vector<Due> due;  // min-heap on (at, seq)
   std::uint64_t next_due = 0;
-  asio::steady_timer due_timer;
+  core::DeadlineQueue* deadlines;
   core::TimePoint due_armed = core::TimePoint::max();
 
   State(asio::any_io_executor ex, SimulatorOptions o)
-      : executor(ex), options(std::move(o)), faults(options.reply_faults), tick_timer(ex), due_timer(ex) {
+      : executor(ex), options(std::move(o)), faults(options.reply_faults), tick_timer(ex), deadlines(&core::DeadlineQueue::of(ex)) {
     clock = options.clock != nullptr ? options.clock : &core::SteadyClock::instance();
     start_real = clock->now();
   }
@@ -114,6 +116,7 @@ struct Simulator::State : std::enable_shared_from_this<State> {
   void schedule(Robot& r, core::TimePoint at);
   void arm_due(core::TimePoint at);
   void run_due();
+  void on_deadline() override { run_due(); }
   void step();
   void check_collisions(SimTime t);
 
@@ -203,11 +206,7 @@ void Simulator::State::schedule(Robot& r, core::TimePoint at) {
 
 void Simulator::State::arm_due(core::TimePoint at) {
   due_armed = at;
-  due_timer.expires_at(at);  // cancels an earlier wait, whose handler then does nothing
-  due_timer.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
-    if (ec == asio::error::operation_aborted) return;
-    self->run_due();
-  });
+  deadlines->arm(*this, at);  // replaces the later deadline armed before
 }
 
 void Simulator::State::run_due() {
@@ -388,7 +387,7 @@ void Simulator::stop() {
   s.stopped = true;
   s.running = false;
   s.tick_timer.cancel();
-  s.due_timer.cancel();
+  s.deadlines->disarm(s);
   for (auto& r : s.robots) {
     r->idle.abandon();
     r->bus->close();
