@@ -245,15 +245,6 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
             for (const Segment& si : sweep) c = std::min(c, segment_distance(si, sj));
             return c;
           };
-          double best_a = poses[j].alpha_deg, best_d = sweep_clearance(segs[j]);
-          for (double a = lj.alpha_min_deg; a <= lj.alpha_max_deg; a += 5) {
-            const double d = sweep_clearance(rj.collision_segment({a, poses[j].beta_deg}));
-            if (d > best_d + 0.5 || (d > best_d - 1e-6 && std::abs(a - poses[j].alpha_deg) < std::abs(best_a - poses[j].alpha_deg))) {
-              best_d = d;
-              best_a = a;
-            }
-          }
-          if (best_a == poses[j].alpha_deg) continue;
           std::vector<Fixed> fj;
           const auto nbj = model.neighbours(j);
           const auto pj = model.pairs_of(j);
@@ -262,6 +253,22 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
           for (const std::uint32_t k : model.obstacle_pairs_of(j))
             fj.push_back({obstacles[opairs[k].obstacle].shape, opairs[k].limit_mm});
           RobotGrid gj(rj, std::move(fj), poses[j], o.alpha_step_deg, o.beta_step_deg, o.margin_mm);
+          // How far it can turn either way (the unfolded robots, often this one, may stop it);
+          // the best alpha within that range.
+          const double lo = gj.walk_alpha(lj.alpha_min_deg).back().alpha_deg;
+          const double hi = gj.walk_alpha(lj.alpha_max_deg).back().alpha_deg;
+          double best_a = poses[j].alpha_deg, best_d = sweep_clearance(segs[j]);
+          auto consider = [&](double a) {
+            const double d = sweep_clearance(rj.collision_segment({a, poses[j].beta_deg}));
+            if (d > best_d + 0.5 || (d > best_d - 1e-6 && std::abs(a - poses[j].alpha_deg) < std::abs(best_a - poses[j].alpha_deg))) {
+              best_d = d;
+              best_a = a;
+            }
+          };
+          for (double a = std::ceil(lo / 5) * 5; a <= hi; a += 5) consider(a);
+          consider(lo);
+          consider(hi);
+          if (best_a == poses[j].alpha_deg) continue;
           std::vector<Pose> w = gj.walk_alpha(best_a);
           if (w.size() < 2) continue;
           slot = std::max(slot, static_cast<double>(w.size() - 1) * o.dt_s);
