@@ -79,5 +79,29 @@ TEST(Untangle, RobotAgainstTheAlphaStopNextToAFiducialGetsOut) {
   }
 }
 
+// A robot against its alpha-0 stop, 0.3 mm from a folded neighbour on the site at 60 deg (problem
+// 1009 of the bench, robots 85, 86 and 44). The neighbour's best alpha lies beyond where the stuck
+// robot lets it turn; turned the other way, within the range it can reach, it clears the way.
+TEST(Untangle, FoldedNeighbourTurnsWithinTheRangeItCanReach) {
+  const std::vector<RobotSpec> specs{RobotSpec{85, {0, 0}, {}, {}, 2.0}, RobotSpec{86, {11.2, 19.399}, {}, {}, 2.0},
+                                     RobotSpec{44, {22.4, 0}, {}, {}, 2.0}};
+  const std::vector<FiducialSpec> fiducials{FiducialSpec{2, {33.6, 19.399}, 3.0}};
+  auto built = CollisionModel::build(specs, ArmDesign{}, fiducials);
+  ASSERT_TRUE(built) << built.error().message();
+  const CollisionModel& m = built.value();
+  std::vector<StepperRobot> robots{{{0.05, 52.41}, {60.16, 180}, false, nullptr},
+                                   {{90.64, 180}, {90.64, 180}, false, nullptr},
+                                   {{251.17, 180}, {251.17, 180}, false, nullptr}};
+  StepperResult r = stuck_result(robots, {false, true, true});
+  ASSERT_EQ(untangle_to_fold(m, robots, r, StepperOptions{}), 1u);
+  EXPECT_DOUBLE_EQ(r.end[0].beta_deg, 180.0);
+  EXPECT_NE(r.end[1].alpha_deg, 90.64);  // the neighbour turned
+  EXPECT_DOUBLE_EQ(r.end[1].beta_deg, 180.0);
+  TrajectoryChecker checker(m);
+  CheckReport report;
+  ASSERT_TRUE(checker.check(r.paths, CheckOptions{}, report));
+  EXPECT_TRUE(report.ok());
+}
+
 }  // namespace
 }  // namespace axon::fps::plan
