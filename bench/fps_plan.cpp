@@ -10,7 +10,7 @@
 // The reference planner cannot run here; its figures on random 500-robot problems on this kind of
 // machine (FIELD-NOTES / issue 5) are printed beside ours and give ratio = 28 s / our median.
 //
-// Usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K] [--local-retries N] [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--stop-avoid DEG] [--fold-stop-gap DEG]
+// Usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K] [--local-retries N] [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--stop-avoid DEG] [--fold-stop-gap DEG] [--give-up N] [--stall S]
 #include "fps/layout/layout_generator.hpp"
 #include "fps/plan/layout_model.hpp"
 #include "fps/plan/planner.hpp"
@@ -62,10 +62,12 @@ int main(int argc, char** argv) {
     else if (key == "--fold-spread") options.fold_spread_deg = std::atof(v);
     else if (key == "--stop-avoid") options.stop_avoid_deg = std::atof(v);
     else if (key == "--fold-stop-gap") options.fold_stop_gap_deg = std::atof(v);
+    else if (key == "--stall") options.stall_s = std::atof(v);
+    else if (key == "--give-up") options.give_up_after = std::atoi(v);
     else if (key == "--untangle") options.untangle = std::atoi(v) != 0;
     else if (key == "--speed") options.speed = {std::atof(v), std::atof(v)};
     else {
-      std::fprintf(stderr, "usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K] [--local-retries N] [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--stop-avoid DEG] [--fold-stop-gap DEG]\n");
+      std::fprintf(stderr, "usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K] [--local-retries N] [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--stop-avoid DEG] [--fold-stop-gap DEG] [--give-up N] [--stall S]\n");
       return 2;
     }
   }

@@ -352,6 +352,8 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   so.margin_mm = o.margin_mm;
   so.max_duration_s = o.max_half_s;
   so.stop_avoid_deg = o.stop_avoid_deg;
+  so.give_up_after = o.give_up_after;
+  so.stall_s = o.stall_s;
 
   StepperResult ra, rb, rm;
   std::vector<StepperRobot> fa(n), fb(n);

@@ -52,6 +52,8 @@ struct PlannerOptions {
   double fold_spread_deg = 90;
   double stop_avoid_deg = 0;      // engine escapes keep away from the alpha stops while unfolded (0: off)
   double fold_stop_gap_deg = 0;   // fold alphas kept this far from the alpha stops (0: off)
+  double stall_s = 20.0;          // a half ends when no robot has arrived for this long (engine time)
+  int give_up_after = 0;          // engine: a robot gives up after this many fruitless escapes (0: never)
   bool untangle = true;           // then robots still stuck are planned one at a time to any fold (untangle.hpp)    // local re-plans: a stuck robot's fold alpha drawn within this of its start
   std::size_t max_points = 1023;  // per arm, after the start point (firmware limit)
   bool verify = true;             // run the checker on the result

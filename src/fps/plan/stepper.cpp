@@ -50,6 +50,9 @@ struct RobotState {
   double best_cost = kInf;
   int stuck = 0;
   int escape_left = 0;
+  double best_ever = kInf;  // lowest cost reached so far
+  int fruitless = 0;        // escapes of its own since best_ever last improved
+  bool gave_up = false;     // stands still for the rest of the run
   Move last{};
   ArmRecorder alpha, beta;
 };
@@ -341,7 +344,7 @@ void Stepper::step_robot(std::size_t i) {
   const Pose p = prev_[i];
   const Pose g = r.goal;
   const double now = cost(i, p);
-  if (now == 0 && st.escape_left == 0) {
+  if ((now == 0 && st.escape_left == 0) || st.gave_up) {
     if (has_scripts_) hold_or_dodge(i);
     return;
   }
@@ -428,6 +431,10 @@ void Stepper::step_robot(std::size_t i) {
   if (chosen == Move{} && has_scripts_) hold_or_dodge(i);
   if (escaping) return;
   const double after = cost(i, q);
+  if (after < st.best_ever - 1e-9) {
+    st.best_ever = after;
+    st.fruitless = 0;
+  }
   if (after < st.best_cost - 1e-9) {
     st.best_cost = after;
     st.stuck = 0;
@@ -448,13 +455,17 @@ void Stepper::step_robot(std::size_t i) {
       const Pose q0 = apply(p, cands[0].mv, g);
       feasible(i, q0, m_.robot(i).collision_segment(q0), travel(i, cands[0].mv), false, &blockers_);
       for (const std::uint32_t j : blockers_) {
-        if (robots_[j].frozen || rank_[j] >= rank_[i] || st_[j].escape_left > 0) continue;
+        if (robots_[j].frozen || rank_[j] >= rank_[i] || st_[j].escape_left > 0 || st_[j].gave_up) continue;
         st_[j].escape_left = len(rng_);
         ++escapes_;
         yielded = true;
       }
     }
     if (!yielded) {
+      if (o_.give_up_after > 0 && ++st.fruitless >= o_.give_up_after) {
+        st.gave_up = true;  // its oscillations only add corners and time: left to the untangle
+        return;
+      }
       st.escape_left = len(rng_);
       ++escapes_;
     }

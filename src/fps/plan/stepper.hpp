@@ -59,6 +59,9 @@ struct StepperOptions {
   int escape_min_steps = 3;
   int escape_max_steps = 15;
   double stop_avoid_deg = 0;     // escapes keep this far from the alpha stops while unfolded (0: off)
+  // A robot that started this many escapes of its own without ever getting closer to its goal
+  // gives up: it stands still for the rest of the run (and no longer yields), stuck (0: never).
+  int give_up_after = 0;
   // A robot stuck next to fixed obstacles (fiducials, robots that never move) switches to a
   // navigation field: the grid cost to its goal around them (Dijkstra), followed downhill.
   bool fields = false;

@@ -1,6 +1,7 @@
 #include "fps/plan/untangle.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -13,6 +14,7 @@ namespace {
 
 constexpr double kTiny = 1e-4;        // mm: the certificate keeps this much above zero
 constexpr double kResolution = 0.01;  // mm: as the engine (stepper.cpp)
+constexpr double kFineMargin = 0.01;  // mm: margin of the finer grids (the certificate still holds)
 
 struct Fixed {
   Segment s;
@@ -27,10 +29,12 @@ class RobotGrid {
   // Path of poses from the start to a fold at beta `fold`, empty when none within `max_cells`.
   std::vector<Pose> search(double fold, std::size_t max_cells) {
     const AngleLimits& l = r_.limits();
-    const int a_lo = -static_cast<int>(std::floor((start_.alpha_deg - l.alpha_min_deg) / sa_ + 1e-9));
-    const int a_hi = static_cast<int>(std::floor((l.alpha_max_deg - start_.alpha_deg) / sa_ + 1e-9));
-    const int b_lo = -static_cast<int>(std::floor((start_.beta_deg - l.beta_min_deg) / sb_ + 1e-9));
-    const int b_hi = static_cast<int>(std::floor((l.beta_max_deg - start_.beta_deg) / sb_ + 1e-9));
+    // The outermost cell on each side may be a partial step that lands exactly on the limit
+    // (pose() clamps): robots caught against a stop often get out only along it.
+    const int a_lo = -static_cast<int>(std::ceil((start_.alpha_deg - l.alpha_min_deg) / sa_ - 1e-9));
+    const int a_hi = static_cast<int>(std::ceil((l.alpha_max_deg - start_.alpha_deg) / sa_ - 1e-9));
+    const int b_lo = -static_cast<int>(std::ceil((start_.beta_deg - l.beta_min_deg) / sb_ - 1e-9));
+    const int b_hi = static_cast<int>(std::ceil((l.beta_max_deg - start_.beta_deg) / sb_ - 1e-9));
     auto key = [](int a, int b) { return (static_cast<std::int64_t>(a) << 32) ^ static_cast<std::uint32_t>(b); };
     std::unordered_map<std::int64_t, std::int64_t> parent;  // cell -> previous cell
     std::deque<std::pair<int, int>> q;
@@ -100,7 +104,11 @@ class RobotGrid {
     return path;
   }
  private:
-  [[nodiscard]] Pose pose(int a, int b) const noexcept { return {start_.alpha_deg + a * sa_, start_.beta_deg + b * sb_}; }
+  [[nodiscard]] Pose pose(int a, int b) const noexcept {
+    const AngleLimits& l = r_.limits();
+    return {std::clamp(start_.alpha_deg + a * sa_, l.alpha_min_deg, l.alpha_max_deg),
+            std::clamp(start_.beta_deg + b * sb_, l.beta_min_deg, l.beta_max_deg)};
+  }
   [[nodiscard]] double clearance(Pose p) const noexcept {
     const Segment s = r_.collision_segment(p);
     double c = std::numeric_limits<double>::infinity();
@@ -126,6 +134,30 @@ class RobotGrid {
   double sa_, sb_, margin_;
   std::unordered_map<std::int64_t, double> clr_;
 };
+
+// A way to a fold and the time of each of its steps.
+struct GridPath {
+  std::vector<Pose> poses;  // empty: none found
+  double dt = 0;
+};
+
+// The search on the engine's grid first; where that finds no way out, on grids of half and a
+// quarter of the step (each step then takes as much less time, the speed stays the same) that
+// keep a smaller margin. The robots left after the engine are mostly caught in narrow passages
+// between a fixed obstacle and an alpha stop, which the coarse grid with the full margin cannot
+// thread (they are not closed pockets: with only the obstacles present, every start pose of the
+// bench problems reaches a fold on a 0.25 deg grid).
+GridPath find_fold(const Positioner& r, const std::vector<Fixed>& fixed, Pose start, double fold, const StepperOptions& o,
+                   std::size_t max_cells) {
+  const double fine_margin = std::min(o.margin_mm, kFineMargin);
+  const std::array<std::pair<double, double>, 3> levels{{{1.0, o.margin_mm}, {0.5, fine_margin}, {0.25, fine_margin}}};
+  for (const auto& [f, margin] : levels) {
+    RobotGrid g(r, fixed, start, o.alpha_step_deg * f, o.beta_step_deg * f, margin);
+    std::vector<Pose> p = g.search(fold, max_cells);
+    if (!p.empty()) return {std::move(p), o.dt_s * f};
+  }
+  return {};
+}
 
 // Appends a path of poses, one per step of dt from t0, keeping only the points where an arm's
 // speed changes.
@@ -185,9 +217,8 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
       for (const std::uint32_t k : model.obstacle_pairs_of(i))
         fixed.push_back({obstacles[opairs[k].obstacle].shape, opairs[k].limit_mm});
       const double fold = robots[i].goal.beta_deg;
-      RobotGrid grid(model.robot(i), fixed, poses[i], o.alpha_step_deg, o.beta_step_deg, o.margin_mm);
-      std::vector<Pose> path = grid.search(fold, max_cells);
-      if (path.empty() && !std::any_of(moving.begin(), moving.end(), [](bool b) { return b; })) {
+      GridPath path = find_fold(model.robot(i), fixed, poses[i], fold, o, max_cells);
+      if (path.poses.empty() && !std::any_of(moving.begin(), moving.end(), [](bool b) { return b; })) {
         // Folded neighbours can turn freely (folded robots never touch): turn each so that its
         // folded capsule lies across the line to this robot's centre, as far as the unfolded
         // robots around it allow, all at once while everyone else stands still; then search again.
@@ -213,15 +244,6 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
             for (const Segment& si : sweep) c = std::min(c, segment_distance(si, sj));
             return c;
           };
-          double best_a = poses[j].alpha_deg, best_d = sweep_clearance(segs[j]);
-          for (double a = lj.alpha_min_deg; a <= lj.alpha_max_deg; a += 5) {
-            const double d = sweep_clearance(rj.collision_segment({a, poses[j].beta_deg}));
-            if (d > best_d + 0.5 || (d > best_d - 1e-6 && std::abs(a - poses[j].alpha_deg) < std::abs(best_a - poses[j].alpha_deg))) {
-              best_d = d;
-              best_a = a;
-            }
-          }
-          if (best_a == poses[j].alpha_deg) continue;
           std::vector<Fixed> fj;
           const auto nbj = model.neighbours(j);
           const auto pj = model.pairs_of(j);
@@ -230,6 +252,22 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
           for (const std::uint32_t k : model.obstacle_pairs_of(j))
             fj.push_back({obstacles[opairs[k].obstacle].shape, opairs[k].limit_mm});
           RobotGrid gj(rj, std::move(fj), poses[j], o.alpha_step_deg, o.beta_step_deg, o.margin_mm);
+          // How far it can turn either way (the unfolded robots, often this one, may stop it);
+          // the best alpha within that range.
+          const double lo = gj.walk_alpha(lj.alpha_min_deg).back().alpha_deg;
+          const double hi = gj.walk_alpha(lj.alpha_max_deg).back().alpha_deg;
+          double best_a = poses[j].alpha_deg, best_d = sweep_clearance(segs[j]);
+          auto consider = [&](double a) {
+            const double d = sweep_clearance(rj.collision_segment({a, poses[j].beta_deg}));
+            if (d > best_d + 0.5 || (d > best_d - 1e-6 && std::abs(a - poses[j].alpha_deg) < std::abs(best_a - poses[j].alpha_deg))) {
+              best_d = d;
+              best_a = a;
+            }
+          };
+          for (double a = std::ceil(lo / 5) * 5; a <= hi; a += 5) consider(a);
+          consider(lo);
+          consider(hi);
+          if (best_a == poses[j].alpha_deg) continue;
           std::vector<Pose> w = gj.walk_alpha(best_a);
           if (w.size() < 2) continue;
           slot = std::max(slot, static_cast<double>(w.size() - 1) * o.dt_s);
@@ -242,9 +280,8 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
           for (std::size_t k = 0; k < nb.size(); ++k) fixed2.push_back({segs2[nb[k]], all_pairs[pairs[k]].limit_mm});
           for (const std::uint32_t k : model.obstacle_pairs_of(i))
             fixed2.push_back({obstacles[opairs[k].obstacle].shape, opairs[k].limit_mm});
-          RobotGrid grid2(model.robot(i), std::move(fixed2), poses[i], o.alpha_step_deg, o.beta_step_deg, o.margin_mm);
-          path = grid2.search(fold, max_cells);
-          if (!path.empty()) {
+          path = find_fold(model.robot(i), fixed2, poses[i], fold, o, max_cells);
+          if (!path.poses.empty()) {
             for (const auto& [j, w] : turns) {
               append_path(result.paths[j], w, t, o.dt_s);
               poses[j] = w.back();
@@ -256,13 +293,13 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
           }
         }
       }
-      if (path.empty()) {
+      if (path.poses.empty()) {
         left.push_back(i);
         continue;
       }
-      append_path(result.paths[i], path, t, o.dt_s);
-      wave = std::max(wave, static_cast<double>(path.size() - 1) * o.dt_s);
-      poses[i] = path.back();
+      append_path(result.paths[i], path.poses, t, path.dt);
+      wave = std::max(wave, static_cast<double>(path.poses.size() - 1) * path.dt);
+      poses[i] = path.poses.back();
       segs[i] = model.robot(i).collision_segment(poses[i]);
       result.end[i] = poses[i];
       result.reached[i] = true;

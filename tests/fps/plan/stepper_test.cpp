@@ -40,5 +40,27 @@ TEST(StepperScript, WithoutScriptsTheSameRobotsNeverMove) {
   EXPECT_EQ(r.violations, 0u);
 }
 
+TEST(StepperGiveUp, ARobotThatNeverGetsCloserStopsTrying) {
+  // Robot 1's goal overlaps robot 2, which never moves: it can only get so close, then escapes
+  // and comes back again and again. With give_up_after it stops after a few fruitless escapes:
+  // still not at its goal, but with fewer corners and an earlier end of motion.
+  const auto m = two_robots();
+  std::vector<StepperRobot> robots{{{180, 0}, {0, 0}, false, nullptr}, {{180, 0}, {180, 0}, true, nullptr}};
+  const StepperResult keep_trying = drive_to_goals(m, robots, StepperOptions{});
+  StepperOptions o;
+  o.give_up_after = 3;
+  const StepperResult given_up = drive_to_goals(m, robots, o);
+  EXPECT_FALSE(keep_trying.reached[0]);
+  EXPECT_FALSE(given_up.reached[0]);
+  const auto points = [](const StepperResult& r) { return r.paths[0].alpha.size() + r.paths[0].beta.size(); };
+  EXPECT_LT(points(given_up), points(keep_trying));
+  EXPECT_LT(given_up.duration_s, keep_trying.duration_s);
+  std::vector<RobotTrajectory> played{given_up.paths[0], given_up.paths[1]};
+  TrajectoryChecker checker(m);
+  CheckReport report;
+  ASSERT_TRUE(checker.check(played, CheckOptions{}, report));
+  EXPECT_TRUE(report.ok());
+}
+
 }  // namespace
 }  // namespace axon::fps::plan

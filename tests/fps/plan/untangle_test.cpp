@@ -48,5 +48,56 @@ TEST(Untangle, RobotsAlreadyReachedAreLeftAlone) {
   EXPECT_EQ(r.paths[0].beta.size(), 1u);
 }
 
+// A robot against its alpha-0 stop, half unfolded, with a fiducial on the neighbouring site at 60
+// deg (the geometry of the bench's default layout): its straight fold touches the fiducial and
+// turning alpha up sweeps into it, so the only way out is a narrow passage along the stop. The
+// engine's grid (1 deg, 0.05 mm margin) does not get through; the finer grids do.
+TEST(Untangle, RobotAgainstTheAlphaStopNextToAFiducialGetsOut) {
+  const std::vector<RobotSpec> specs{RobotSpec{1, {0, 0}, {}, {}, 2.0}};
+  const std::vector<FiducialSpec> fiducials{FiducialSpec{7, {11.2, 19.399}, 3.0}};
+  auto built = CollisionModel::build(specs, ArmDesign{}, fiducials);
+  ASSERT_TRUE(built) << built.error().message();
+  const CollisionModel& m = built.value();
+  for (const Pose start : {Pose{0.18, 77.30}, Pose{0.93, 67.95}}) {
+    std::vector<StepperRobot> robots{{start, {82.67, 180}, false, nullptr}};
+    StepperResult r = stuck_result(robots, {false});
+    ASSERT_EQ(untangle_to_fold(m, robots, r, StepperOptions{}), 1u) << start.alpha_deg << ", " << start.beta_deg;
+    EXPECT_TRUE(r.reached[0]);
+    EXPECT_DOUBLE_EQ(r.end[0].beta_deg, 180.0);
+    EXPECT_GE(r.end[0].alpha_deg, 0.0);
+    TrajectoryChecker checker(m);
+    CheckReport report;
+    ASSERT_TRUE(checker.check(r.paths, CheckOptions{}, report));
+    EXPECT_TRUE(report.ok());
+    // Never faster than the engine's speed (1 deg per step of 1/12 s on each arm).
+    EXPECT_LE(max_speed(r.paths[0].alpha), 12.0 + 1e-6);
+    EXPECT_LE(max_speed(r.paths[0].beta), 12.0 + 1e-6);
+  }
+}
+
+// A robot against its alpha-0 stop, 0.3 mm from a folded neighbour on the site at 60 deg (problem
+// 1009 of the bench, robots 85, 86 and 44). The neighbour's best alpha lies beyond where the stuck
+// robot lets it turn; turned the other way, within the range it can reach, it clears the way.
+TEST(Untangle, FoldedNeighbourTurnsWithinTheRangeItCanReach) {
+  const std::vector<RobotSpec> specs{RobotSpec{85, {0, 0}, {}, {}, 2.0}, RobotSpec{86, {11.2, 19.399}, {}, {}, 2.0},
+                                     RobotSpec{44, {22.4, 0}, {}, {}, 2.0}};
+  const std::vector<FiducialSpec> fiducials{FiducialSpec{2, {33.6, 19.399}, 3.0}};
+  auto built = CollisionModel::build(specs, ArmDesign{}, fiducials);
+  ASSERT_TRUE(built) << built.error().message();
+  const CollisionModel& m = built.value();
+  std::vector<StepperRobot> robots{{{0.05, 52.41}, {60.16, 180}, false, nullptr},
+                                   {{90.64, 180}, {90.64, 180}, false, nullptr},
+                                   {{251.17, 180}, {251.17, 180}, false, nullptr}};
+  StepperResult r = stuck_result(robots, {false, true, true});
+  ASSERT_EQ(untangle_to_fold(m, robots, r, StepperOptions{}), 1u);
+  EXPECT_DOUBLE_EQ(r.end[0].beta_deg, 180.0);
+  EXPECT_NE(r.end[1].alpha_deg, 90.64);  // the neighbour turned
+  EXPECT_DOUBLE_EQ(r.end[1].beta_deg, 180.0);
+  TrajectoryChecker checker(m);
+  CheckReport report;
+  ASSERT_TRUE(checker.check(r.paths, CheckOptions{}, report));
+  EXPECT_TRUE(report.ok());
+}
+
 }  // namespace
 }  // namespace axon::fps::plan
