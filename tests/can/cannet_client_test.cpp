@@ -492,7 +492,7 @@ TEST(CanNetClient, FifoOverflowCanBeSilentLikeTheDevice) {
 // coroutines send at once, each numbering its frame at the call; the bus must see the numbers in
 // ascending order, none missing.
 TEST(CanNetClient, FramesKeepTheirOrderWhenTheOutputBufferIsFull) {
-  Bench b;
+  ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
     auto gw = co_await b.connect(1);
     CO_ASSERT_TRUE(gw);
