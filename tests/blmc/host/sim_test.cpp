@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 
 namespace axon::blmc::host {
@@ -198,6 +199,11 @@ struct ErrorCase {
   proto::ErrorCode expect;
 };
 
+void PrintTo(const ErrorCase& c, std::ostream* os) {
+  for (auto k : c.kinds) *os << sim::name(k) << " ";
+  *os << "-> " << proto::name(c.expect);
+}
+
 class BlmcHostSimErrors : public ::testing::TestWithParam<ErrorCase> {};
 
 TEST_P(BlmcHostSimErrors, EachErrorCodeIsSeenByNameWithPrecedence) {
@@ -225,7 +231,16 @@ INSTANTIATE_TEST_SUITE_P(
                       ErrorCase{{sim::FaultKind::transmit}, proto::ErrorCode::other},
                       ErrorCase{{sim::FaultKind::over_current}, proto::ErrorCode::other},
                       ErrorCase{{sim::FaultKind::pos_converter, sim::FaultKind::encoder}, proto::ErrorCode::encoder},
-                      ErrorCase{{sim::FaultKind::over_current, sim::FaultKind::pos_converter}, proto::ErrorCode::pos_converter}));
+                      ErrorCase{{sim::FaultKind::over_current, sim::FaultKind::pos_converter}, proto::ErrorCode::pos_converter}),
+    // A stable, readable test name: the injected faults and the error code expected.
+    [](const ::testing::TestParamInfo<ErrorCase>& info) {
+      std::string n;
+      for (auto k : info.param.kinds) n += std::string(sim::name(k)) + "_";
+      n += "gives_" + std::string(proto::name(info.param.expect));
+      for (char& ch : n)
+        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+      return n;
+    });
 
 TEST(BlmcHostSim, BoardErrorDuringControlStopsAndIsNamed) {
   SimRig rig;
