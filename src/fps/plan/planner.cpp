@@ -1,5 +1,6 @@
 #include "fps/plan/planner.hpp"
 
+#include "fps/plan/smooth.hpp"
 #include "fps/plan/stepper.hpp"
 #include "fps/plan/untangle.hpp"
 
@@ -71,6 +72,53 @@ std::vector<TimedAngle> simplify_arm(std::span<const TimedAngle> points, double 
   for (std::size_t k = 0; k < points.size(); ++k)
     if (keep[k]) out.push_back(points[k]);
   return out;
+}
+
+namespace {
+
+bool same_arm(const std::vector<TimedAngle>& a, const std::vector<TimedAngle>& b) noexcept {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const TimedAngle& x, const TimedAngle& y) { return x.t_s == y.t_s && x.deg == y.deg; });
+}
+
+}  // namespace
+
+Result<void> verify_with_fallbacks(const CollisionModel& model, std::span<const std::vector<RobotTrajectory>> layers,
+                                   const CheckOptions& options, std::vector<RobotTrajectory>& out,
+                                   std::vector<std::size_t>& level, CheckReport& report, int max_passes) {
+  const std::size_t n = model.size();
+  if (layers.empty()) return make_error(PlanErrc::bad_trajectory, "no trajectories to verify");
+  for (const auto& layer : layers)
+    if (layer.size() != n)
+      return make_error(PlanErrc::bad_trajectory,
+                        fmt::format("{} trajectories for {} robots", layer.size(), n));
+  out = layers.front();
+  level.assign(n, 0);
+  TrajectoryChecker checker(model);
+  std::vector<bool> flagged(n, false);
+  for (int pass = 0; pass < std::max(1, max_passes); ++pass) {
+    AXON_TRY(checker.check(out, options, report));
+    if (report.ok()) break;
+    std::fill(flagged.begin(), flagged.end(), false);
+    const auto rp = model.robot_pairs();
+    for (std::size_t k = 0; k < rp.size(); ++k)
+      if (report.robot_pairs[k].collided) flagged[rp[k].a] = flagged[rp[k].b] = true;
+    const auto op = model.obstacle_pairs();
+    for (std::size_t k = 0; k < op.size(); ++k)
+      if (report.obstacle_pairs[k].collided) flagged[op[k].robot] = true;
+    bool reverted = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!flagged[i]) continue;
+      std::size_t l = level[i] + 1;
+      while (l < layers.size() && same_arm(layers[l][i].alpha, out[i].alpha) && same_arm(layers[l][i].beta, out[i].beta)) ++l;
+      if (l >= layers.size()) continue;  // already on the last layer (or one equal to it)
+      level[i] = l;
+      out[i] = layers[l][i];
+      reverted = true;
+    }
+    if (!reverted) break;
+  }
+  return ok();
 }
 
 namespace {
@@ -544,17 +592,29 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   }
   plan.stats.search_s = search_s;
 
-  // Simplify where it pays, then verify; robots in a pair the checker flags get their exact
-  // (certified) trajectories back, until the checker is satisfied.
-  const std::vector<RobotTrajectory> exact = plan.trajectories;
+  // Arms the engine left jagged (dithering, stop-and-go) are shortened by certified shortcuts;
+  // then everything is simplified where it pays, and verified; robots in a pair the checker flags
+  // fall back one layer (simplified -> smoothed -> exact, which the engine certified), until the
+  // checker is satisfied.
+  std::vector<std::vector<RobotTrajectory>> layers;
+  layers.push_back(plan.trajectories);  // becomes the simplified layer
+  std::vector<bool> smoothed(n, false);
+  if (o.smooth_points > 0) {
+    SmoothOptions sm;
+    sm.min_points = o.smooth_points;
+    smooth_arms(model, layers.front(), sm, smoothed);
+    if (std::find(smoothed.begin(), smoothed.end(), true) != smoothed.end()) layers.push_back(layers.front());
+  }
+  layers.push_back(plan.trajectories);  // exact
+  const std::vector<RobotTrajectory>& base = layers[1];  // smoothed, or exact when nothing was
   std::vector<bool> simplified(n, false);
   for (std::size_t i = 0; i < n; ++i) {
-    RobotTrajectory& t = plan.trajectories[i];
+    RobotTrajectory& t = layers.front()[i];
     const bool over = firmware_points(t.alpha) > o.max_points || firmware_points(t.beta) > o.max_points;
     if (o.simplify_deg <= 0 && !over) continue;
     double tol = std::max(o.simplify_deg, 1e-3);
     for (;;) {
-      auto a = simplify_arm(exact[i].alpha, tol), b = simplify_arm(exact[i].beta, tol);
+      auto a = simplify_arm(base[i].alpha, tol), b = simplify_arm(base[i].beta, tol);
       if ((firmware_points(a) <= o.max_points && firmware_points(b) <= o.max_points) || tol > 10) {
         if (a.size() < t.alpha.size() || b.size() < t.beta.size()) {
           t.alpha = std::move(a);
@@ -567,31 +627,18 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
     }
   }
 
-  TrajectoryChecker checker(model);
   const auto t_check = Clock::now();
+  std::vector<std::size_t> level(n, 0);
   if (o.verify) {
-    for (int pass = 0; pass < 6; ++pass) {
-      AXON_TRY(checker.check(plan.trajectories, o.check, plan.check));
-      if (plan.check.ok()) break;
-      bool reverted = false;
-      auto revert = [&](std::size_t i) {
-        if (!simplified[i]) return;
-        plan.trajectories[i] = exact[i];
-        simplified[i] = false;
-        reverted = true;
-      };
-      const auto rp = model.robot_pairs();
-      for (std::size_t k = 0; k < rp.size(); ++k)
-        if (plan.check.robot_pairs[k].collided) {
-          revert(rp[k].a);
-          revert(rp[k].b);
-        }
-      const auto op = model.obstacle_pairs();
-      for (std::size_t k = 0; k < op.size(); ++k)
-        if (plan.check.obstacle_pairs[k].collided) revert(op[k].robot);
-      if (!reverted) break;
-    }
+    AXON_TRY(verify_with_fallbacks(model, layers, o.check, plan.trajectories, level, plan.check));
     plan.verified = plan.check.ok();
+  } else {
+    plan.trajectories = layers.front();
+  }
+  const std::size_t exact_level = layers.size() - 1;
+  for (std::size_t i = 0; i < n; ++i) {
+    simplified[i] = simplified[i] && level[i] == 0;
+    smoothed[i] = smoothed[i] && level[i] < exact_level;
   }
   plan.stats.check_s = seconds_since(t_check);
 
@@ -599,6 +646,7 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   for (std::size_t i = 0; i < n; ++i) {
     const RobotTrajectory& t = plan.trajectories[i];
     plan.stats.simplified += simplified[i] ? 1 : 0;
+    plan.stats.smoothed += smoothed[i] ? 1 : 0;
     for (const auto* arm : {&t.alpha, &t.beta}) {
       const std::size_t c = firmware_points(*arm);
       if (c == 0) continue;

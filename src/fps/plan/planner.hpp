@@ -49,12 +49,13 @@ struct PlannerOptions {
   int relax_after = 8;            // from this retry on, stuck robots fold without turning alpha (8: never)
   int local_retries = 24;         // then re-plans of only the stuck robots' neighbourhood (new seeds)
   int local_rings = 2;            // neighbour rings around the stuck robots re-planned with them
-  double fold_spread_deg = 90;
+  double fold_spread_deg = 90;    // local re-plans: a stuck robot's fold alpha drawn within this of its start
   double stop_avoid_deg = 0;      // engine escapes keep away from the alpha stops while unfolded (0: off)
   double fold_stop_gap_deg = 0;   // fold alphas kept this far from the alpha stops (0: off)
   double stall_s = 20.0;          // a half ends when no robot has arrived for this long (engine time)
   int give_up_after = 0;          // engine: a robot gives up after this many fruitless escapes (0: never)
-  bool untangle = true;           // then robots still stuck are planned one at a time to any fold (untangle.hpp)    // local re-plans: a stuck robot's fold alpha drawn within this of its start
+  bool untangle = true;           // then robots still stuck are planned one at a time to any fold (untangle.hpp)
+  std::size_t smooth_points = 40; // arms with more points are shortened by certified shortcuts (smooth.hpp; 0: off)
   std::size_t max_points = 1023;  // per arm, after the start point (firmware limit)
   bool verify = true;             // run the checker on the result
   CheckOptions check{};           // the checker's settings (full buffer)
@@ -90,6 +91,7 @@ struct PlanStats {
   std::size_t rounds = 0;        // engine rounds (1 + re-plans)
   std::size_t escapes = 0;       // escape episodes (deadlock nudges)
   std::size_t simplified = 0;    // robots whose simplified trajectories were kept
+  std::size_t smoothed = 0;      // robots whose shortcut (smoothed) trajectories were kept
   std::size_t median_points = 0; // per arm, after the start point, over moving arms
   std::size_t max_points = 0;
   double max_alpha_speed = 0;    // deg/s
@@ -118,5 +120,15 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
 // Ramer-Douglas-Peucker on one arm's (time, angle) points: drops points while the angle stays
 // within `tolerance_deg` of the original at every dropped point's time. Speeds never increase.
 std::vector<TimedAngle> simplify_arm(std::span<const TimedAngle> points, double tolerance_deg);
+
+// Verification with fallbacks: `layers` are whole plans (one trajectory per robot each), from the
+// most processed (layers[0]) to the one certified by construction (the last). Every robot starts
+// on layer 0; the checker checks the plan, and every robot of a pair it flags moves on to its next
+// layer that differs from its current trajectory; then the plan is checked again, until the
+// checker is satisfied, nothing is left to fall back to, or `max_passes` checks ran. `out` gets
+// the trajectories, `level[i]` the layer robot i ends on, `report` the last check.
+Result<void> verify_with_fallbacks(const CollisionModel& model, std::span<const std::vector<RobotTrajectory>> layers,
+                                   const CheckOptions& options, std::vector<RobotTrajectory>& out,
+                                   std::vector<std::size_t>& level, CheckReport& report, int max_passes = 8);
 
 }  // namespace axon::fps::plan
