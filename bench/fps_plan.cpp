@@ -10,7 +10,7 @@
 // The reference planner cannot run here; its figures on random 500-robot problems on this kind of
 // machine (FIELD-NOTES / issue 5) are printed beside ours and give ratio = 28 s / our median.
 //
-// Usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K] [--local-retries N] [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--stop-avoid DEG] [--fold-stop-gap DEG] [--give-up N] [--stall S]
+// Usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K] [--local-retries N] [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--stop-avoid DEG] [--fold-stop-gap DEG] [--give-up N] [--stall S] [--smooth-points N] [--smooth-clearance MM]
 #include "fps/layout/layout_generator.hpp"
 #include "fps/plan/layout_model.hpp"
 #include "fps/plan/planner.hpp"
@@ -65,9 +65,11 @@ int main(int argc, char** argv) {
     else if (key == "--stall") options.stall_s = std::atof(v);
     else if (key == "--give-up") options.give_up_after = std::atoi(v);
     else if (key == "--untangle") options.untangle = std::atoi(v) != 0;
+    else if (key == "--smooth-points") options.smooth_points = static_cast<std::size_t>(std::atoi(v));
+    else if (key == "--smooth-clearance") options.smooth_clearance_mm = std::atof(v);
     else if (key == "--speed") options.speed = {std::atof(v), std::atof(v)};
     else {
-      std::fprintf(stderr, "usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K] [--local-retries N] [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--stop-avoid DEG] [--fold-stop-gap DEG] [--give-up N] [--stall S]\n");
+      std::fprintf(stderr, "usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K] [--local-retries N] [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--stop-avoid DEG] [--fold-stop-gap DEG] [--give-up N] [--stall S] [--smooth-points N] [--smooth-clearance MM]\n");
       return 2;
     }
   }
@@ -77,8 +79,8 @@ int main(int argc, char** argv) {
   fmt::print("fps_plan: {} robots, {} fiducials, {} neighbour pairs; speed {} / {} deg/s, step {} deg, buffer 2.0 mm\n",
              model.size(), plane.fiducials().size(), model.robot_pairs().size(), options.speed.alpha_deg_s,
              options.speed.beta_deg_s, options.step_deg);
-  fmt::print("{:>3} {:>7} {:>8} {:>8} {:>8} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7} {:>8} {:>7} {:>5}\n", "#", "from", "plan_s",
-             "search_s", "check_s", "success", "dead", "escape", "p_med", "p_max", "move_s", "min_clr", "rounds", "mid_s");
+  fmt::print("{:>3} {:>7} {:>8} {:>8} {:>8} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7} {:>8} {:>7} {:>5} {:>8} {:>6}\n", "#", "from", "plan_s",
+             "search_s", "check_s", "success", "dead", "escape", "p_med", "p_max", "move_s", "min_clr", "rounds", "mid_s", "smooth_s", "checks");
 
   std::vector<double> times, moves, med_points;
   std::size_t solved = 0, max_points = 0;
@@ -101,10 +103,10 @@ int main(int argc, char** argv) {
     moves.push_back(p.stats.duration_s);
     med_points.push_back(static_cast<double>(p.stats.median_points));
     max_points = std::max(max_points, p.stats.max_points);
-    fmt::print("{:>3} {:>7} {:>8.3f} {:>8.3f} {:>8.3f} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7.1f} {:>8.3f} {:>7} {:>5.1f}\n", k,
+    fmt::print("{:>3} {:>7} {:>8.3f} {:>8.3f} {:>8.3f} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7.1f} {:>8.3f} {:>7} {:>5.1f} {:>8.3f} {:>6}\n", k,
                from_folded ? "folded" : "random", p.stats.plan_s, p.stats.search_s, p.stats.check_s, ok ? "yes" : "no",
                p.not_reached, p.stats.escapes, p.stats.median_points, p.stats.max_points, p.stats.duration_s,
-               p.check.min_clearance_mm, p.stats.rounds, p.stats.middle_s);
+               p.check.min_clearance_mm, p.stats.rounds, p.stats.middle_s, p.stats.smooth_s, p.stats.checks);
     if (!p.ok()) std::fputs(p.summary(model).c_str(), stdout);
     std::fflush(stdout);
   }

@@ -83,7 +83,7 @@ bool same_arm(const std::vector<TimedAngle>& a, const std::vector<TimedAngle>& b
 
 }  // namespace
 
-Result<void> verify_with_fallbacks(const CollisionModel& model, std::span<const std::vector<RobotTrajectory>> layers,
+Result<std::size_t> verify_with_fallbacks(const CollisionModel& model, std::span<const std::vector<RobotTrajectory>> layers,
                                    const CheckOptions& options, std::vector<RobotTrajectory>& out,
                                    std::vector<std::size_t>& level, CheckReport& report, int max_passes) {
   const std::size_t n = model.size();
@@ -96,8 +96,10 @@ Result<void> verify_with_fallbacks(const CollisionModel& model, std::span<const 
   level.assign(n, 0);
   TrajectoryChecker checker(model);
   std::vector<bool> flagged(n, false);
+  std::size_t checks = 0;
   for (int pass = 0; pass < std::max(1, max_passes); ++pass) {
     AXON_TRY(checker.check(out, options, report));
+    ++checks;
     if (report.ok()) break;
     std::fill(flagged.begin(), flagged.end(), false);
     const auto rp = model.robot_pairs();
@@ -118,7 +120,7 @@ Result<void> verify_with_fallbacks(const CollisionModel& model, std::span<const 
     }
     if (!reverted) break;
   }
-  return ok();
+  return checks;
 }
 
 namespace {
@@ -602,7 +604,10 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   if (o.smooth_points > 0) {
     SmoothOptions sm;
     sm.min_points = o.smooth_points;
+    sm.min_clearance_mm = o.smooth_clearance_mm;
+    const auto t_smooth = Clock::now();
     smooth_arms(model, layers.front(), sm, smoothed);
+    plan.stats.smooth_s = seconds_since(t_smooth);
     if (std::find(smoothed.begin(), smoothed.end(), true) != smoothed.end()) layers.push_back(layers.front());
   }
   layers.push_back(plan.trajectories);  // exact
@@ -630,7 +635,8 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   const auto t_check = Clock::now();
   std::vector<std::size_t> level(n, 0);
   if (o.verify) {
-    AXON_TRY(verify_with_fallbacks(model, layers, o.check, plan.trajectories, level, plan.check));
+    AXON_TRY(checks, verify_with_fallbacks(model, layers, o.check, plan.trajectories, level, plan.check));
+    plan.stats.checks = checks;
     plan.verified = plan.check.ok();
   } else {
     plan.trajectories = layers.front();

@@ -56,6 +56,7 @@ struct PlannerOptions {
   int give_up_after = 0;          // engine: a robot gives up after this many fruitless escapes (0: never)
   bool untangle = true;           // then robots still stuck are planned one at a time to any fold (untangle.hpp)
   std::size_t smooth_points = 40; // arms with more points are shortened by certified shortcuts (smooth.hpp; 0: off)
+  double smooth_clearance_mm = 0.1;  // clearance the shortcuts keep (room for the simplification around them)
   std::size_t max_points = 1023;  // per arm, after the start point (firmware limit)
   bool verify = true;             // run the checker on the result
   CheckOptions check{};           // the checker's settings (full buffer)
@@ -86,6 +87,8 @@ struct PlanStats {
   double plan_s = 0;             // wall time of plan_moves
   double search_s = 0;           // of which the engine
   double check_s = 0;            // of which the checker
+  double smooth_s = 0;           // of which the shortcuts (smooth.hpp)
+  std::size_t checks = 0;        // checker runs (1 + fallback passes)
   double duration_s = 0;         // the move
   double middle_s = 0;           // of which the middle phase (folded robots turning alpha)
   std::size_t rounds = 0;        // engine rounds (1 + re-plans)
@@ -126,8 +129,9 @@ std::vector<TimedAngle> simplify_arm(std::span<const TimedAngle> points, double 
 // on layer 0; the checker checks the plan, and every robot of a pair it flags moves on to its next
 // layer that differs from its current trajectory; then the plan is checked again, until the
 // checker is satisfied, nothing is left to fall back to, or `max_passes` checks ran. `out` gets
-// the trajectories, `level[i]` the layer robot i ends on, `report` the last check.
-Result<void> verify_with_fallbacks(const CollisionModel& model, std::span<const std::vector<RobotTrajectory>> layers,
+// the trajectories, `level[i]` the layer robot i ends on, `report` the last check. Returns the
+// number of checks run.
+Result<std::size_t> verify_with_fallbacks(const CollisionModel& model, std::span<const std::vector<RobotTrajectory>> layers,
                                    const CheckOptions& options, std::vector<RobotTrajectory>& out,
                                    std::vector<std::size_t>& level, CheckReport& report, int max_passes = 8);
 

@@ -25,29 +25,28 @@ class ShortcutCertifier {
     }
   }
 
-  // Robot i with arm `alpha_arm ? alpha : beta` moving straight from p to q (the other arm as in
-  // its trajectory): clear of everything over [p.t_s, q.t_s]?
-  bool clear(std::size_t i, bool alpha_arm, TimedAngle p, TimedAngle q) const {
+  // Robot i with arm `alpha_arm ? alpha : beta` following `piece` (two or more points, linear in
+  // between; the other arm as in its trajectory): clear of everything over the piece's interval?
+  bool clear(std::size_t i, bool alpha_arm, std::span<const TimedAngle> piece) const {
     const Positioner& ri = m_.robot(i);
     const RobotTrajectory& ti = traj_[i];
+    const double t0 = piece.front().t_s, t1 = piece.back().t_s;
     auto pose_i = [&](double t) {
-      const double f = (t - p.t_s) / (q.t_s - p.t_s);
-      const double edited = p.deg + f * (q.deg - p.deg);
+      const double edited = angle_at(piece, t);
       return alpha_arm ? Pose{edited, angle_at(ti.beta, t)} : Pose{angle_at(ti.alpha, t), edited};
     };
-    const double vi = std::abs(q.deg - p.deg) / (q.t_s - p.t_s) * kRad *
-                          (alpha_arm ? ri.reach_mm() : ri.collision_length_mm()) +
-                      (alpha_arm ? max_speed(ti.beta) * ri.collision_length_mm()
-                                 : max_speed(ti.alpha) * ri.reach_mm()) * kRad;
+    const double vi = (max_speed(piece) * (alpha_arm ? ri.reach_mm() : ri.collision_length_mm()) +
+                       (alpha_arm ? max_speed(ti.beta) * ri.collision_length_mm()
+                                  : max_speed(ti.alpha) * ri.reach_mm())) * kRad;
     // One body against another that moves at most `v` mm/s faster than the pair can close.
     auto advance = [&](double v, auto&& clearance_at) {
-      double t = p.t_s;
+      double t = t0;
       for (;;) {
         const double c = clearance_at(t);
         if (!(c >= o_.min_clearance_mm)) return false;
         if (v <= 0) return true;
         const double step = (c - o_.min_clearance_mm) / v;
-        if (t + step >= q.t_s) return true;
+        if (t + step >= t1) return true;
         if (step < o_.min_step_s) return false;
         t += step;
       }
@@ -106,12 +105,36 @@ SmoothStats smooth_arms(const CollisionModel& model, std::vector<RobotTrajectory
   ShortcutCertifier cert(model, trajectories, options);
   for (const auto& [count, i, alpha] : arms) {
     // A copy: the certifier reads the robot's current trajectory (the other arm) while this one is
-    // rebuilt; the arm being edited is described to it by the shortcut's end points only.
+    // rebuilt; the arm being edited is described to it by the shortcut's own points.
     const std::vector<TimedAngle> pts = alpha ? trajectories[i].alpha : trajectories[i].beta;
     const std::size_t m = pts.size();
-    auto ok = [&](std::size_t a, std::size_t b) {
+    const double vmax = max_speed(pts);
+    // Shortcuts from point a to point b: straight, else holding at the lowest or the highest angle
+    // the arm had in between (reached and left at the arm's top speed: a dither around a pose a
+    // neighbour squeezes is replaced by waiting on the side where it was clear).
+    std::vector<TimedAngle> piece, best_piece;
+    auto shortcut = [&](std::size_t a, std::size_t b) {
       ++stats.shortcuts_tried;
-      return cert.clear(i, alpha, pts[a], pts[b]);
+      piece.assign({pts[a], pts[b]});
+      if (cert.clear(i, alpha, piece)) return true;
+      if (b <= a + 1 || vmax <= 0) return false;
+      double lo = pts[a].deg, hi = pts[a].deg;
+      for (std::size_t k = a + 1; k <= b; ++k) {
+        lo = std::min(lo, pts[k].deg);
+        hi = std::max(hi, pts[k].deg);
+      }
+      for (const double hold : {lo, hi}) {
+        if (hold == pts[a].deg && hold == pts[b].deg) continue;  // the straight piece, tried
+        const double ta = pts[a].t_s + std::abs(hold - pts[a].deg) / vmax;
+        const double tb = pts[b].t_s - std::abs(pts[b].deg - hold) / vmax;
+        if (tb < ta - 1e-9) continue;  // cannot happen for angles the arm reached in between
+        piece.assign({pts[a]});
+        if (ta > pts[a].t_s + 1e-9) piece.push_back({ta, hold});
+        if (tb > piece.back().t_s + 1e-9 && tb < pts[b].t_s - 1e-9) piece.push_back({tb, hold});
+        piece.push_back(pts[b]);
+        if (cert.clear(i, alpha, piece)) return true;
+      }
+      return false;
     };
     std::vector<TimedAngle> out{pts.front()};
     std::size_t at = 0;
@@ -119,23 +142,27 @@ SmoothStats smooth_arms(const CollisionModel& model, std::vector<RobotTrajectory
       // The segment to the next point is the arm's own (certified by the planner); farther ones
       // are tried by doubling the span, then bisecting between the last success and the failure.
       std::size_t good = at + 1, bad = m;
+      best_piece.assign({pts[at], pts[at + 1]});
+      auto attempt = [&](std::size_t j) {
+        if (!shortcut(at, j)) return false;
+        good = j;
+        best_piece = piece;
+        return true;
+      };
       for (std::size_t span = 2;; span *= 2) {
         const std::size_t j = std::min(at + span, m - 1);
         if (j <= good) break;
-        if (ok(at, j)) {
-          good = j;
-          if (j == m - 1) break;
-        } else {
+        if (!attempt(j)) {
           bad = j;
           break;
         }
+        if (j == m - 1) break;
       }
       while (bad < m && bad - good > 1) {
         const std::size_t mid = good + (bad - good) / 2;
-        if (ok(at, mid)) good = mid;
-        else bad = mid;
+        if (!attempt(mid)) bad = mid;
       }
-      out.push_back(pts[good]);
+      out.insert(out.end(), best_piece.begin() + 1, best_piece.end());
       at = good;
     }
     if (out.size() < m) {
