@@ -56,7 +56,7 @@ struct PlannerOptions {
   int give_up_after = 0;          // engine: a robot gives up after this many fruitless escapes (0: never)
   bool untangle = true;           // then robots still stuck are planned one at a time to any fold (untangle.hpp)
   std::size_t smooth_points = 40; // arms with more points are shortened by certified shortcuts (smooth.hpp; 0: off)
-  double smooth_clearance_mm = 0.1;  // clearance the shortcuts keep (room for the simplification around them)
+  double smooth_clearance_mm = 0.02;  // clearance the shortcuts keep (room for the simplification around them)
   std::size_t max_points = 1023;  // per arm, after the start point (firmware limit)
   bool verify = true;             // run the checker on the result
   CheckOptions check{};           // the checker's settings (full buffer)

@@ -28,10 +28,12 @@ struct SmoothOptions {
   std::size_t min_points = 40;     // only arms with more points than this (after the start point)
   double min_clearance_mm = 1e-4;  // every shortcut keeps at least this much clearance throughout
   double min_step_s = 1e-4;        // a shortcut whose certificate needs smaller steps is refused
+  int sweeps = 2;                  // passes over the arms still over min_points (a later pass sees
+                                   // the neighbours' shortened arms)
 };
 
 struct SmoothStats {
-  std::size_t arms = 0;           // arms shortened
+  std::size_t arms = 0;           // arms shortened (per sweep)
   std::size_t points_before = 0;  // over those arms
   std::size_t points_after = 0;
   std::size_t shortcuts_tried = 0;
