@@ -32,7 +32,7 @@ RobotTrajectory neighbour_swing() {
   return {{{0, 90}, {6, 90}, {11, 150}, {16, 90}}, {{0, 0}}};
 }
 
-TEST(Smooth, DitherAwayFromEveryoneBecomesOneSegment) {
+TEST(PlanSmooth, DitherAwayFromEveryoneBecomesOneSegment) {
   const auto m = two_robots();
   // Robot 1 dithers by a degree around alpha 90 (pointing away from robot 2) for five seconds,
   // then turns to 120; robot 2 stays folded.
@@ -68,7 +68,7 @@ TEST(Smooth, DitherAwayFromEveryoneBecomesOneSegment) {
   EXPECT_TRUE(report.ok());
 }
 
-TEST(Smooth, ExcursionThatKeepsClearOfANeighbourStays) {
+TEST(PlanSmooth, ExcursionThatKeepsClearOfANeighbourStays) {
   const auto m = two_robots();
   const std::vector<RobotTrajectory> original{excursion_with_dither(), neighbour_swing()};
   TrajectoryChecker checker(m);
@@ -95,7 +95,7 @@ TEST(Smooth, ExcursionThatKeepsClearOfANeighbourStays) {
   EXPECT_TRUE(report.ok()) << "min clearance " << report.min_clearance_mm;
 }
 
-TEST(Smooth, FlattenedArmThatCollidesFallsBackToTheCertifiedOne) {
+TEST(PlanSmooth, FlattenedArmThatCollidesFallsBackToTheCertifiedOne) {
   const auto m = two_robots();
   const std::vector<RobotTrajectory> exact{excursion_with_dither(), neighbour_swing()};
   std::vector<RobotTrajectory> flat = exact;
