@@ -8,8 +8,10 @@
 // turns during both halves and neither half waits for it. Robots that cannot leave their target
 // region are parked folded instead and reported; robots that cannot leave their current pose are
 // held there and reported; the rest is re-planned around them. Trajectories keep only the corners
-// of the piecewise-constant speed profile, are simplified where that stays clear, and the result
-// is verified by the independent dense-sampling checker at the full buffer.
+// of the piecewise-constant speed profile; jagged arms are shortened by certified shortcuts
+// (smooth.hpp), everything is simplified where that stays clear, and the result is verified by the
+// independent dense-sampling checker at the full buffer (flagged robots fall back to their
+// shortcut, then to their exact trajectories: verify_with_fallbacks).
 #pragma once
 
 #include "fps/plan/checker.hpp"
