@@ -1,5 +1,6 @@
 #include "fps/host/correction.hpp"
 
+#include "core/header_table.hpp"
 #include "core/text.hpp"
 
 #include <fmt/format.h>
@@ -11,6 +12,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 namespace axon::fps::host {
 
@@ -70,73 +72,32 @@ const Measurement* MeasurementSet::find(std::int32_t robot) const noexcept {
 
 Result<MeasurementSet> parse_measurements_csv(std::string_view text, const std::string& name,
                                               std::span<const std::int32_t> known_robots) {
-  enum Col { robot, x, y, fibre };
+  enum Field { robot, x, y, fibre };
+  static constexpr core::TableColumn kColumns[] = {{"robot", robot}, {"x", x}, {"y", y}, {"fibre", fibre}, {"fiber", fibre}};
+  static constexpr int kRequired[] = {robot, x, y};
   const std::set<std::int32_t> known(known_robots.begin(), known_robots.end());
-  std::vector<int> columns;
   std::set<std::int32_t> seen;
   MeasurementSet out;
   out.source = name;
-  int line_no = 0;
-  while (!text.empty()) {
-    const auto nl = text.find('\n');
-    std::string_view line = text.substr(0, nl);
-    text.remove_prefix(nl == std::string_view::npos ? text.size() : nl + 1);
-    ++line_no;
-    if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-    line = core::trim(line);
-    if (line.empty()) continue;
-    const auto cells = core::split_fields(line);
-    if (columns.empty()) {
-      std::vector<bool> have(4, false);
-      for (const auto c : cells) {
-        const std::string l = lower(c);
-        int col = -1;
-        if (l == "robot") col = robot;
-        if (l == "x") col = x;
-        if (l == "y") col = y;
-        if (l == "fibre" || l == "fiber") col = fibre;
-        if (col < 0)
-          return at(CorrectionErrc::unknown_column, name, line_no,
-                    fmt::format("unknown column '{}' (known: robot, x, y, fibre)", c));
-        if (have[static_cast<std::size_t>(col)])
-          return at(CorrectionErrc::unknown_column, name, line_no, fmt::format("column '{}' twice", c));
-        have[static_cast<std::size_t>(col)] = true;
-        columns.push_back(col);
-      }
-      for (auto [col, what] : {std::pair{robot, "robot"}, std::pair{x, "x"}, std::pair{y, "y"}})
-        if (!have[static_cast<std::size_t>(col)])
-          return at(CorrectionErrc::missing_column, name, line_no, fmt::format("the header needs a '{}' column", what));
-      continue;
-    }
-    if (cells.size() != columns.size())
-      return at(CorrectionErrc::missing_column, name, line_no,
-                fmt::format("{} cells, the header has {}", cells.size(), columns.size()));
+  core::HeaderTable table(text, kColumns, kRequired);
+  while (table.next()) {
+    const int line_no = table.line();
     Measurement m;
     m.line = line_no;
-    for (std::size_t i = 0; i < cells.size(); ++i) {
-      const std::string_view c = cells[i];
-      switch (columns[i]) {
-        case robot: {
-          const auto id = core::parse_number<std::int64_t>(c);
-          if (!id) return at(CorrectionErrc::not_a_number, name, line_no, fmt::format("robot id '{}' is not an integer", c));
-          if (*id < 1 || *id > 2047)
-            return at(CorrectionErrc::unknown_robot, name, line_no, fmt::format("robot id {} out of range 1..2047", *id));
-          m.robot = static_cast<std::int32_t>(*id);
-          break;
-        }
-        case x:
-        case y: {
-          const auto v = core::parse_number<double>(c);
-          if (!v || !std::isfinite(*v))
-            return at(CorrectionErrc::not_a_number, name, line_no,
-                      fmt::format("{} '{}' is not a number", columns[i] == x ? "x" : "y", c));
-          (columns[i] == x ? m.position.x : m.position.y) = *v;
-          break;
-        }
-        default:
-          if (!c.empty()) m.fibre = std::string(c);
-      }
+    const auto id_text = table.cell(robot);
+    const auto id = core::parse_number<std::int64_t>(id_text);
+    if (!id) return at(CorrectionErrc::not_a_number, name, line_no, fmt::format("robot id '{}' is not an integer", id_text));
+    if (*id < 1 || *id > 2047)
+      return at(CorrectionErrc::unknown_robot, name, line_no, fmt::format("robot id {} out of range 1..2047", *id));
+    m.robot = static_cast<std::int32_t>(*id);
+    for (auto [field, slot, what] : {std::tuple{x, &m.position.x, "x"}, std::tuple{y, &m.position.y, "y"}}) {
+      const auto c = table.cell(field);
+      const auto v = core::parse_number<double>(c);
+      if (!v || !std::isfinite(*v))
+        return at(CorrectionErrc::not_a_number, name, line_no, fmt::format("{} '{}' is not a number", what, c));
+      *slot = *v;
     }
+    if (const auto c = table.cell(fibre); !c.empty()) m.fibre = std::string(c);
     if (!known.empty() && !known.contains(m.robot))
       return at(CorrectionErrc::unknown_robot, name, line_no,
                 fmt::format("robot {} is not part of the focal plane", m.robot));
@@ -144,7 +105,12 @@ Result<MeasurementSet> parse_measurements_csv(std::string_view text, const std::
       return at(CorrectionErrc::duplicate_robot, name, line_no, fmt::format("robot {} measured twice", m.robot));
     out.items.push_back(std::move(m));
   }
-  if (columns.empty()) return at(CorrectionErrc::missing_column, name, line_no, "no header line (robot,x,y)");
+  if (const auto& e = table.error()) {
+    const bool naming = e->problem == core::TableProblem::unknown_column || e->problem == core::TableProblem::duplicate_column;
+    const auto code = naming ? CorrectionErrc::unknown_column : CorrectionErrc::missing_column;
+    return at(code, name, e->line, e->message);
+  }
+  if (!table.header_seen()) return at(CorrectionErrc::missing_column, name, table.line(), "no header line (robot,x,y)");
   return out;
 }
 

@@ -1,5 +1,6 @@
 #include "fps/plan/targets.hpp"
 
+#include "core/header_table.hpp"
 #include "core/text.hpp"
 
 #include "core/config.hpp"
@@ -11,7 +12,6 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
-#include <map>
 #include <sstream>
 
 namespace axon::fps::plan {
@@ -121,60 +121,33 @@ Result<std::vector<Target>> parse_targets_yaml(std::string_view text, const std:
 }
 
 Result<std::vector<Target>> parse_targets_csv(std::string_view text, const std::string& name) {
-  static const std::map<std::string, int, std::less<>> known{{"robot", 0}, {"alpha", 1}, {"beta", 2}, {"x", 3},
-                                                             {"y", 4},     {"fibre", 5}, {"fiber", 5}, {"elbow", 6}};
-  std::vector<int> columns;  // header position -> field number
+  enum Field { robot, alpha, beta, x, y, fibre, elbow };
+  static constexpr core::TableColumn kColumns[] = {{"robot", robot}, {"alpha", alpha}, {"beta", beta},
+                                                   {"x", x},         {"y", y},         {"fibre", fibre},
+                                                   {"fiber", fibre}, {"elbow", elbow}};
+  static constexpr int kRequired[] = {robot};
+  core::HeaderTable table(text, kColumns, kRequired);
   std::vector<Target> out;
-  int line_no = 0;
-  while (!text.empty()) {
-    const auto nl = text.find('\n');
-    std::string_view line = text.substr(0, nl);
-    text.remove_prefix(nl == std::string_view::npos ? text.size() : nl + 1);
-    ++line_no;
-    if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-    line = core::trim(line);
-    if (line.empty()) continue;
-    const auto cells = core::split_fields(line);
-    if (columns.empty()) {
-      std::vector<bool> seen(7, false);
-      for (const auto c : cells) {
-        const auto it = known.find(lower(c));
-        if (it == known.end())
-          return file_error(name, line_no,
-                            fmt::format("unknown column '{}' (known: robot, alpha, beta, x, y, fibre, elbow)", c));
-        if (seen[static_cast<std::size_t>(it->second)])
-          return file_error(name, line_no, fmt::format("column '{}' twice", c));
-        seen[static_cast<std::size_t>(it->second)] = true;
-        columns.push_back(it->second);
-      }
-      if (!seen[0]) return file_error(name, line_no, "the header needs a 'robot' column");
-      continue;
-    }
-    if (cells.size() != columns.size())
-      return file_error(name, line_no, fmt::format("{} cells, the header has {}", cells.size(), columns.size()));
+  while (table.next()) {
+    const int line_no = table.line();
     Fields f;
-    for (std::size_t i = 0; i < cells.size(); ++i) {
-      const std::string_view c = cells[i];
-      if (c.empty()) continue;
-      const int field = columns[i];
-      if (field == 0) {
-        f.robot = core::parse_number<std::int64_t>(c);
-        if (!f.robot) return file_error(name, line_no, fmt::format("robot id '{}' is not an integer", c));
-      } else if (field <= 4) {
-        const auto v = core::parse_number<double>(c);
-        if (!v) return file_error(name, line_no, fmt::format("'{}' is not a number", c));
-        std::optional<double>* slots[] = {&f.alpha, &f.beta, &f.x, &f.y};
-        *slots[field - 1] = v;
-      } else if (field == 5) {
-        f.fibre = std::string(c);
-      } else {
-        f.elbow = std::string(c);
-      }
+    if (const auto c = table.cell(robot); !c.empty()) {
+      f.robot = core::parse_number<std::int64_t>(c);
+      if (!f.robot) return file_error(name, line_no, fmt::format("robot id '{}' is not an integer", c));
     }
+    for (auto [field, slot] : {std::pair{alpha, &f.alpha}, std::pair{beta, &f.beta}, std::pair{x, &f.x}, std::pair{y, &f.y}}) {
+      const auto c = table.cell(field);
+      if (c.empty()) continue;
+      *slot = core::parse_number<double>(c);
+      if (!*slot) return file_error(name, line_no, fmt::format("'{}' is not a number", c));
+    }
+    if (const auto c = table.cell(fibre); !c.empty()) f.fibre = std::string(c);
+    if (const auto c = table.cell(elbow); !c.empty()) f.elbow = std::string(c);
     AXON_TRY(t, make_target(f, name, line_no));
     out.push_back(std::move(t));
   }
-  if (columns.empty()) return file_error(name, line_no, "no header line");
+  if (const auto& e = table.error()) return file_error(name, e->line, e->message);
+  if (!table.header_seen()) return file_error(name, table.line(), "no header line");
   return out;
 }
 
