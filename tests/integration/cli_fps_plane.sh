@@ -28,16 +28,11 @@ robots:
   - {id: 12, x: 112, y: 38.8, sextant: 2, gateway: 2, bus: 2, fibres: [boss]}
 EOF
 
-# start_plane NAME ARGS...: a simulated plane in the background; sets PLC (HOST:PORT) and writes
-# the layout with the emulators' addresses to $TMP/NAME.yaml.
-start_plane() {
+# plane NAME ARGS...: lib.sh's simulated plane on this test's layout, one gateway line each.
+plane() {
   local name=$1; shift
-  "$AXON" sim fps --layout "$TMP/plane.yaml" --folded --time-scale 20 --write-layout "$TMP/$name.yaml" "$@" \
-    >"$TMP/$name.out" 2>"$TMP/$name.err" &
-  PIDS+=($!)
-  wait_for_line "$TMP/$name.out" '^ready$' >/dev/null
+  start_plane "$name" "$TMP/plane.yaml" "$@"
   [ "$(grep -c '^listening gateway ' "$TMP/$name.out")" = 2 ] || fail "expected one ready line per gateway"
-  PLC=$(wait_for_line "$TMP/$name.out" '^listening plc ' | awk '{print $3}')
 }
 
 # 1. Discovery with a robot missing and one too many.
@@ -45,7 +40,7 @@ cat >"$TMP/scenario.yaml" <<'EOF'
 absent: [5]
 extra: [{id: 900, gateway: 2, bus: 1}]
 EOF
-start_plane a --scenario "$TMP/scenario.yaml"
+plane a --scenario "$TMP/scenario.yaml"
 set +e
 "$AXON" fps plane --layout "$TMP/a.yaml" check --window 0.3 >"$TMP/check.out" 2>"$TMP/check.err"
 rc=$?
@@ -80,7 +75,7 @@ grep -Eq '^  bootloader: 6$' "$TMP/on.out" || fail "sextant 2 should be in the b
 cat >"$TMP/collide.yaml" <<'EOF'
 collide_on_move: [8]
 EOF
-start_plane b --scenario "$TMP/collide.yaml"
+plane b --scenario "$TMP/collide.yaml"
 set +e
 "$AXON" fps plane --layout "$TMP/b.yaml" --plc "$PLC" move --alpha 90 --beta 120 --duration 40 --sync \
   >"$TMP/coll.out" 2>"$TMP/coll.err"

@@ -12,21 +12,6 @@
 source "$(dirname "$0")/lib.sh"
 PY=/usr/bin/python3
 
-cat >"$TMP/plane.yaml" <<'EOF2'
-name: two-sextants
-pitch_mm: 22.4
-gateways:
-  - {id: 1, address: "127.0.0.1:1", sextant: 1, channels: 4}
-  - {id: 2, address: "127.0.0.1:1", sextant: 2, channels: 4}
-robots:
-  - {id: 1, x: 0, y: 0, sextant: 1, gateway: 1, bus: 1, fibres: [boss]}
-  - {id: 2, x: 22.4, y: 0, sextant: 1, gateway: 1, bus: 1, fibres: [boss]}
-  - {id: 3, x: 44.8, y: 0, sextant: 1, gateway: 1, bus: 2, fibres: [boss]}
-  - {id: 7, x: 0, y: 38.8, sextant: 2, gateway: 2, bus: 1, fibres: [boss]}
-  - {id: 8, x: 22.4, y: 38.8, sextant: 2, gateway: 2, bus: 1, fibres: [boss]}
-  - {id: 9, x: 44.8, y: 38.8, sextant: 2, gateway: 2, bus: 2, fibres: [boss]}
-EOF2
-
 cat >"$TMP/camera.py" <<'EOF2'
 # camera.py OUT ROBOT:ALPHA:BETA[:DX_UM] ...  writes robot,x,y (mm) of each robot's boss fibre.
 import math, os, sys
@@ -49,10 +34,7 @@ with open(out + ".part", "w") as f:
 os.rename(out + ".part", out)  # appears complete
 EOF2
 
-"$AXON" sim fps --layout "$TMP/plane.yaml" --folded --time-scale 20 --write-layout "$TMP/a.yaml" \
-  >"$TMP/a.out" 2>"$TMP/a.err" &
-PIDS+=($!)
-wait_for_line "$TMP/a.out" '^ready$' >/dev/null
+start_plane a "$SMALL_PLANE"
 
 # 1. Everyone to (30, 150).
 "$AXON" fps plane --layout "$TMP/a.yaml" move --alpha 30 --beta 150 --duration 2 --points 4 \

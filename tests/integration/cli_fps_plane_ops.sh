@@ -4,26 +4,7 @@
 # `axon fps plane cold` (the cold-temperature policy from the PLC's temperatures).
 source "$(dirname "$0")/lib.sh"
 
-cat >"$TMP/plane.yaml" <<'EOF2'
-name: two-sextants
-pitch_mm: 22.4
-gateways:
-  - {id: 1, address: "127.0.0.1:1", sextant: 1, channels: 4}
-  - {id: 2, address: "127.0.0.1:1", sextant: 2, channels: 4}
-robots:
-  - {id: 1, x: 0, y: 0, sextant: 1, gateway: 1, bus: 1, fibres: [boss]}
-  - {id: 2, x: 22.4, y: 0, sextant: 1, gateway: 1, bus: 1, fibres: [boss]}
-  - {id: 3, x: 44.8, y: 0, sextant: 1, gateway: 1, bus: 2, fibres: [boss]}
-  - {id: 7, x: 0, y: 38.8, sextant: 2, gateway: 2, bus: 1, fibres: [boss]}
-  - {id: 8, x: 22.4, y: 38.8, sextant: 2, gateway: 2, bus: 1, fibres: [boss]}
-  - {id: 9, x: 44.8, y: 38.8, sextant: 2, gateway: 2, bus: 2, fibres: [boss]}
-EOF2
-
-"$AXON" sim fps --layout "$TMP/plane.yaml" --folded --time-scale 20 --write-layout "$TMP/a.yaml" \
-  >"$TMP/a.out" 2>"$TMP/a.err" &
-PIDS+=($!)
-wait_for_line "$TMP/a.out" '^ready$' >/dev/null
-PLC=$(wait_for_line "$TMP/a.out" '^listening plc ' | awk '{print $3}')
+start_plane a "$SMALL_PLANE"
 
 # 1. Firmware of every robot, sextant by sextant; a progress line per sextant on stderr.
 { printf 'AXON-FPS-FW:04.02.00'; head -c 4000 /dev/zero | tr '\0' 'x'; } >"$TMP/fw.bin"

@@ -53,6 +53,22 @@ start_sim_fps() {
   done
 }
 
+# The six-robot, two-sextant layout of the plane tests (tests/integration/data).
+SMALL_PLANE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/data/plane_two_sextants.yaml"
+
+# start_plane NAME LAYOUT ARGS...: a simulated focal plane (`axon sim fps --layout LAYOUT`, robots
+# folded, time x20, plus ARGS) in the background; waits until it is ready, sets PLC (HOST:PORT)
+# and writes the layout with the emulators' addresses to $TMP/NAME.yaml.
+start_plane() {
+  local name=$1 layout=$2; shift 2
+  rm -f "$TMP/$name.out" "$TMP/$name.err"
+  "$AXON" sim fps --layout "$layout" --folded --time-scale 20 --write-layout "$TMP/$name.yaml" "$@" \
+    >"$TMP/$name.out" 2>"$TMP/$name.err" &
+  PIDS+=($!)
+  wait_for_line "$TMP/$name.out" '^ready$' >/dev/null
+  PLC=$(wait_for_line "$TMP/$name.out" '^listening plc ' | awk '{print $3}')
+}
+
 # ---- c4g ----
 # skip_without_sim_c4g: ends the test with success when this axon has no `axon sim c4g` yet (the
 # simulator is developed on its own branch).
