@@ -13,6 +13,8 @@ import json, sys
 j = json.load(open(sys.argv[1]))
 assert j["format"] == "axon-fps-plan" and j["verified"] is True, j.get("verified")
 assert len(j["robots"]) == 500
+st = j["stats"]
+assert st["checks"] >= 1 and st["smooth_s"] >= 0 and st["max_points"] <= 1023, st
 for r in j["robots"]:
     for arm in ("alpha", "beta"):
         pts = r[arm]

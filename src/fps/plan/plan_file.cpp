@@ -33,7 +33,8 @@ std::string plan_to_json(const CollisionModel& model, const Plan& plan, const Pl
                 {"check_s", plan.stats.check_s},       {"rounds", plan.stats.rounds},
                 {"escapes", plan.stats.escapes},       {"median_points", plan.stats.median_points},
                 {"max_points", plan.stats.max_points}, {"max_alpha_deg_s", plan.stats.max_alpha_speed},
-                {"max_beta_deg_s", plan.stats.max_beta_speed}};
+                {"max_beta_deg_s", plan.stats.max_beta_speed}, {"smooth_s", plan.stats.smooth_s},
+                {"smoothed", plan.stats.smoothed},     {"checks", plan.stats.checks}};
   json robots = json::array();
   for (std::size_t i = 0; i < plan.trajectories.size(); ++i) {
     const auto& t = plan.trajectories[i];
