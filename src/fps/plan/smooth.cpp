@@ -106,7 +106,10 @@ SmoothStats smooth_arms(const CollisionModel& model, std::vector<RobotTrajectory
       }
     std::stable_sort(arms.begin(), arms.end(), [](const auto& a, const auto& b) { return std::get<0>(a) > std::get<0>(b); });
     std::size_t shortened = 0;
-    for (const auto& [count, i, alpha] : arms) {
+    for (const auto& arm : arms) {
+      // Named copies, not structured bindings: clang 14 cannot capture those in the lambda below.
+      const std::size_t i = std::get<1>(arm);
+      const bool alpha = std::get<2>(arm);
       // A copy: the certifier reads the robot's current trajectory (the other arm) while this one is
       // rebuilt; the arm being edited is described to it by the shortcut's own points.
       const std::vector<TimedAngle> pts = alpha ? trajectories[i].alpha : trajectories[i].beta;
