@@ -10,6 +10,7 @@
 #include "c4g/sim/controller.hpp"
 #include "c4g/sim/robots.hpp"
 #include "c4g/sim/scenario.hpp"
+#include "sim_loop.hpp"
 
 #include <gtest/gtest.h>
 
@@ -39,53 +40,22 @@ Result run(PidOptions o, std::string_view yaml, double max_s) {
   Result r;
   PidApp app(std::move(o));
   auto c = sim::Controller::create(sim::six_axis_robot(), sim::Scenario::parse(yaml).value()).value();
-  P::InitPacket init;
-  P::AxisMap map;
-  host::Safety safety;
   host::SwitchTracker tracker;  // the soft-switching phase, inferred as the Server does
-  P::Packet req, rep;
-  std::uint64_t cycle = 0;
-  const auto ticks = static_cast<std::uint64_t>(max_s / c.period_s());
-  for (std::uint64_t k = 0; k < ticks && !c.finished(); ++k) {
-    const auto d = c.begin_cycle();
-    if (P::classify(d.size()) == P::DatagramKind::init) {
-      init = P::decode_init(d).value();
-      map = P::AxisMap::from_init(init).value();
-      app.on_init(init, map);
-      safety.configure(init, map);
-      rep = P::Packet{};
-      rep.num = init.protocol_number;
-      rep.count = map.count();
-    } else if (!d.empty()) {
-      EXPECT_TRUE(P::decode_packet(d, req).ok());
-      rep = P::Packet{};
-      rep.num = req.num;
-      rep.count = req.count;
-      for (std::size_t i = 0; i < req.count; ++i) rep.axes[i].mode = req.axes[i].mode;
-      if (cycle > 0 || init.open_axes > 0) {
-        tracker.update(req, c.period_s());
-        const host::CycleContext ctx{req, &init, &map, cycle++, 0, &tracker};
-        host::ReplyBuilder b(rep);
-        app.on_cycle(ctx, b);
-        safety.apply(req, rep);
-        const bool measured = req.axes[0].mode == 1 || req.axes[0].mode == 2;
-        for (std::size_t i = 0; measured && i < req.count; ++i) {
-          const double e = std::fabs(req.axes[i].d1 - req.axes[i].d3);
-          r.worst = std::max(r.worst, e);
-        }
-      }
+  SimLoop loop(c, app, tracker);
+  loop.run(max_s, [&] {
+    const auto& req = loop.req;
+    const bool measured = req.axes[0].mode == 1 || req.axes[0].mode == 2;
+    for (std::size_t i = 0; measured && i < req.count; ++i) {
+      const double e = std::fabs(req.axes[i].d1 - req.axes[i].d3);
+      r.worst = std::max(r.worst, e);
     }
-    std::array<std::byte, P::kMaxPacketSize> out{};
-    if (!d.empty() && P::encode_packet(rep, out).ok()) c.on_datagram(std::span<const std::byte>(out.data(), P::packet_size(rep.count)));
-    c.end_cycle();
-    for (const auto& e : c.take_events())
-      if (e.level == sim::EventLevel::error) r.errors += e.name + ": " + e.text + "\n";
-  }
+  });
+  r.errors = loop.errors;
   r.finished = app.finished();
   r.scenario_done = c.scenario_done();
   r.saturated = app.saturated_cycles();
   r.errors += app.error();
-  EXPECT_EQ(safety.reason(), host::FaultReason::none);
+  EXPECT_EQ(loop.safety.reason(), host::FaultReason::none);
   return r;
 }
 

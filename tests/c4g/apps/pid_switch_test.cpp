@@ -13,6 +13,7 @@
 #include "c4g/sim/controller.hpp"
 #include "c4g/sim/robots.hpp"
 #include "harness.hpp"
+#include "sim_loop.hpp"
 
 #include <gtest/gtest.h>
 
@@ -122,56 +123,25 @@ Figures run_switching(PidOptions o, bool controller_reduces, std::string_view ya
   auto c = sim::Controller::create(robot, sim::Scenario::parse(yaml).value()).value();
   PidApp app(std::move(o));
   host::SwitchTracker tracker(robot.scs.times);
-  host::Safety safety;
-  P::InitPacket init;
-  P::AxisMap map;
-  P::Packet req, rep;
+  SimLoop loop(c, app, tracker);
   std::array<double, P::kMaxAxes> anchor{};
-  std::uint64_t cycle = 0;
-  const auto ticks = static_cast<std::uint64_t>(max_s / c.period_s());
-  for (std::uint64_t k = 0; k < ticks && !c.finished(); ++k) {
-    const auto d = c.begin_cycle();
-    if (P::classify(d.size()) == P::DatagramKind::init) {
-      init = P::decode_init(d).value();
-      map = P::AxisMap::from_init(init).value();
-      app.on_init(init, map);
-      safety.configure(init, map);
-      rep = P::Packet{};
-      rep.num = init.protocol_number;
-      rep.count = map.count();
-    } else if (!d.empty()) {
-      EXPECT_TRUE(P::decode_packet(d, req).ok());
-      rep = P::Packet{};
-      rep.num = req.num;
-      rep.count = req.count;
-      for (std::size_t i = 0; i < req.count; ++i) rep.axes[i].mode = req.axes[i].mode;
-      if (init.open_axes > 0) {
-        tracker.update(req, c.period_s());
-        const host::CycleContext ctx{req, &init, &map, cycle++, 0, &tracker};
-        host::ReplyBuilder b(rep);
-        app.on_cycle(ctx, b);
-        safety.apply(req, rep);
-        for (std::size_t i = 0; i < req.count; ++i) {
-          const auto& s = tracker.axis(i);
-          if (s.elapsed_s == 0 && s.interval == SwitchInterval::pre) anchor[i] = req.axes[i].d3;
-          if (!s.robot_must_be_still()) continue;
-          f.switch_packets += i == 0;
-          f.still = std::max(f.still, std::fabs(req.axes[i].d3 - anchor[i]));
-          f.current = std::max(f.current, static_cast<double>(std::fabs(req.axes[i].d5)));
-          f.pc_current = std::max(f.pc_current, static_cast<double>(std::fabs(rep.axes[i].d5)));
-        }
-      }
+  loop.run(max_s, [&] {
+    const auto& req = loop.req;
+    for (std::size_t i = 0; i < req.count; ++i) {
+      const auto& s = tracker.axis(i);
+      if (s.elapsed_s == 0 && s.interval == SwitchInterval::pre) anchor[i] = req.axes[i].d3;
+      if (!s.robot_must_be_still()) continue;
+      f.switch_packets += i == 0;
+      f.still = std::max(f.still, std::fabs(req.axes[i].d3 - anchor[i]));
+      f.current = std::max(f.current, static_cast<double>(std::fabs(req.axes[i].d5)));
+      f.pc_current = std::max(f.pc_current, static_cast<double>(std::fabs(loop.rep.axes[i].d5)));
     }
-    std::array<std::byte, P::kMaxPacketSize> out{};
-    if (!d.empty() && P::encode_packet(rep, out).ok()) c.on_datagram(std::span<const std::byte>(out.data(), P::packet_size(rep.count)));
-    c.end_cycle();
-    for (const auto& e : c.take_events())
-      if (e.level == sim::EventLevel::error) f.errors += e.name + ": " + e.text + "\n";
-  }
+  });
+  f.errors = loop.errors;
   f.scenario_done = c.scenario_done();
   f.app_finished = app.finished();
   f.errors += app.error();
-  EXPECT_EQ(safety.reason(), host::FaultReason::none);
+  EXPECT_EQ(loop.safety.reason(), host::FaultReason::none);
   return f;
 }
 
