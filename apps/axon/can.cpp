@@ -47,6 +47,9 @@ struct DumpOptions {
   std::uint64_t count = 0;
   double timeout_s = 0;
   bool quiet_frames = false;
+  std::uint64_t log_max_bytes = 0;
+  double log_max_seconds = 0;
+  unsigned log_keep = 10;
 };
 
 int run_dump(const DumpOptions& o) {
@@ -59,7 +62,13 @@ int run_dump(const DumpOptions& o) {
     auto bus = need(std::move(r1));
     bus->set_filters(filters);
     std::optional<can::CandumpWriter> log;
-    if (!o.log.empty()) log.emplace(need(can::CandumpWriter::create(o.log)));
+    if (!o.log.empty()) {
+      core::RotationLimits limits;
+      limits.max_bytes = o.log_max_bytes;
+      limits.max_age = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.log_max_seconds));
+      limits.keep = o.log_keep;
+      log.emplace(need(can::CandumpWriter::create(o.log, limits)));
+    }
     set_on_signal([&] { bus->close(); });
     spdlog::info("dump: receiving on {}{}", spec.to_string(), o.log.empty() ? "" : " (logging to " + o.log + ")");
 
@@ -320,6 +329,17 @@ void add_can_commands(CLI::App& app, GlobalOptions&) {
   d->add_option("-n,--count", dump.count, "stop after this many frames");
   d->add_option("-t,--timeout", dump.timeout_s, "seconds; with --count: fail (exit 3) if not reached, else run this long");
   d->add_flag("--no-print", dump.quiet_frames, "do not print frames (log only)");
+  d->add_option("--log-max-size", dump.log_max_bytes,
+                "rotate the log before it passes this size (bytes; k, M, G suffixes): the full file becomes "
+                "FILE.1, the older ones FILE.2 ...")
+      ->transform(CLI::AsSizeValue(false))
+      ->needs("--log");
+  d->add_option("--log-max-seconds", dump.log_max_seconds, "rotate the log once it is this many seconds old")
+      ->check(CLI::PositiveNumber)
+      ->needs("--log");
+  d->add_option("--log-keep", dump.log_keep, "rotated files kept, FILE.1 .. FILE.N (default 10; older ones are deleted)")
+      ->check(CLI::Range(1u, 100000u))
+      ->needs("--log");
   d->callback([] { exit_code() = run_dump(dump); });
 
   static SendOptions send;

@@ -49,11 +49,28 @@ struct SimFpsOptions {
   std::string scenario;
   std::string plc = "127.0.0.1:0";
   std::string bind = "127.0.0.1";
+  std::uint16_t port = 0;
   std::uint16_t base_port = 0;
   std::uint64_t seed = 1;
   bool folded = false;
   std::string write_layout;
+  // Every robot (both modes; over the config file's own settings when given).
+  std::string firmware;
+  std::string firmware_history;
+  std::string start_without_trajectory;
 };
+
+// The firmware settings of the command line, applied to one robot's configuration.
+void apply_firmware_options(const SimFpsOptions& o, sim::PositionerConfig& c) {
+  if (!o.firmware.empty()) {
+    c.firmware = need(fps::protocol::FirmwareVersion::parse(o.firmware));
+    need(c.validate());
+  }
+  if (!o.firmware_history.empty())
+    c.firmware_history = o.firmware_history == "field" ? sim::FirmwareHistory::field : sim::FirmwareHistory::document;
+  if (!o.start_without_trajectory.empty())
+    c.start_without_trajectory = o.start_without_trajectory == "refuse" ? sim::EmptyStart::refuse : sim::EmptyStart::accept;
+}
 
 // The simulator configuration the options describe: a file, or a hexagonal grid of the listed ids
 // spread over can0..canN-1 in consecutive blocks (like daisy chains).
@@ -62,13 +79,17 @@ sim::SimulatorConfig build_config(const SimFpsOptions& o) {
     const auto node = need(core::ConfigNode::load_file(o.config));
     auto config = need(sim::SimulatorConfig::from_config(node));
     if (o.time_scale != 1.0) config.options.time_scale = o.time_scale;
+    for (auto& r : config.robots) apply_firmware_options(o, r.config);
     return config;
   }
   const auto ids = need(parse_id_list(o.robots));
   std::vector<std::string> channels;
   for (unsigned i = 0; i < o.buses; ++i) channels.push_back(fmt::format("can{}", i));
   auto config = need(sim::SimulatorConfig::grid(ids.size(), channels));
-  for (std::size_t i = 0; i < ids.size(); ++i) config.robots[i].config.id = ids[i];
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    config.robots[i].config.id = ids[i];
+    apply_firmware_options(o, config.robots[i].config);
+  }
   config.options.time_scale = o.time_scale;
   return config;
 }
@@ -92,10 +113,12 @@ int run_sim_layout(const SimFpsOptions& o) {
   fo.simulator.time_scale = o.time_scale;
   fo.seed = o.seed;
   fo.random_start = !o.folded;
-  fo.bind_address = o.bind;
+  apply_firmware_options(o, fo.defaults);
+  fo.binding.address = o.bind;
+  fo.binding.port = o.port;
   if (o.base_port != 0) {
     std::uint16_t port = o.base_port;
-    for (const auto& g : plane.gateways()) fo.gateway_ports[g.id] = port++;
+    for (const auto& g : plane.gateways()) fo.binding.ports[g.id] = port++;
   }
   if (!o.scenario.empty()) fo.scenario = need(sim::Scenario::from_config(need(core::ConfigNode::load_file(o.scenario))));
   fo.plc = !o.plc.empty() && o.plc != "off";
@@ -297,10 +320,24 @@ void add_sim_commands(CLI::App& app, GlobalOptions&) {
   f->add_option("--seed", fps.seed, "with --layout: seed of the random start positions (default 1)");
   f->add_flag("--folded", fps.folded, "with --layout: every robot at alpha 0, beta 180 (default: random alpha, beta folded)");
   f->add_option("--plc", fps.plc, "with --layout: PLC emulator on HOST:PORT (default 127.0.0.1:0; `off`: none)");
-  f->add_option("--bind", fps.bind, "with --layout: address of the gateway emulators (default 127.0.0.1)");
+  f->add_option("--bind", fps.bind, "with --layout: address of the first gateway emulator, the next gateways on the "
+                                 "next addresses (default 127.0.0.1: 127.0.0.1..127.0.0.6), or `layout`: each at "
+                                 "the HOST:PORT of its layout entry");
+  f->add_option("--port", fps.port, "with --layout: every gateway on this port, each at its own address (default: any free port)");
   f->add_option("--base-port", fps.base_port, "with --layout: gateway N listens on base + N - 1 (default: any free port)");
+  f->add_option("--firmware", fps.firmware, "application firmware version of every robot, XX.YY.ZZ (default 04.01.13; "
+                                         "04.01.00 and later are modelled)");
+  f->add_option("--firmware-history", fps.firmware_history,
+                "which commands a version takes: document (every command of the document's table, default) or "
+                "field (precise-move switches 128..131 from 04.01.17 on)")
+      ->check(CLI::IsMember({"document", "field"}));
+  f->add_option("--start-without-trajectory", fps.start_without_trajectory,
+                "START_TRAJECTORY while nothing is loaded: accept (code 0, the robot stays; robots in service, "
+                "default) or refuse (code 2, INVALID_TRAJECTORY)")
+      ->check(CLI::IsMember({"accept", "refuse"}));
   f->add_option("--write-layout", fps.write_layout, "with --layout: write the layout with the emulators' addresses to FILE");
   f->get_option("--config")->excludes("--robots")->excludes("--buses");
+  f->get_option("--port")->excludes("--base-port");
   f->get_option("--layout")->excludes("--robots")->excludes("--buses")->excludes("--config")->excludes("--gateway")->excludes("--socketcand");
   f->callback([] { exit_code() = run_sim_fps(fps); });
 

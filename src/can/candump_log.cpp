@@ -244,20 +244,35 @@ std::string format_candump_line(const LogEntry& entry) {
 
 CandumpWriter::CandumpWriter(std::ostream& out, Flush flush) : out_(&out), name_("<stream>"), flush_(flush) {}
 
-CandumpWriter::CandumpWriter(std::unique_ptr<std::ofstream> file, std::string name, Flush flush)
-    : file_(std::move(file)), out_(file_.get()), name_(std::move(name)), flush_(flush) {}
+CandumpWriter::CandumpWriter(core::RotatingFile file, Flush flush)
+    : file_(std::move(file)), name_(file_->path().string()), flush_(flush) {}
 
 Result<CandumpWriter> CandumpWriter::create(const std::filesystem::path& path, Flush flush, bool append) {
-  auto file = std::make_unique<std::ofstream>(path, append ? std::ios::app : std::ios::trunc);
-  if (!*file)
-    return Error(CanErrc::io, fmt::format("cannot write candump log {}: {}", path.string(), std::strerror(errno)));
-  return CandumpWriter(std::move(file), path.string(), flush);
+  return create(path, core::RotationLimits{}, flush, append);
 }
 
-Result<void> CandumpWriter::put(const std::string& line) {
-  *out_ << line << '\n';
-  if (flush_ == Flush::every_line) out_->flush();
-  if (!*out_) return Error(CanErrc::io, fmt::format("writing candump log {} failed (disk full?)", name_));
+Result<CandumpWriter> CandumpWriter::create(const std::filesystem::path& path, core::RotationLimits limits, Flush flush,
+                                            bool append) {
+  auto file = core::RotatingFile::open(path, limits, core::steady_now(), {}, append);
+  if (!file) {
+    if (file.error() == CoreErrc::io)
+      return Error(CanErrc::io, fmt::format("candump log: {}", file.error().detail));
+    return file.error();
+  }
+  return CandumpWriter(std::move(file).value(), flush);
+}
+
+Result<void> CandumpWriter::put(std::string line) {
+  line.push_back('\n');
+  if (file_) {
+    auto written = file_->write(line, core::steady_now());
+    if (written && flush_ == Flush::every_line) written = file_->flush();
+    if (!written) return Error(CanErrc::io, fmt::format("writing candump log {} failed: {}", name_, written.error().message()));
+  } else {
+    *out_ << line;
+    if (flush_ == Flush::every_line) out_->flush();
+    if (!*out_) return Error(CanErrc::io, fmt::format("writing candump log {} failed (disk full?)", name_));
+  }
   ++lines_;
   return ok();
 }
@@ -269,6 +284,11 @@ Result<void> CandumpWriter::write(const Frame& frame, std::string_view iface) {
 Result<void> CandumpWriter::write(const LogEntry& entry) { return put(format_candump_line(entry)); }
 
 Result<void> CandumpWriter::flush() {
+  if (file_) {
+    auto r = file_->flush();
+    if (!r) return Error(CanErrc::io, fmt::format("flushing candump log {} failed: {}", name_, r.error().message()));
+    return ok();
+  }
   out_->flush();
   if (!*out_) return Error(CanErrc::io, fmt::format("flushing candump log {} failed (disk full?)", name_));
   return ok();

@@ -14,6 +14,7 @@
 #pragma once
 
 #include "can/frame.hpp"
+#include "core/rotating_file.hpp"
 
 #include <cstdint>
 #include <filesystem>
@@ -62,6 +63,10 @@ class CandumpWriter {
   // Creates (or appends to) a file. Errors: io, naming the file.
   static Result<CandumpWriter> create(const std::filesystem::path& path, Flush flush = Flush::every_line,
                                       bool append = false);
+  // The same with a size and/or age limit: the file rotates (NAME.1, NAME.2, ...; see
+  // core/rotating_file.hpp) instead of growing without end. Errors: io, or invalid limits.
+  static Result<CandumpWriter> create(const std::filesystem::path& path, core::RotationLimits limits,
+                                      Flush flush = Flush::every_line, bool append = false);
 
   CandumpWriter(CandumpWriter&&) noexcept = default;
   CandumpWriter& operator=(CandumpWriter&&) noexcept = default;
@@ -71,13 +76,15 @@ class CandumpWriter {
   Result<void> flush();
 
   [[nodiscard]] std::uint64_t lines_written() const noexcept { return lines_; }
+  // Rotations so far (0 for a stream or a file without limits).
+  [[nodiscard]] std::uint64_t rotations() const noexcept { return file_ ? file_->rotations() : 0; }
 
  private:
-  CandumpWriter(std::unique_ptr<std::ofstream> file, std::string name, Flush flush);
-  Result<void> put(const std::string& line);
+  CandumpWriter(core::RotatingFile file, Flush flush);
+  Result<void> put(std::string line);
 
-  std::unique_ptr<std::ofstream> file_;
-  std::ostream* out_;
+  std::optional<core::RotatingFile> file_;
+  std::ostream* out_ = nullptr;
   std::string name_;
   Flush flush_;
   std::uint64_t lines_ = 0;

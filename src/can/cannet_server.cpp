@@ -59,9 +59,10 @@ bool filter_passes(const std::vector<CanFilterAdd>& filters, const Frame& f) {
 
 struct CanNetGatewayEmulator::Impl : std::enable_shared_from_this<CanNetGatewayEmulator::Impl> {
   struct Connection {
-    Connection(tcp::socket s, std::uint64_t n) : socket(std::move(s)), id(n) {}
+    Connection(tcp::socket s, std::uint64_t n, std::string p) : socket(std::move(s)), id(n), peer(std::move(p)) {}
     tcp::socket socket;
     std::uint64_t id;
+    std::string peer;               // the client's address, for the log
     bool open = true;
     std::string out;                // lines waiting for the writer
     core::Wakeup* writer_idle = nullptr;  // the writer, when it has nothing to write
@@ -98,6 +99,12 @@ struct CanNetGatewayEmulator::Impl : std::enable_shared_from_this<CanNetGatewayE
 
   Result<void> start();
   void stop();
+  // "HOST:PORT" where it listens, for log lines.
+  [[nodiscard]] std::string local_text() const {
+    boost::system::error_code ec;
+    const auto ep = acceptor.local_endpoint(ec);
+    return ec ? options.bind_address : net::Endpoint{ep.address().to_string(), ep.port()}.to_string();
+  }
 
   static asio::awaitable<void> run_acceptor(std::shared_ptr<Impl> self);
   static asio::awaitable<void> run_reader(std::shared_ptr<Impl> self, std::shared_ptr<Connection> conn);
@@ -196,18 +203,23 @@ asio::awaitable<void> CanNetGatewayEmulator::Impl::run_acceptor(std::shared_ptr<
 }
 
 void CanNetGatewayEmulator::Impl::attach(tcp::socket socket) {
-  if (client) {
-    ++stats.replaced;
-    drop(client, "replaced by a newer connection");
-  }
-  for (auto& c : chan) c.reset();
   boost::system::error_code ignored;
   socket.set_option(tcp::no_delay(true), ignored);
-  const auto peer = socket.remote_endpoint(ignored);
-  auto conn = std::make_shared<Connection>(std::move(socket), next_connection++);
+  const auto remote = socket.remote_endpoint(ignored);
+  const std::string peer = net::Endpoint{remote.address().to_string(), remote.port()}.to_string();
+  if (client) {
+    // As the device does: the newest connection wins. Its ASCII protocol has no message for this,
+    // so the old client only sees its connection closed; the log says who took over.
+    ++stats.replaced;
+    spdlog::warn("CAN@net emulator {}: client {} takes over from client {}, whose connection is closed",
+                 local_text(), peer, client->peer);
+    drop(client, fmt::format("replaced by a newer connection from {}", peer));
+  }
+  for (auto& c : chan) c.reset();
+  auto conn = std::make_shared<Connection>(std::move(socket), next_connection++, peer);
   client = conn;
   ++stats.connections;
-  spdlog::debug("CAN@net emulator: client {}:{} connected", peer.address().to_string(), peer.port());
+  spdlog::debug("CAN@net emulator {}: client {} connected", local_text(), peer);
   asio::co_spawn(executor, run_reader(shared_from_this(), conn), asio::detached);
   asio::co_spawn(executor, run_writer(shared_from_this(), conn), asio::detached);
 }
@@ -215,7 +227,7 @@ void CanNetGatewayEmulator::Impl::attach(tcp::socket socket) {
 void CanNetGatewayEmulator::Impl::drop(std::shared_ptr<Connection> conn, std::string_view why) {
   if (!conn->open) return;
   conn->open = false;
-  spdlog::debug("CAN@net emulator: connection {} closed: {}", conn->id, why);
+  spdlog::debug("CAN@net emulator: connection {} ({}) closed: {}", conn->id, conn->peer, why);
   boost::system::error_code ignored;
   conn->socket.shutdown(tcp::socket::shutdown_both, ignored);
   conn->socket.close(ignored);

@@ -8,7 +8,10 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ringbuffer_sink.h>
+#include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -188,6 +191,47 @@ TEST(CanNetEmulator, NewConnectionReplacesTheOldOneAndResetsState) {
     EXPECT_EQ(b.emulator->stats().replaced, 1u);
     EXPECT_TRUE(b.emulator->has_client());
   });
+}
+
+// Collects what is logged while it lives (on the default logger).
+struct LogCapture {
+  std::shared_ptr<spdlog::sinks::ringbuffer_sink_mt> sink = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(64);
+  LogCapture() { spdlog::default_logger()->sinks().push_back(sink); }
+  ~LogCapture() {
+    auto& sinks = spdlog::default_logger()->sinks();
+    sinks.erase(std::remove(sinks.begin(), sinks.end(), sink), sinks.end());
+  }
+  [[nodiscard]] std::vector<std::string> warnings() const {
+    std::vector<std::string> out;
+    for (const auto& m : sink->last_raw()) {
+      if (m.level == spdlog::level::warn) out.emplace_back(m.payload.data(), m.payload.size());
+    }
+    return out;
+  }
+};
+
+TEST(CanNetEmulator, TakeoverIsLoggedNamingBothClientsAndTheOldOneSeesItsConnectionEnd) {
+  LogCapture log;
+  EmulatorBench b;
+  std::string first_peer, second_peer;
+  run(b.io, [&]() -> asio::awaitable<void> {
+    LineClient first(b.io.get_executor());
+    CO_ASSERT_TRUE(co_await first.connect(b.emulator->local_endpoint()));
+    CO_ASSERT_TRUE(co_await set_up(first, 1));
+    LineClient second(b.io.get_executor());
+    CO_ASSERT_TRUE(co_await second.connect(b.emulator->local_endpoint()));
+    first_peer = first.local();
+    second_peer = second.local();
+    // The device's protocol has no line for "taken over": the old client reads the end of its stream.
+    EXPECT_EQ(co_await first.read_line(), std::nullopt);
+    EXPECT_TRUE(first.closed());
+    EXPECT_EQ(co_await second.ask("CAN 1 STATUS"), "R CAN 1 ----I 100");
+  });
+  const auto warnings = log.warnings();
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("client " + second_peer + " takes over from client " + first_peer), std::string::npos)
+      << warnings[0];
+  EXPECT_NE(warnings[0].find(b.emulator->local_endpoint().to_string()), std::string::npos) << warnings[0];
 }
 
 TEST(CanNetEmulator, FaultHooksSendEventsAndHoldTheChannel) {

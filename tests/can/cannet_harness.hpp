@@ -106,6 +106,12 @@ class LineClient {
   }
 
   [[nodiscard]] bool closed() const noexcept { return closed_; }
+  // "HOST:PORT" of this end of the connection.
+  [[nodiscard]] std::string local() const {
+    boost::system::error_code ec;
+    const auto ep = socket_.local_endpoint(ec);
+    return ec ? std::string("?") : net::Endpoint{ep.address().to_string(), ep.port()}.to_string();
+  }
   void close() {
     boost::system::error_code ignored;
     socket_.close(ignored);

@@ -32,6 +32,15 @@ class PlcEmulator::Impl {
   void shutdown() noexcept;
   void loop();
   void serve(int fd, std::vector<int>& clients, fd_set& all);
+  // "HOST:PORT" of a client socket.
+  static std::string peer_of(int fd) {
+    sockaddr_in addr{};
+    socklen_t len = sizeof addr;
+    if (getpeername(fd, reinterpret_cast<sockaddr*>(&addr), &len) != 0) return "?";
+    char text[INET_ADDRSTRLEN] = {};
+    inet_ntop(AF_INET, &addr.sin_addr, text, sizeof text);
+    return fmt::format("{}:{}", text, ntohs(addr.sin_port));
+  }
   // Under the lock.
   void apply_script_locked();
   void write_input_locked(const AnalogInput& in, std::optional<double> v) {
@@ -139,6 +148,13 @@ void PlcEmulator::Impl::serve(int fd, std::vector<int>& clients, fd_set& all) {
   const int rc = modbus_receive(ctx, query.data());
   if (rc == 0) return;  // not for this server (another unit id): ignored, as the PLC does
   if (rc < 0) {
+    // The client left, or sent what is not a Modbus TCP request (libmodbus cannot resync the
+    // stream, so the connection ends). Either way nothing in the map changed.
+    if (errno != ECONNRESET) {
+      std::lock_guard lock(mu);
+      ++counters.bad_requests;
+      spdlog::warn("plc emulator: client {}: {}; connection closed", peer_of(fd), modbus_strerror(errno));
+    }
     ::close(fd);
     FD_CLR(fd, &all);
     clients.erase(std::remove(clients.begin(), clients.end(), fd), clients.end());
@@ -160,6 +176,9 @@ void PlcEmulator::Impl::serve(int fd, std::vector<int>& clients, fd_set& all) {
       }
     }
   }
+  // Any client may switch the relays (Modbus has no sessions): say who did, so that a change
+  // nobody expected can be traced.
+  for (const auto& e : events) spdlog::info("plc emulator: client {} switched {} {}", peer_of(fd), e.relay.to_string(), e.on ? "on" : "off");
   dispatch(events);
 }
 

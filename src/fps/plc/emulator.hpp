@@ -3,6 +3,11 @@
 // registers the host reads. Several clients may be connected at once.
 //
 // Hooks, for `axon sim fps` and tests:
+// Any client may write the coils, as on the real PLC (Modbus has no sessions): every change a
+// client makes is logged at info level with its address. Requests libmodbus answers with an
+// exception (unknown function, address out of the map) keep the connection; a frame that is not
+// Modbus TCP at all is counted (bad_requests), logged and ends that connection only.
+//
 //   - on_relay_change(handler): called once per coil that a client's write changed, with the
 //     relay and its new state (sync line: on = high; a rising edge is on == true). Handlers run on
 //     the server thread, or, when EmulatorOptions::hook_executor is set, are posted to that
@@ -57,6 +62,7 @@ struct EmulatorCounters {
   std::uint64_t connections = 0;
   std::uint64_t requests = 0;
   std::uint64_t relay_changes = 0;
+  std::uint64_t bad_requests = 0;   // frames that are not Modbus TCP requests (the connection is closed)
 };
 
 class PlcEmulator {

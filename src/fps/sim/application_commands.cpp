@@ -60,8 +60,12 @@ Outbox PositionerModel::handle(const proto::Message& m, SimTime now) {
     return out;
   }
   const auto mode = run_ == RunState::bootloader ? proto::Mode::bootloader : proto::Mode::application;
-  const auto verdict =
+  auto verdict =
       proto::check_device_request(m.id.command, mode, m.id.is_broadcast(), m.payload.size(), config_.device_options);
+  if (mode == proto::Mode::application && verdict.command != nullptr &&
+      !firmware_takes(verdict.command->id, flash_.main.version, config_.firmware_history)) {
+    verdict.code = ResponseCode::unknown_command;  // a number this version has never heard of
+  }
   if (verdict.code != ResponseCode::accepted) {
     reply(m, verdict.code, out);
     return out;
@@ -108,6 +112,9 @@ ResponseCode PositionerModel::motion_check(Activity kind, PerArm<bool> arms) con
 }
 
 ResponseCode PositionerModel::start_trajectory(SimTime t) {
+  if (!upload_.loaded && config_.start_without_trajectory == EmptyStart::accept) {
+    return ResponseCode::accepted;  // nothing to start: the robot stays as it is, whatever it does
+  }
   if (const auto code = motion_check(Activity::trajectory, {{true, true}}); code != ResponseCode::accepted) {
     return code;
   }

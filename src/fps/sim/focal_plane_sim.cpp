@@ -6,12 +6,14 @@
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
+#include <boost/asio/ip/address_v4.hpp>
 #include <boost/asio/redirect_error.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/use_awaitable.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <optional>
 #include <random>
 
 namespace axon::fps::sim {
@@ -31,7 +33,46 @@ Result<std::set<std::uint16_t>> read_ids(const core::ConfigNode& node, std::stri
   return out;
 }
 
+// The IPv4 address `k` after `first`, if both are IPv4 and the sum does not overflow.
+std::optional<std::string> ipv4_plus(const std::string& first, std::size_t k) {
+  boost::system::error_code ec;
+  const auto a = asio::ip::make_address_v4(first, ec);
+  if (ec || a.is_unspecified()) return std::nullopt;
+  const std::uint64_t v = std::uint64_t{a.to_uint()} + k;
+  if (v > 0xFFFF'FFFFu) return std::nullopt;
+  return asio::ip::address_v4(static_cast<std::uint32_t>(v)).to_string();
+}
+
 }  // namespace
+
+Result<std::map<std::uint16_t, net::Endpoint>> gateway_endpoints(const FocalPlane& plane, const GatewayBinding& binding) {
+  std::map<std::uint16_t, net::Endpoint> out;
+  std::set<std::pair<std::string, std::uint16_t>> taken;
+  boost::system::error_code ec;
+  const auto first = asio::ip::make_address_v4(binding.address, ec);
+  const bool count_up = !ec && !first.is_unspecified();
+  std::size_t k = 0;
+  for (const auto& g : plane.gateways()) {
+    net::Endpoint ep;
+    if (binding.address == GatewayBinding::kLayoutAddresses) {
+      auto parsed = net::parse_endpoint(g.address, can::cannet::kDefaultPort);
+      if (!parsed)
+        return Error(CoreErrc::invalid_argument, fmt::format("gateway {}: address '{}': {}", g.id, g.address, parsed.error().message()));
+      ep = parsed.value();
+    } else {
+      const auto host = count_up ? ipv4_plus(binding.address, k) : binding.address;
+      if (!host)
+        return Error(CoreErrc::invalid_argument, fmt::format("gateway {}: no IPv4 address {} after {}", g.id, k, binding.address));
+      const auto port = binding.ports.find(g.id);
+      ep = net::Endpoint{*host, port == binding.ports.end() ? binding.port : port->second};
+    }
+    ++k;
+    if (ep.port != 0 && !taken.emplace(ep.host, ep.port).second)
+      return Error(CoreErrc::invalid_argument, fmt::format("gateways share the endpoint {}", ep.to_string()));
+    out[g.id] = ep;
+  }
+  return out;
+}
 
 Result<Scenario> Scenario::from_config(const core::ConfigNode& node) {
   AXON_TRY(node.reject_unknown({"datum_lost", "uncalibrated", "collided", "bootloader", "absent", "collide_on_move", "extra"}));
@@ -83,7 +124,7 @@ struct FocalPlaneSimulator::Impl {
   Result<void> start_gateway(std::size_t i) {
     auto& g = gateways[i];
     can::CanNetEmulatorOptions eo = options.gateway_options;
-    eo.bind_address = options.bind_address;
+    eo.bind_address = g.endpoint.host;
     eo.port = g.endpoint.port;
     std::vector<std::string> channels(static_cast<std::size_t>(kMaxGatewayChannels));
     for (const auto& [ch, name] : g.channels) channels[static_cast<std::size_t>(ch - 1)] = name;
@@ -270,12 +311,12 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
     asio::co_spawn(executor, Impl::watch_collisions(&s, s.alive, sc.collide_on_move), asio::detached);
 
   // Gateways: one emulator each, its channels are the layout's buses on it.
+  AXON_TRY(endpoints, gateway_endpoints(plane, o.binding));
   for (const auto& gw : plane.gateways()) {
     GatewayInfo g;
     g.id = gw.id;
     g.sextant = gw.sextant;
-    const auto port = o.gateway_ports.find(gw.id);
-    g.endpoint = net::Endpoint{o.bind_address, port == o.gateway_ports.end() ? std::uint16_t{0} : port->second};
+    g.endpoint = endpoints.at(gw.id);
     for (const auto& b : buses) {
       if (b.gateway == gw.id) g.channels.emplace_back(b.channel, medium_name(b));
     }

@@ -40,6 +40,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,24 @@ struct Scenario {
   static Result<Scenario> from_config(const core::ConfigNode& node);
 };
 
+// Where the gateway emulators listen. Installations reach their six gateways at six addresses on
+// one port (19228); a host configured that way works unchanged against the simulator when each
+// emulator has its own address too.
+struct GatewayBinding {
+  // kLayoutAddresses: each gateway at the HOST:PORT its layout names (the port defaults to 19228).
+  // An IPv4 address: the layout's gateways, in layout order, at this address, the next one, ...
+  // (127.0.0.11 gives 127.0.0.11..127.0.0.16 for six; all of 127.0.0.0/8 is loopback on Linux).
+  // Any other host (0.0.0.0, a name, IPv6): every gateway on that one address.
+  static constexpr std::string_view kLayoutAddresses = "layout";
+  std::string address = "127.0.0.1";
+  std::uint16_t port = 0;                          // every gateway on this port (0: any free one)
+  std::map<std::uint16_t, std::uint16_t> ports;    // per gateway id, instead of `port`
+};
+
+// The endpoint of every gateway of `plane` under `binding`. Errors (CoreErrc::invalid_argument): a
+// layout address that does not parse, counting beyond 255.255.255.255, two gateways on one endpoint.
+Result<std::map<std::uint16_t, net::Endpoint>> gateway_endpoints(const FocalPlane& plane, const GatewayBinding& binding);
+
 struct FocalPlaneSimOptions {
   SimulatorOptions simulator;            // time scale, collision step, ...
   std::uint64_t seed = 1;                // random start positions, per-robot noise
@@ -73,11 +92,10 @@ struct FocalPlaneSimOptions {
   // many of them. The CPU a wake-up costs (a timer system call, dear on a VM) was a third of the
   // simulator's thread at 170 000 frames/s. 0: every deadline waited for exactly.
   core::Duration timer_slack = std::chrono::microseconds(200);
-  std::string bind_address = "127.0.0.1";
-  std::map<std::uint16_t, std::uint16_t> gateway_ports;  // per layout gateway id; 0 or absent: any free port
+  GatewayBinding binding;                // where the gateway emulators listen
   bool plc = true;                       // run the PLC emulator
   plc::EmulatorOptions plc_options;      // bind address and port, register map, sensor script
-  can::CanNetEmulatorOptions gateway_options;  // bind address and port are set per gateway
+  can::CanNetEmulatorOptions gateway_options;  // bind address and port are set per gateway (binding)
   PositionerConfig defaults;             // for every robot (id, position, seed are set per robot)
   Scenario scenario;
 };

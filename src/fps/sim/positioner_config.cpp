@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
+#include <utility>
 #include <string>
 
 namespace axon::fps::sim {
@@ -45,11 +47,40 @@ Result<protocol::FirmwareVersion> version(const core::ConfigNode& node, std::str
   return v.value();
 }
 
+template <class E>
+Result<E> choice(const core::ConfigNode& node, std::string_view key,
+                 std::initializer_list<std::pair<std::string_view, E>> names) {
+  AXON_TRY(c, node.child(key));
+  AXON_TRY(text, c.as<std::string>());
+  std::string all;
+  for (const auto& [name, value] : names) {
+    if (text == name) return value;
+    all += fmt::format("{}{}", all.empty() ? "" : " or ", name);
+  }
+  return c.error(CoreErrc::config_bad_value, fmt::format("expected {}", all));
+}
+
 }  // namespace
+
+bool firmware_takes(protocol::CommandId c, protocol::FirmwareVersion version, FirmwareHistory history) noexcept {
+  using protocol::CommandId;
+  switch (c) {
+    case CommandId::switch_on_precise_move_alpha:
+    case CommandId::switch_off_precise_move_alpha:
+    case CommandId::switch_on_precise_move_beta:
+    case CommandId::switch_off_precise_move_beta:
+      return history == FirmwareHistory::document || version.has_precise_move_switches();
+    default: return true;
+  }
+}
 
 Result<void> PositionerConfig::validate() const {
   if (id < 1 || id > 2047) return bad("id", fmt::format("{} is not within 1..2047", id));
   if (firmware.is_bootloader()) return bad("firmware", "must not have the bootloader's middle number 80");
+  if (firmware < kOldestModelledFirmware) {
+    return bad("firmware", fmt::format("{} is older than {}: its status word layout is not modelled", firmware.to_string(),
+                                       kOldestModelledFirmware.to_string()));
+  }
   if (!bootloader.is_bootloader()) return bad("bootloader", "must have the middle number 80");
   if (!finite_in(gear_ratio, 1e-3, 1e6)) return bad("gear_ratio", "must be positive");
   for (Arm a : kArms) {
@@ -91,7 +122,7 @@ Result<void> PositionerConfig::validate() const {
 
 namespace {
 constexpr std::string_view kKeys[] = {
-    "id", "firmware", "bootloader", "get_holding_current_on_112", "gear_ratio", "hard_stop_lower_deg",
+    "id", "firmware", "bootloader", "get_holding_current_on_112", "firmware_history", "start_without_trajectory", "gear_ratio", "hard_stop_lower_deg",
     "hard_stop_upper_deg", "default_speed_rpm", "min_speed_rpm", "max_speed_rpm", "max_current_percent",
     "default_drive_current_percent", "precise_approach_deg", "datum_backoff_deg", "motor_calibration_turns",
     "datum_spread_motor_deg", "motors_calibrated", "datums_calibrated", "cogging_calibrated", "datums_initialized",
@@ -143,6 +174,18 @@ Result<PositionerConfig> PositionerConfig::from_config(const core::ConfigNode& n
     c.bootloader = v;
   }
   AXON_TRY(num("get_holding_current_on_112", c.device_options.get_holding_current_on_112));
+  if (node.has("firmware_history")) {
+    const auto v = choice<FirmwareHistory>(node, "firmware_history",
+                                           {{"document", FirmwareHistory::document}, {"field", FirmwareHistory::field}});
+    if (!v) return v.error();
+    c.firmware_history = v.value();
+  }
+  if (node.has("start_without_trajectory")) {
+    const auto v = choice<EmptyStart>(node, "start_without_trajectory",
+                                      {{"accept", EmptyStart::accept}, {"refuse", EmptyStart::refuse}});
+    if (!v) return v.error();
+    c.start_without_trajectory = v.value();
+  }
   AXON_TRY(num("gear_ratio", c.gear_ratio));
   AXON_TRY(arms("hard_stop_lower_deg", c.hard_stop_lower_deg));
   AXON_TRY(arms("hard_stop_upper_deg", c.hard_stop_upper_deg));

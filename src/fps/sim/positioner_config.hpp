@@ -22,12 +22,41 @@ namespace axon::fps::sim {
 
 using namespace std::chrono_literals;
 
+// START_TRAJECTORY (or the sync line) while no trajectory is loaded. The interface document says
+// only that the command starts a loaded trajectory (5.3.8, 6, 7.2). Robots in service answer
+// COMMAND_ACCEPTED and stay where they are, which host software in service relies on when it moves
+// a subset of the plane with one broadcast (it waits for every robot's acceptance).
+enum class EmptyStart : std::uint8_t {
+  accept,  // code 0, nothing moves (robots in service; the default)
+  refuse,  // code 2 INVALID_TRAJECTORY (the simulator's behaviour before issue 14)
+};
+
+// Which commands an application firmware version takes beyond the document's table 6.
+enum class FirmwareHistory : std::uint8_t {
+  document,  // every command of table 6 (which describes 04.01.13) in every version modelled
+  field,     // as above, but the precise-move switches 128..131 only from 04.01.17 on (FIELD-NOTES:
+             // hosts in service send them from that version); older versions answer 13, unknown
+};
+
+// The oldest application firmware modelled: from 04.01.00 on the status word is the 64-bit one of
+// the document (FIELD-NOTES); the 32-bit layout of older versions is not described anywhere we can
+// cite, so older versions are refused rather than answered wrongly.
+inline constexpr protocol::FirmwareVersion kOldestModelledFirmware{4, 1, 0};
+
+// Does application firmware `version` know command `c` at all? A command it does not know is
+// answered 13 (UNKNOWN_COMMAND, table 3); check_device_request decides the rest (mode, broadcast,
+// size).
+[[nodiscard]] bool firmware_takes(protocol::CommandId c, protocol::FirmwareVersion version,
+                                  FirmwareHistory history) noexcept;
+
 struct PositionerConfig {
   // Identity.
   std::uint16_t id = 1;                                    // 1..2047
   protocol::FirmwareVersion firmware{4, 1, 13};            // main application at power-up
   protocol::FirmwareVersion bootloader{3, 80, 1};          // middle number 80
   protocol::DeviceOptions device_options{};                // firmware quirks (112 read as a get)
+  FirmwareHistory firmware_history = FirmwareHistory::document;  // commands per version
+  EmptyStart start_without_trajectory = EmptyStart::accept;   // START_TRAJECTORY with nothing loaded
 
   // Mechanics.
   double gear_ratio = 1000.0;                              // motor turns per arm turn
@@ -83,7 +112,8 @@ struct PositionerConfig {
   [[nodiscard]] Result<void> validate() const;
 
   // Reads the keys present in `node` on top of `base` (unknown keys are errors). Keys: id, firmware
-  // ("04.01.13"), bootloader, get_holding_current_on_112, gear_ratio, hard_stop_lower_deg and
+  // ("04.01.13"), bootloader, get_holding_current_on_112, firmware_history (document | field),
+  // start_without_trajectory (accept | refuse), gear_ratio, hard_stop_lower_deg and
   // hard_stop_upper_deg ([alpha, beta] or one number), default_speed_rpm, min_speed_rpm,
   // max_speed_rpm, max_current_percent, default_drive_current_percent, precise_approach_deg,
   // datum_backoff_deg, motor_calibration_turns, datum_spread_motor_deg, motors_calibrated,

@@ -51,7 +51,8 @@ TEST(FpsSimCodes, BroadcastCommandsAreTakenAsBroadcast) {
   Harness fresh;
   auto out = fresh.send(CommandId::start_trajectory, {}, 0);
   ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(out[0].id.response, ResponseCode::invalid_trajectory);  // broadcast is fine; nothing loaded
+  EXPECT_EQ(out[0].id.response, ResponseCode::accepted);  // broadcast is fine; nothing loaded, nothing moves
+  EXPECT_FALSE(fresh.model.moving());
 }
 
 TEST(FpsSimCodes, BootloaderCommandsInTheApplicationAreCode12) {

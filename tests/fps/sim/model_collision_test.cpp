@@ -105,7 +105,8 @@ TEST(FpsSimCollision, CollisionDuringATrajectoryStopsBothArms) {
   EXPECT_NEAR(h.position().first, 50, 1e-3);
   EXPECT_NEAR(h.position().second, 130, 1e-3);
   EXPECT_EQ(h.code(CommandId::stop_trajectory), ResponseCode::accepted);
-  EXPECT_EQ(h.code(CommandId::start_trajectory), ResponseCode::invalid_trajectory);  // nothing left to resume
+  EXPECT_EQ(h.code(CommandId::start_trajectory), ResponseCode::accepted);  // nothing left to resume
+  EXPECT_FALSE(h.model.moving());
 }
 
 TEST(FpsSimCollision, NothingWhenNotInTheApplication) {

@@ -65,7 +65,9 @@ TEST(FpsSimTrajectory, PointTooFastIsOutOfRangeAndSpoilsTheEnd) {
   const auto codes = upload(h, {{40, 1}}, {});
   EXPECT_EQ(codes[1], ResponseCode::value_out_of_range);
   EXPECT_EQ(h.code(CommandId::trajectory_data_end), ResponseCode::invalid_trajectory);
-  EXPECT_EQ(h.code(CommandId::start_trajectory), ResponseCode::invalid_trajectory);
+  // The spoiled trajectory was dropped: a start finds nothing to run.
+  EXPECT_EQ(h.code(CommandId::start_trajectory), ResponseCode::accepted);
+  EXPECT_FALSE(h.model.moving());
 }
 
 TEST(FpsSimTrajectory, SpeedIsCheckedBetweenPointsToo) {
@@ -124,9 +126,36 @@ TEST(FpsSimTrajectory, AnnouncingAgainRestartsTheCount) {
   EXPECT_EQ(h.code(CommandId::trajectory_data_end), ResponseCode::accepted);
 }
 
-TEST(FpsSimTrajectory, StartWithoutTrajectoryIsInvalid) {
-  Harness h;
+TEST(FpsSimTrajectory, StartWithoutTrajectoryIsAcceptedAndTheRobotStays) {
+  Harness h;  // the default: as robots in service do
+  const auto before = h.position();
+  EXPECT_EQ(h.code(CommandId::start_trajectory), ResponseCode::accepted);
+  EXPECT_FALSE(h.model.moving());
+  h.wait(5s);
+  EXPECT_EQ(h.position(), before);
+  EXPECT_TRUE(h.status().has(StatusBit::displacement_completed));
+}
+
+TEST(FpsSimTrajectory, StartWithoutTrajectoryAnswersEveryRobotOfABroadcastWithAcceptance) {
+  // What a host in service relies on when it moves a subset with one START_TRAJECTORY broadcast.
+  Harness loaded(test_config(1)), idle(test_config(2));
+  ASSERT_TRUE(all_accepted(upload(loaded, {{10, 1}}, {})));
+  ASSERT_EQ(loaded.code(CommandId::trajectory_data_end), ResponseCode::accepted);
+  for (Harness* h : {&loaded, &idle}) {
+    const auto out = h->send(CommandId::start_trajectory, {}, 0);
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_EQ(out[0].id.response, ResponseCode::accepted) << "robot " << h->id();
+  }
+  EXPECT_TRUE(loaded.model.moving());
+  EXPECT_FALSE(idle.model.moving());
+}
+
+TEST(FpsSimTrajectory, StartWithoutTrajectoryIsInvalidWhenConfiguredSo) {
+  auto c = test_config();
+  c.start_without_trajectory = EmptyStart::refuse;
+  Harness h(c);
   EXPECT_EQ(h.code(CommandId::start_trajectory), ResponseCode::invalid_trajectory);
+  EXPECT_EQ(h.model.sync_pulse(h.now).at(0).id.response, ResponseCode::invalid_trajectory);
 }
 
 TEST(FpsSimTrajectory, FirstPointIsCheckedAgainAtTheStartFromWhereTheArmIsThen) {
@@ -147,7 +176,9 @@ TEST(FpsSimTrajectory, StopInterruptsAndDropsTheTrajectory) {
   ASSERT_EQ(h.code(CommandId::stop_trajectory), ResponseCode::accepted);
   h.wait(10s);
   EXPECT_NEAR(h.position().first, 45, 1e-3);
-  EXPECT_EQ(h.code(CommandId::start_trajectory), ResponseCode::invalid_trajectory);
+  EXPECT_EQ(h.code(CommandId::start_trajectory), ResponseCode::accepted);  // nothing left to run
+  h.wait(10s);
+  EXPECT_NEAR(h.position().first, 45, 1e-3);
 }
 
 TEST(FpsSimTrajectory, AbortDuringUploadDropsIt) {
@@ -168,10 +199,19 @@ TEST(FpsSimTrajectory, SyncPulseStartsWithUidZero) {
   EXPECT_EQ(out[0].id.uid, 0);
   EXPECT_EQ(out[0].id.response, ResponseCode::accepted);
   EXPECT_TRUE(h.model.moving());
-  // A second pulse finds nothing loaded (and the robot moving).
+  // A second pulse finds nothing loaded: accepted, and the running trajectory goes on.
   out = h.model.sync_pulse(h.now);
   ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(out[0].id.response, ResponseCode::already_in_motion);
+  EXPECT_EQ(out[0].id.response, ResponseCode::accepted);
+  EXPECT_TRUE(h.model.moving());
+  // With the old behaviour the motion check comes first.
+  auto c = test_config();
+  c.start_without_trajectory = EmptyStart::refuse;
+  Harness old(c);
+  ASSERT_TRUE(all_accepted(upload(old, {{10, 1}}, {})));
+  ASSERT_EQ(old.code(CommandId::trajectory_data_end), ResponseCode::accepted);
+  ASSERT_EQ(old.model.sync_pulse(old.now).at(0).id.response, ResponseCode::accepted);
+  EXPECT_EQ(old.model.sync_pulse(old.now).at(0).id.response, ResponseCode::already_in_motion);
 }
 
 TEST(FpsSimTrajectory, UploadNeedsTheDatum) {
