@@ -6,6 +6,7 @@
 #include "can/relay.hpp"
 #include "can/socketcand_server.hpp"
 #include "can/virtual_bus.hpp"
+#include "checks.hpp"
 #include "commands.hpp"
 #include "core/clock.hpp"
 #include "run.hpp"
@@ -69,7 +70,10 @@ int run_dump(const DumpOptions& o) {
       limits.keep = o.log_keep;
       log.emplace(need(can::CandumpWriter::create(o.log, limits)));
     }
-    set_on_signal([&] { bus->close(); });
+    set_on_signal([&] {
+      signal_is_normal_end().store(true);  // a dump runs until Ctrl-C: that is its normal end
+      bus->close();
+    });
     spdlog::info("dump: receiving on {}{}", spec.to_string(), o.log.empty() ? "" : " (logging to " + o.log + ")");
 
     const auto name = spec.short_name();
@@ -85,7 +89,7 @@ int run_dump(const DumpOptions& o) {
       if (!f) {
         if (f.error() == can::CanErrc::timeout && o.count > 0) {
           spdlog::error("dump: {} of {} frames within {} s", n, o.count, o.timeout_s);
-          rc = 3;
+          rc = exit_code_value::failed;
         } else if (f.error() != can::CanErrc::timeout && f.error() != can::CanErrc::closed) {
           spdlog::error("dump: {}", f.error().message());
           rc = 1;
@@ -346,8 +350,8 @@ void add_can_commands(CLI::App& app, GlobalOptions&) {
   auto* s = can_cmd->add_subcommand("send", "send frames given as ID#DATA (cansend notation)");
   s->add_option("-b,--bus", send.bus, kBusHelp)->required();
   s->add_option("frames", send.frames, "frames: 123#DEADBEEF, 12345678#00.11, 123#R, 123#R4")->required();
-  s->add_option("-r,--repeat", send.repeat, "send the list this many times")->check(CLI::PositiveNumber);
-  s->add_option("-i,--interval", send.interval_ms, "milliseconds between frames")->check(CLI::NonNegativeNumber);
+  s->add_option("-r,--repeat", send.repeat, "send the list this many times")->check(positive());
+  s->add_option("-i,--interval", send.interval_ms, "milliseconds between frames")->check(non_negative());
   s->callback([] { exit_code() = run_send(send); });
 
   static BridgeOptions bridge;
@@ -367,7 +371,7 @@ void add_can_commands(CLI::App& app, GlobalOptions&) {
   r->add_option("file", replay.file, "candump log file")->required();
   r->add_option("--speed", replay.speed, "time scale: 2 plays twice as fast");
   r->add_flag("--no-timing", replay.no_timing, "send as fast as the bus takes them");
-  r->add_option("--loop", replay.loops, "play the file this many times")->check(CLI::PositiveNumber);
+  r->add_option("--loop", replay.loops, "play the file this many times")->check(positive());
   r->add_option("--only", replay.only_iface, "only frames logged on this interface");
   r->add_flag("--skip-bad", replay.skip_bad, "skip malformed lines (counted) instead of stopping at the first");
   r->callback([] { exit_code() = run_replay(replay); });

@@ -2,9 +2,11 @@
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "exit_codes.hpp"
 
 #include <fmt/format.h>
 
+#include <csignal>
 #include <cstdio>
 #include <exception>
 
@@ -13,10 +15,26 @@ int& exit_code() {
   static int code = 0;
   return code;
 }
+// Errors that mean "the input was wrong" (option values, files): nothing was done.
+bool is_usage_error(std::error_code ec) {
+  if (ec.category() != axon::core_category()) return false;
+  using axon::CoreErrc;
+  switch (static_cast<CoreErrc>(ec.value())) {
+    case CoreErrc::invalid_argument:
+    case CoreErrc::config_syntax:
+    case CoreErrc::config_missing_key:
+    case CoreErrc::config_bad_value:
+    case CoreErrc::config_unknown_key: return true;
+    default: return false;
+  }
+}
 }  // namespace axon::app
 
 int main(int argc, char** argv) {
   using namespace axon::app;
+  // A closed pipe (`axon ... | head`) must not kill a command that has devices to make safe: writes
+  // fail with EPIPE instead, and the command stops its devices and exits.
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"axon: host-side control of CAN and real-time UDP actuators (fps, blmc, c4g)", "axon"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "axon 0.1.0");
@@ -43,13 +61,14 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version end here too (CLI11 gives them code 0); every parse error is a usage error.
+    return app.exit(e) == 0 ? exit_code_value::ok : exit_code_value::usage;
   } catch (const axon::Exception& e) {
     std::fprintf(stderr, "axon: error: %s\n", e.what());
-    return 1;
+    return is_usage_error(e.code()) ? exit_code_value::usage : exit_code_value::failed;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "axon: internal error: %s\n", e.what());
-    return 2;
+    return exit_code_value::internal;
   }
   return exit_code();
 }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "core/error.hpp"
+#include "exit_codes.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/io_context.hpp>
@@ -10,6 +11,7 @@
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/use_awaitable.hpp>
 
+#include <atomic>
 #include <chrono>
 
 #include <csignal>
@@ -24,17 +26,27 @@ namespace asio = boost::asio;
 // A command-line mistake (bad option value, missing file): reported to the user as such.
 inline Error usage(std::string text) { return Error(CoreErrc::invalid_argument, std::move(text)); }
 
+// Set by a command whose normal end is a stop signal (servers, simulators, monitors that run until
+// Ctrl-C): its exit code stays the body's own instead of 128+N.
+inline std::atomic<bool>& signal_is_normal_end() noexcept {
+  static std::atomic<bool> normal{false};
+  return normal;
+}
+
 // Runs `body` to completion and returns its exit code; exceptions thrown inside are rethrown here
-// (axon::Exception becomes "axon: error: ..." in main). SIGINT/SIGTERM call `on_signal` (which
-// should close buses so that the body finishes normally and prints its summary); a second signal
-// stops at once.
+// (axon::Exception becomes "axon: error: ..." in main). SIGINT/SIGTERM/SIGHUP call `on_signal`, which
+// a command that drives devices sets to make them safe (stop the robots, zero the current) so that
+// the body finishes normally and prints what it stopped; without one, the first signal stops the
+// event loop. A second signal stops at once. A command ended by a signal exits 128+N (see
+// exit_codes.hpp) unless its normal end is a signal (signal_is_normal_end()).
 inline int run_command(const std::function<asio::awaitable<int>(asio::io_context&, std::function<void(std::function<void()>)>)>& body) {
   asio::io_context io;
-  asio::signal_set signals(io, SIGINT, SIGTERM);
+  asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);
   std::function<void()> on_signal = [&io] { io.stop(); };
   int signalled = 0;
-  std::function<void(const boost::system::error_code&, int)> handler = [&](const boost::system::error_code& ec, int) {
+  std::function<void(const boost::system::error_code&, int)> handler = [&](const boost::system::error_code& ec, int signo) {
     if (ec) return;
+    record_stop_signal(signo);
     if (signalled++ > 0) io.stop();
     else on_signal();
     signals.async_wait(handler);
@@ -51,18 +63,24 @@ inline int run_command(const std::function<asio::awaitable<int>(asio::io_context
                  });
   io.run();
   if (failure) std::rethrow_exception(failure);
+  const int signo = received_stop_signal().load();
+  if (signo != 0 && !signal_is_normal_end().load()) return signal_exit_code(signo);
   return rc;
 }
 
 // For servers and simulators that run until told to stop: waits for `duration_s` seconds (0 or less:
-// for ever) or until the first SIGINT/SIGTERM, whichever comes first. `set_on_signal` is the second
+// for ever) or until the first SIGINT/SIGTERM/SIGHUP, whichever comes first (a signal is then their
+// normal end: exit code 0). `set_on_signal` is the second
 // argument run_command gives the body (taken by value: no temporary lives across the co_await).
 template <class SetOnSignal>
 asio::awaitable<void> wait_for_stop(asio::io_context& io, double duration_s, SetOnSignal set_on_signal) {
   asio::steady_timer until(io, std::chrono::steady_clock::time_point::max());
   if (duration_s > 0) until.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                           std::chrono::duration<double>(duration_s)));
-  set_on_signal([&until] { until.cancel(); });
+  set_on_signal([&until] {
+    signal_is_normal_end().store(true);
+    until.cancel();
+  });
   boost::system::error_code ec;
   co_await until.async_wait(asio::redirect_error(asio::use_awaitable, ec));
   set_on_signal([] {});  // `until` is about to go; as before, the next signal does nothing and a second one stops

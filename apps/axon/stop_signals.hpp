@@ -1,7 +1,10 @@
 #pragma once
-// SIGINT/SIGTERM for commands whose main thread polls instead of running an io_context (the c4g
-// server and controller simulator: their loops run on plain threads). While a StopSignals object
-// lives, each signal bumps a counter and raises a flag; the destructor restores the default action.
+// SIGINT/SIGTERM/SIGHUP for commands whose main thread polls instead of running an io_context (the
+// c4g server and controller simulator: their loops run on plain threads). While a StopSignals object
+// lives, each signal bumps a counter, raises a flag and is recorded (received_stop_signal(), for the
+// exit code 128+N); the destructor restores the default action.
+#include "exit_codes.hpp"
+
 #include <atomic>
 #include <csignal>
 
@@ -15,18 +18,18 @@ class StopSignals {
     struct sigaction sa{};
     sa.sa_handler = &StopSignals::on_signal;
     sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, nullptr);
-    sigaction(SIGTERM, &sa, nullptr);
+    for (int s : kStopSignals) sigaction(s, &sa, nullptr);
   }
   ~StopSignals() {
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
+    for (int s : kStopSignals) std::signal(s, SIG_DFL);
   }
   StopSignals(const StopSignals&) = delete;
   StopSignals& operator=(const StopSignals&) = delete;
 
   // How many signals arrived (a second one usually means "stop now, skip the clean-up").
   int count() const noexcept { return count_().load(); }
+  // The first signal's number (0: none yet).
+  int signo() const noexcept { return received_stop_signal().load(); }
   // Raised by the first signal; loops that take an atomic<bool>* stop flag can watch it directly.
   std::atomic<bool>* flag() noexcept { return &flag_(); }
 
@@ -39,7 +42,8 @@ class StopSignals {
     static std::atomic<bool> f{false};
     return f;
   }
-  static void on_signal(int) noexcept {
+  static void on_signal(int signo) noexcept {
+    record_stop_signal(signo);
     count_().fetch_add(1);
     flag_().store(true);
   }
