@@ -264,6 +264,9 @@ struct ReplayOptions {
   bool skip_bad = false;
 };
 
+// Gaps in a log at least this long (after --speed) are announced before the wait.
+constexpr double kAnnouncedGap_s = 2.0;
+
 int run_replay(const ReplayOptions& o) {
   if (o.speed <= 0) throw Exception(Error(CoreErrc::invalid_argument, "--speed must be positive"));
   return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
@@ -272,8 +275,11 @@ int run_replay(const ReplayOptions& o) {
     auto r6 = co_await can::open_bus(ex, spec);
     auto bus = need(std::move(r6));
     bool stop = false;
-    set_on_signal([&] { stop = true; });
     asio::steady_timer timer(io);
+    set_on_signal([&] {
+      stop = true;
+      timer.cancel();  // a long gap in the log must not hold the stop back
+    });
     std::uint64_t sent = 0, skipped = 0;
     const auto t_start = std::chrono::steady_clock::now();
     auto next_progress = t_start + 2s;
@@ -292,7 +298,12 @@ int run_replay(const ReplayOptions& o) {
           if (!first) first = entry->frame.timestamp();
           const auto offset = std::chrono::duration_cast<core::Duration>((entry->frame.timestamp() - *first) / o.speed);
           timer.expires_at(loop_start + offset);
-          co_await timer.async_wait(asio::use_awaitable);
+          const auto gap = std::chrono::duration<double>(timer.expiry() - std::chrono::steady_clock::now()).count();
+          if (gap >= kAnnouncedGap_s)
+            spdlog::info("replay: waiting {:.1f} s for the next frame (line {})", gap, reader.lines_read());
+          boost::system::error_code ec;
+          co_await timer.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+          if (stop) break;
         }
         auto r7 = co_await bus->send(entry->frame);
         need(std::move(r7));
@@ -308,6 +319,7 @@ int run_replay(const ReplayOptions& o) {
     }
     auto r8 = co_await bus->flush(5s);
     need(std::move(r8));
+    if (stop) spdlog::warn("replay: stopped by {} before the end of {}", signal_name(received_stop_signal().load()), o.file);
     spdlog::info("replay: {} frames sent to {} in {:.3f} s ({} error frames or other interfaces skipped)", sent,
                  spec.to_string(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count(),
                  skipped);
