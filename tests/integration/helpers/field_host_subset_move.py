@@ -4,7 +4,7 @@ CAN@net ASCII protocol, against `axon sim fps` (or real gateways).
 
 usage: field_host_subset_move.py MOVER DELTA_DEG HOST:PORT [HOST:PORT ...]
 
-Every gateway is set up (channels 1..4), every robot found with a GET_ID broadcast (0.5 s window,
+Every gateway is set up (each of channels 1..4 that has a bus), every robot found with a GET_ID broadcast (0.5 s window,
 as in service). Robot MOVER gets a one-point trajectory (alpha + DELTA_DEG in 1 s), then
 START_TRAJECTORY is broadcast on every bus and, like the field software, the host waits for every
 robot's COMMAND_ACCEPTED: any other answer (or none) fails the move (exit 1, robots stopped).
@@ -34,6 +34,7 @@ class Gateway:
         self.name = endpoint
         self.sock = socket.create_connection((host, int(port)), timeout=5)
         self.buf = b""
+        self.pending = []  # frame lines read while waiting for a command's reply
 
     def line(self, timeout):
         self.sock.settimeout(max(timeout, 0.001))
@@ -56,6 +57,7 @@ class Gateway:
                 raise SystemExit(f"FAIL: {self.name}: no reply to '{text}'")
             if reply.startswith("R "):
                 return reply
+            self.pending.append(reply)
 
     def send(self, bus, identifier, payload=b""):
         data = " ".join(f"{b:02X}" for b in payload)
@@ -66,7 +68,7 @@ class Gateway:
         end = time.monotonic() + window
         out = []
         while (left := end - time.monotonic()) > 0:
-            text = self.line(left)
+            text = self.pending.pop(0) if self.pending else self.line(left)
             if text is None:
                 break
             parts = text.split()
@@ -97,11 +99,15 @@ def main():
     gateways = [Gateway(e) for e in endpoints]
     robots = {}  # id -> (gateway, bus)
     for gw in gateways:
+        gw.buses = []
         for bus in range(1, 5):
-            for cmd in ("STOP", "INIT STD 1000", "FILTER CLEAR", "FILTER ADD EXT 00000000 00000000", "START"):
+            if gw.command(f"CAN {bus} STOP") != "R ok":
+                continue  # a channel without a bus behind it
+            for cmd in ("INIT STD 1000", "FILTER CLEAR", "FILTER ADD EXT 00000000 00000000", "START"):
                 reply = gw.command(f"CAN {bus} {cmd}")
                 if reply != "R ok":
                     raise SystemExit(f"FAIL: {gw.name}: CAN {bus} {cmd}: {reply}")
+            gw.buses.append(bus)
             gw.send(bus, ident(0, GET_ID, 0))
         for bus, i, _ in gw.frames(0.5):
             pid, cmd, _, code = split(i)
@@ -120,7 +126,7 @@ def main():
             raise SystemExit(f"FAIL: robot {mover} refused command {cmd} with code {code}")
     print("loaded robot", mover)
     for g in gateways:
-        for b in range(1, 5):
+        for b in g.buses:
             g.send(b, ident(0, START, 0))
     codes = {}
     for g in gateways:
@@ -131,7 +137,7 @@ def main():
     refused = {pid: codes.get(pid) for pid in robots if codes.get(pid) != 0}
     if refused:
         for g in gateways:
-            for b in range(1, 5):
+            for b in g.buses:
                 g.send(b, ident(0, STOP, 0))
         detail = ", ".join(f"{pid}: {'no answer' if c is None else f'code {c}'}" for pid, c in sorted(refused.items()))
         print(f"FAIL: START_TRAJECTORY not accepted by every robot ({detail}); robots stopped")
