@@ -35,10 +35,10 @@ PY
 
 plc sync pulse --hold 0.05 >"$TMP/sync.out" 2>"$TMP/sync.err" || fail "sync pulse exited with $?"
 grep -q '^sync line low$' "$TMP/sync.out" || fail "sync pulse did not end low"
-wait_for_line "$TMP/plc.err" 'plc: positioner power 3 off' >/dev/null
-wait_for_line "$TMP/plc.err" 'plc: gateway power 5 off' >/dev/null
-wait_for_line "$TMP/plc.err" 'plc: sync line high' >/dev/null
-wait_for_line "$TMP/plc.err" 'plc: sync line low' >/dev/null
+wait_for_line "$TMP/plc.err" 'plc emulator: client 127\.0\.0\.1:[0-9]+ switched positioner power 3 off' >/dev/null
+wait_for_line "$TMP/plc.err" 'plc emulator: client 127\.0\.0\.1:[0-9]+ switched gateway power 5 off' >/dev/null
+wait_for_line "$TMP/plc.err" 'plc emulator: client 127\.0\.0\.1:[0-9]+ switched sync line high' >/dev/null
+wait_for_line "$TMP/plc.err" 'plc emulator: client 127\.0\.0\.1:[0-9]+ switched sync line low' >/dev/null
 
 plc --json cold >"$TMP/cold.json" 2>"$TMP/cold.err" || fail "cold exited with $?"
 /usr/bin/python3 - "$TMP/cold.json" <<'PY' || fail "cold policy is not what -12.5 degC calls for"

@@ -178,7 +178,11 @@ void PlcEmulator::Impl::serve(int fd, std::vector<int>& clients, fd_set& all) {
   }
   // Any client may switch the relays (Modbus has no sessions): say who did, so that a change
   // nobody expected can be traced.
-  for (const auto& e : events) spdlog::info("plc emulator: client {} switched {} {}", peer_of(fd), e.relay.to_string(), e.on ? "on" : "off");
+  for (const auto& e : events) {
+    const bool sync = e.relay.kind == RelayKind::sync_line;
+    spdlog::info("plc emulator: client {} switched {} {}", peer_of(fd), e.relay.to_string(),
+                 sync ? (e.on ? "high" : "low") : (e.on ? "on" : "off"));
+  }
   dispatch(events);
 }
 

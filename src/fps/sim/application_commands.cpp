@@ -113,7 +113,11 @@ ResponseCode PositionerModel::motion_check(Activity kind, PerArm<bool> arms) con
 
 ResponseCode PositionerModel::start_trajectory(SimTime t) {
   if (!upload_.loaded && config_.start_without_trajectory == EmptyStart::accept) {
-    return ResponseCode::accepted;  // nothing to start: the robot stays as it is, whatever it does
+    // Nothing to start: the robot stays as it is. A collision flag still answers 8/9, the answer
+    // the document's start sequence looks for [7.2].
+    if (arms_[Arm::alpha].collided) return ResponseCode::alpha_collision;
+    if (arms_[Arm::beta].collided) return ResponseCode::beta_collision;
+    return ResponseCode::accepted;
   }
   if (const auto code = motion_check(Activity::trajectory, {{true, true}}); code != ResponseCode::accepted) {
     return code;
