@@ -51,10 +51,13 @@ Result<std::map<std::uint16_t, net::Endpoint>> gateway_endpoints(const FocalPlan
   boost::system::error_code ec;
   const auto first = asio::ip::make_address_v4(binding.address, ec);
   const bool count_up = !ec && !first.is_unspecified();
+  const bool from_layout = binding.address == GatewayBinding::kLayoutAddresses;
+  if (from_layout && (binding.port != 0 || !binding.ports.empty()))
+    return Error(CoreErrc::invalid_argument, "with the layout's addresses the ports come from the layout too");
   std::size_t k = 0;
   for (const auto& g : plane.gateways()) {
     net::Endpoint ep;
-    if (binding.address == GatewayBinding::kLayoutAddresses) {
+    if (from_layout) {
       auto parsed = net::parse_endpoint(g.address, can::cannet::kDefaultPort);
       if (!parsed)
         return Error(CoreErrc::invalid_argument, fmt::format("gateway {}: address '{}': {}", g.id, g.address, parsed.error().message()));

@@ -37,6 +37,8 @@ TEST(GatewayBinding, LayoutTakesEachGatewaysOwnAddress) {
   const auto plane = six_gateways();
   const auto eps = gateway_endpoints(plane, b).value();
   for (const auto& g : plane.gateways()) EXPECT_EQ(eps.at(g.id).to_string(), g.address);
+  b.port = 5000;  // the layout gives the ports too
+  EXPECT_FALSE(gateway_endpoints(plane, b));
 }
 
 TEST(GatewayBinding, OneAddressForAllNeedsDistinctPorts) {
