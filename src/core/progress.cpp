@@ -16,7 +16,7 @@ Progress::~Progress() { finish(); }
 bool Progress::update(std::string_view text) {
   const auto now = clock_.now();
   if (now - start_ < options_.quiet_for) return false;
-  if (reports_ > 0 && now - last_ < options_.interval) return false;
+  if (reports_ > 0 && now - last_ < (terminal_ ? options_.terminal_interval : options_.interval)) return false;
   last_ = now;
   ++reports_;
   if (terminal_) {

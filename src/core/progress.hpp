@@ -13,7 +13,8 @@
 namespace axon::core {
 
 struct ProgressOptions {
-  Duration interval = std::chrono::seconds(1);  // shortest time between two reports
+  Duration interval = std::chrono::seconds(1);  // shortest time between two lines into a file or pipe
+  Duration terminal_interval = std::chrono::milliseconds(250);  // between two rewrites on a terminal
   // Reports start only after this long, so that work that ends quickly prints nothing but its result.
   Duration quiet_for = std::chrono::seconds(2);
   int terminal = -1;                            // 1 / 0: force; -1: ask isatty() of the stream
