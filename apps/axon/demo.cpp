@@ -77,15 +77,15 @@ void report(const char* path, const RoundTrips& r, int count) {
              r.percentile(0.5), r.percentile(0.99));
 }
 
-int run_can_and_fps();
+int run_can_fps_blmc();
 
 int run_demo() {
-  const int rc = run_can_and_fps();
+  const int rc = run_can_fps_blmc();
   if (rc != 0) return rc;
   return demo_c4g();
 }
 
-int run_can_and_fps() {
+int run_can_fps_blmc() {
   return run_command([](asio::io_context& io, auto) -> asio::awaitable<int> {
     auto ex = io.get_executor();
     const int n = 200;
@@ -143,7 +143,8 @@ int run_can_and_fps() {
     gw->stop();
     const asio::any_io_executor any_ex = ex;
     co_await demo_fps(any_ex);
-    co_return 0;
+    const int blmc = co_await demo_blmc(any_ex);
+    co_return blmc;
   });
 }
 
