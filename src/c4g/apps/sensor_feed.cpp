@@ -25,8 +25,9 @@ Result<void> parse_feed_datagram(std::string_view text, std::span<double> out, b
     const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
     if (ec != std::errc{} || ptr != token.data() + token.size())
       return Error(CoreErrc::invalid_argument, fmt::format("value {} \"{}\" is not a number", count + 1, token.substr(0, 40)));
+    if (degrees) v *= std::numbers::pi / 180.0;  // one factor: 1e308 deg stays finite in rad
     if (!std::isfinite(v)) return Error(CoreErrc::invalid_argument, fmt::format("value {} is not finite", count + 1));
-    out[count++] = degrees ? v * std::numbers::pi / 180.0 : v;
+    out[count++] = v;
     i = end;
   }
   if (count != out.size())
