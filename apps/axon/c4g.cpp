@@ -68,6 +68,7 @@ struct ServeOptions {
   double open_time_s = 0;
   double ramp_s = 0.5;
   std::string feed;
+  std::string feed_from;
   std::size_t feed_axes = 6;
   double feed_timeout_ms = 100;
   std::vector<double> max_correction_deg{apps::kDefaultMaxCorrectionDeg};
@@ -169,6 +170,7 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     if (!o.feed.empty()) {
       apps::SensorFeedOptions f;
       f.listen = need(net::parse_endpoint(o.feed, 0));
+      if (!o.feed_from.empty()) f.source = need(net::parse_endpoint(o.feed_from, 0));
       f.axes = o.feed_axes;
       f.degrees = o.units == "deg";
       c.feed = need(apps::SensorFeed::open(f));
@@ -218,6 +220,8 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     p.ramp_s = o.ramp_s;
     p.dynamic_model_feedforward = !o.no_dynamic_model;
     p.reduce_in_pc = o.reduce_in_pc;
+    p.limits.max_abs_rad = deg_to_rad(o.max_correction_deg);
+    p.limits.max_step_rad = deg_to_rad(o.max_correction_step_deg);
     const std::size_t n = std::max({o.kp.size(), o.kv.size(), o.ki.size()});
     auto pick = [](const std::vector<double>& v, std::size_t i, double def) {
       return v.empty() ? def : (i < v.size() ? v[i] : v.back());
@@ -575,10 +579,11 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("--open-time", so.open_time_s, "correct/pid: leave the open mode after this long [s] (0: until stopped); handover: hold / zero-correction / sine time per phase (default 0.5)")->check(c4g_cli::non_negative());
   s->add_option("--ramp", so.ramp_s, "fade in/out time of corrections and sines [s] (default 0.5)")->check(c4g_cli::non_negative());
   s->add_option("--feed", so.feed, "correct: live correction values over UDP on HOST:PORT (one datagram of numbers per measurement)");
+  s->add_option("--feed-from", so.feed_from, "correct: read the feed only from this sensor HOST[:PORT] (a host alone: any port); others are counted and ignored");
   s->add_option("--feed-axes", so.feed_axes, "correct: values per feed datagram (default 6)")->check(CLI::Range(1, 10));
   s->add_option("--feed-timeout-ms", so.feed_timeout_ms, "correct: feed values older than this count as none (default 100)")->check(c4g_cli::positive());
-  s->add_option("--max-correction", so.max_correction_deg, "correct: largest correction per axis [deg, link side] (default 5; one value: every axis); beyond it a feed reading is refused, a sine or file is refused at start")->delimiter(',')->check(c4g_cli::positive());
-  s->add_option("--max-correction-step", so.max_correction_step_deg, "correct: largest change of the correction per cycle and axis [deg, link side] (default 0.1); a feed slews at it, a sine or file that needs more is refused")->delimiter(',')->check(c4g_cli::positive());
+  s->add_option("--max-correction", so.max_correction_deg, "correct (and the pid sine): largest correction per axis [deg, link side] (default 5; one value: every axis); beyond it a feed reading is refused, a sine or file is refused at start")->delimiter(',')->check(c4g_cli::positive());
+  s->add_option("--max-correction-step", so.max_correction_step_deg, "correct (and the pid sine): largest change of the correction per cycle and axis [deg, link side] (default 0.1); a feed slews at it, a sine or file that needs more is refused")->delimiter(',')->check(c4g_cli::positive());
   s->add_option("--kp", so.kp, "pid: position gain per axis [1/s]")->delimiter(',');
   s->add_option("--kv", so.kv, "pid: velocity gain per axis [A/(turn/s)]")->delimiter(',');
   s->add_option("--ki", so.ki, "pid: velocity integral rate per axis [1/s]")->delimiter(',');

@@ -15,31 +15,12 @@ using protocol::code;
 using protocol::Mode;
 
 namespace {
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
 Exception refused(std::string text) { return Exception(Error(CoreErrc::invalid_argument, std::move(text))); }
 
-Result<void> validate_list(const std::vector<double>& v, const char* what) {
-  if (v.empty() || v.size() > protocol::kAxesPerArm)
-    return Error(CoreErrc::invalid_argument, fmt::format("correct: {} needs 1 to {} values, got {}", what, protocol::kAxesPerArm, v.size()));
-  for (std::size_t j = 0; j < v.size(); ++j)
-    if (!(v[j] > 0) || !std::isfinite(v[j]))
-      return Error(CoreErrc::invalid_argument, fmt::format("correct: {} of axis {} must be > 0 and finite, got {}", what, j + 1, v[j] * kRadToDeg));
-  return ok();
-}
-
 // The sine's amplitudes and the file's values within max_abs: checked when the app is built.
 void check_sources(const CorrectOptions& o) {
-  const auto& a = o.amplitude_rad;
-  for (std::size_t j = 0; j < a.size() && j < protocol::kAxesPerArm; ++j) {
-    const std::size_t first = a.size() == 1 ? 0 : j, last = a.size() == 1 ? protocol::kAxesPerArm - 1 : j;
-    for (std::size_t axis = first; axis <= last; ++axis)
-      if (!(std::fabs(a[j]) <= o.limits.max_abs(axis)))
-        throw refused(fmt::format("correct: the sine amplitude {:g} deg on axis {} exceeds the correction limit {:g} deg "
-                                  "(--max-correction)", a[j] * kRadToDeg, axis + 1, o.limits.max_abs(axis) * kRadToDeg));
-  }
-  for (double f : o.frequency_hz)
-    if (!(f >= 0) || !std::isfinite(f)) throw refused(fmt::format("correct: a sine frequency must be >= 0 and finite, got {}", f));
+  if (auto v = check_sine("correct", o.amplitude_rad, o.frequency_hz, o.limits); !v) throw Exception(v.error());
   if (!o.values) return;
   const Trajectory& t = *o.values;
   for (std::size_t r = 0; r < t.rows(); ++r)
@@ -50,11 +31,6 @@ void check_sources(const CorrectOptions& o) {
                                   o.limits.max_abs(j) * kRadToDeg));
 }
 }  // namespace
-
-Result<void> validate(const CorrectionLimits& limits) {
-  AXON_TRY(validate_list(limits.max_abs_rad, "the correction limit"));
-  return validate_list(limits.max_step_rad, "the correction limit per cycle");
-}
 
 CorrectApp::CorrectApp(CorrectOptions options) : options_(std::move(options)) {
   for (auto& a : applied_) a.store(0, std::memory_order_relaxed);
@@ -135,7 +111,7 @@ void CorrectApp::setup(const protocol::InitPacket& init, const protocol::AxisMap
 
 bool CorrectApp::check_steps(double period) noexcept {
   const std::size_t n = view_->count;
-  const double fade = options_.ramp_s > 0 ? std::min(1.0, period / options_.ramp_s) : 1.0;  // envelope change per cycle
+  const double fade = fade_per_cycle(period, options_.ramp_s);
   for (std::size_t j = 0; j < n; ++j) {
     double step = 0;  // bound on the change per cycle, link side
     if (options_.values) {
@@ -151,8 +127,7 @@ bool CorrectApp::check_steps(double period) noexcept {
       }
       step += peak * fade;
     } else {
-      const double a = std::fabs(amplitude_[j]);
-      step = 2.0 * std::numbers::pi * std::fabs(frequency_[j]) * a * period + a * fade;
+      step = sine_step_bound(amplitude_[j], frequency_[j], period, options_.ramp_s);
     }
     if (step > options_.limits.max_step(j) * (1 + 1e-9)) {
       fail("correct: the correction can change by %.4f deg in one cycle on axis %zu (fades included), beyond the limit "
@@ -387,9 +362,10 @@ std::string CorrectApp::summary() const {
   std::string out = App::summary() + fmt::format("correct: {:.3f} s corrected, phase {}\n",
                                                 elapsed_.load(std::memory_order_relaxed), names[static_cast<int>(phase())]);
   if (options_.feed) {
-    out += fmt::format("correct: feed on port {}: {} datagrams accepted, {} rejected, {} readings refused beyond the limits, "
-                       "{} stale cycles, {} cycles slewed\n", options_.feed->port(), options_.feed->accepted(),
-                       options_.feed->rejected(), refused_samples(), stale_cycles(), slewed_cycles());
+    out += fmt::format("correct: feed on port {}: {} datagrams accepted, {} rejected, {} from other senders ignored, "
+                       "{} readings refused beyond the limits, {} stale cycles, {} cycles slewed\n", options_.feed->port(),
+                       options_.feed->accepted(), options_.feed->rejected(), options_.feed->foreign(), refused_samples(),
+                       stale_cycles(), slewed_cycles());
     if (const auto e = options_.feed->last_error(); !e.empty()) out += "correct: last rejected datagram " + e + "\n";
     if (refused_samples() > 0) {
       const int j = refused_axis_.load(std::memory_order_relaxed);

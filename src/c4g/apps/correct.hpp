@@ -30,35 +30,14 @@
 #pragma once
 
 #include "c4g/apps/app.hpp"
+#include "c4g/apps/correction_limits.hpp"
 #include "c4g/apps/sensor_feed.hpp"
 #include "c4g/apps/trajectory.hpp"
 
-#include <algorithm>
 #include <memory>
-#include <numbers>
 #include <vector>
 
 namespace axon::c4g::apps {
-
-// The defaults: 5 degrees at most, 0.1 degree per cycle at most (50 deg/s at 2 ms).
-inline constexpr double kDefaultMaxCorrectionDeg = 5.0;
-inline constexpr double kDefaultMaxCorrectionStepDeg = 0.1;
-
-// Bounds on a mode-7 correction, link side [rad], per axis of the arm: one value applies to every
-// axis; with several, the last one also applies to the axes after it.
-struct CorrectionLimits {
-  std::vector<double> max_abs_rad{kDefaultMaxCorrectionDeg * std::numbers::pi / 180.0};
-  std::vector<double> max_step_rad{kDefaultMaxCorrectionStepDeg * std::numbers::pi / 180.0};
-  [[nodiscard]] double max_abs(std::size_t axis) const noexcept { return pick(max_abs_rad, axis); }
-  [[nodiscard]] double max_step(std::size_t axis) const noexcept { return pick(max_step_rad, axis); }
-
- private:
-  static double pick(const std::vector<double>& v, std::size_t axis) noexcept {
-    return v.empty() ? 0.0 : v[std::min(axis, v.size() - 1)];
-  }
-};
-// Every limit finite and > 0, 1..kAxesPerArm values each; invalid_argument in words otherwise.
-Result<void> validate(const CorrectionLimits& limits);
 
 struct CorrectOptions {
   std::size_t arm = 1;

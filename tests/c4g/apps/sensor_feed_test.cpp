@@ -88,6 +88,25 @@ TEST(SensorFeed, PublishesTheLatestValuesAndCountsRejects) {
   EXPECT_NE(feed->last_error().find("not a number"), std::string::npos);
 }
 
+TEST(SensorFeed, WithASourceOnlyThatSenderIsRead) {
+  Sender sensor(0), stranger(0);
+  SensorFeedOptions o;
+  o.listen = net::Endpoint{"127.0.0.1", 0};
+  o.axes = 1;
+  o.source = net::Endpoint{"127.0.0.1", sensor.socket.local_port()};
+  auto feed = SensorFeed::open(o).value();
+  sensor.to.port = stranger.to.port = feed->port();
+  stranger.send("0.7");
+  sensor.send("0.1");
+  ASSERT_TRUE(eventually([&] { return feed->accepted() == 1 && feed->foreign() == 1; }));
+  SensorFeed::Reading r;
+  ASSERT_TRUE(feed->latest(r));
+  EXPECT_EQ(r.values[0], 0.1);
+  EXPECT_EQ(feed->rejected(), 0u);
+  o.source = net::Endpoint{"0.0.0.0", 0};
+  EXPECT_FALSE(SensorFeed::open(o));  // names no host
+}
+
 TEST(SensorFeed, RejectsImpossibleAxisCounts) {
   SensorFeedOptions o;
   o.axes = 0;
