@@ -130,6 +130,28 @@ std::vector<double> deg_to_rad(const std::vector<double>& v) {
   return out;
 }
 
+apps::PidOptions pid_options(const ServeOptions& o) {
+  apps::PidOptions p;
+  p.arm = o.arm;
+  p.amplitude_rad = deg_to_rad(o.amplitude_deg);
+  p.frequency_hz = o.frequency_hz;
+  p.open_time_s = o.open_time_s;
+  p.ramp_s = o.ramp_s;
+  p.dynamic_model_feedforward = !o.no_dynamic_model;
+  p.reduce_in_pc = o.reduce_in_pc;
+  p.limits.max_abs_rad = deg_to_rad(o.max_correction_deg);
+  p.limits.max_step_rad = deg_to_rad(o.max_correction_step_deg);
+  const std::size_t n = std::max({o.kp.size(), o.kv.size(), o.ki.size()});
+  auto pick = [](const std::vector<double>& v, std::size_t i, double def) {
+    return v.empty() ? def : (i < v.size() ? v[i] : v.back());
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const apps::PidGains d;
+    p.gains.push_back({pick(o.kp, i, d.kp), pick(o.kv, i, d.kv), pick(o.ki, i, d.ki)});
+  }
+  return p;
+}
+
 std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
   std::optional<apps::AngleUnit> unit;
   if (!o.units.empty()) {
@@ -211,27 +233,7 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     }
     return std::make_unique<apps::HandoverApp>(std::move(h));
   }
-  if (o.app == "pid") {
-    apps::PidOptions p;
-    p.arm = o.arm;
-    p.amplitude_rad = deg_to_rad(o.amplitude_deg);
-    p.frequency_hz = o.frequency_hz;
-    p.open_time_s = o.open_time_s;
-    p.ramp_s = o.ramp_s;
-    p.dynamic_model_feedforward = !o.no_dynamic_model;
-    p.reduce_in_pc = o.reduce_in_pc;
-    p.limits.max_abs_rad = deg_to_rad(o.max_correction_deg);
-    p.limits.max_step_rad = deg_to_rad(o.max_correction_step_deg);
-    const std::size_t n = std::max({o.kp.size(), o.kv.size(), o.ki.size()});
-    auto pick = [](const std::vector<double>& v, std::size_t i, double def) {
-      return v.empty() ? def : (i < v.size() ? v[i] : v.back());
-    };
-    for (std::size_t i = 0; i < n; ++i) {
-      const apps::PidGains d;
-      p.gains.push_back({pick(o.kp, i, d.kp), pick(o.kv, i, d.kv), pick(o.ki, i, d.ki)});
-    }
-    return std::make_unique<apps::PidApp>(std::move(p));
-  }
+  if (o.app == "pid") return std::make_unique<apps::PidApp>(pid_options(o));
   if (o.app == "contribute") {
     if (o.mode != 8 && o.mode != 9) throw bad("--app contribute: --mode must be 8 (velocity) or 9 (current)");
     apps::ContributeOptions c;

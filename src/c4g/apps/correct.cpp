@@ -287,6 +287,12 @@ void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) 
       ph = Phase::exiting;
     }
   }
+  emit(env, ph, reply);
+}
+
+void CorrectApp::emit(double env, Phase ph, host::ReplyBuilder& reply) noexcept {
+  const std::size_t n = view_->count, first = view_->first;
+  const double period = view_->period_s;
   protocol::ArmTransform::Vector link(static_cast<Eigen::Index>(n));
   if (options_.feed) {
     feed_target(env, link);

@@ -96,6 +96,9 @@ class CorrectApp final : public App {
   [[nodiscard]] int out_of_bounds(const protocol::ArmTransform::Vector& link) const noexcept;
   // At setup: the largest change per cycle of the sine or the file against max_step; fails if above.
   bool check_steps(double period) noexcept;
+  // Builds this cycle's correction (envelope env), checks it against every bound and sends its
+  // increment; with the feed, may move an exiting phase back to fading until the correction is zero.
+  void emit(double env, Phase ph, host::ReplyBuilder& reply) noexcept;
   // Refuses and leaves mode 7 with zero increments.
   void refuse_now(host::ReplyBuilder& reply) noexcept;
 
