@@ -93,4 +93,5 @@ assert j["session"]["sessions"] == 1, j["session"]
 assert j["init_packets"] == 1 and j["protocol_errors"] == 0, j
 assert j["safety_fault"] == "none", j["safety_fault"]
 PY
+grep -h "foreign datagrams ignored\|^stranger" "$TMP/serve.out" "$TMP/stranger.out" >&2 || true
 echo ok
