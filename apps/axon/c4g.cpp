@@ -240,6 +240,7 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     c.arm = o.arm;
     c.mode = o.mode;
     c.amplitude = o.amplitude_deg;  // motor side for this app: turns/s (8) or A (9)
+    c.max_motor_speed = o.max_motor_speed;
     c.frequency_hz = o.frequency_hz;
     c.open_time_s = o.open_time_s;
     c.ramp_s = o.ramp_s;
