@@ -2,6 +2,7 @@
 //   serve      runs a c4g::host::Server with one of the built-in applications (src/c4g/apps)
 //   init-info  prints an initialization packet from a 1200-byte file or from a capture
 // The ready line `listening c4g HOST:PORT`, events and status lines go to stdout; logs to stderr.
+// With --json, stdout carries one JSON document and nothing else: the lines go to stderr.
 #include "c4g/apps/app.hpp"
 #include "c4g/apps/contribute.hpp"
 #include "c4g/apps/correct.hpp"
@@ -15,6 +16,7 @@
 #include "c4g/host/server.hpp"
 #include "c4g/protocol/axis_map.hpp"
 #include "c4g/protocol/init_packet.hpp"
+#include "checks.hpp"
 #include "commands.hpp"
 #include "net/endpoint.hpp"
 #include "run.hpp"
@@ -47,6 +49,8 @@ using Clock = std::chrono::steady_clock;
 
 struct ServeOptions {
   std::string listen = fmt::format("{}:{}", host::kDefaultServerAddress, host::kDefaultPort);
+  std::string controller;  // HOST[:PORT]; empty: learned from the first packet
+  double period_ms = 0;    // timing figures until the initialization packet gives the period
   std::string app;
   // stream / correct / pid
   std::string file;
@@ -64,8 +68,11 @@ struct ServeOptions {
   double open_time_s = 0;
   double ramp_s = 0.5;
   std::string feed;
+  std::string feed_from;
   std::size_t feed_axes = 6;
   double feed_timeout_ms = 100;
+  std::vector<double> max_correction_deg{apps::kDefaultMaxCorrectionDeg};
+  std::vector<double> max_correction_step_deg{apps::kDefaultMaxCorrectionStepDeg};
   std::vector<double> kp, kv, ki;
   bool no_dynamic_model = false;
   bool reduce_in_pc = false;
@@ -114,10 +121,35 @@ struct FreezeSignals {
 
 Exception bad(std::string text) { return Exception(Error(CoreErrc::invalid_argument, std::move(text))); }
 
+// Where the human-readable lines go: stdout, or stderr when stdout carries the JSON report.
+std::FILE* text_out(const ServeOptions& o) { return o.json ? stderr : stdout; }
+
 std::vector<double> deg_to_rad(const std::vector<double>& v) {
   std::vector<double> out;
   for (double d : v) out.push_back(d * std::numbers::pi / 180.0);
   return out;
+}
+
+apps::PidOptions pid_options(const ServeOptions& o) {
+  apps::PidOptions p;
+  p.arm = o.arm;
+  p.amplitude_rad = deg_to_rad(o.amplitude_deg);
+  p.frequency_hz = o.frequency_hz;
+  p.open_time_s = o.open_time_s;
+  p.ramp_s = o.ramp_s;
+  p.dynamic_model_feedforward = !o.no_dynamic_model;
+  p.reduce_in_pc = o.reduce_in_pc;
+  p.limits.max_abs_rad = deg_to_rad(o.max_correction_deg);
+  p.limits.max_step_rad = deg_to_rad(o.max_correction_step_deg);
+  const std::size_t n = std::max({o.kp.size(), o.kv.size(), o.ki.size()});
+  auto pick = [](const std::vector<double>& v, std::size_t i, double def) {
+    return v.empty() ? def : (i < v.size() ? v[i] : v.back());
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const apps::PidGains d;
+    p.gains.push_back({pick(o.kp, i, d.kp), pick(o.kv, i, d.kv), pick(o.ki, i, d.ki)});
+  }
+  return p;
 }
 
 std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
@@ -160,14 +192,17 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     if (!o.feed.empty()) {
       apps::SensorFeedOptions f;
       f.listen = need(net::parse_endpoint(o.feed, 0));
+      if (!o.feed_from.empty()) f.source = need(net::parse_endpoint(o.feed_from, 0));
       f.axes = o.feed_axes;
       f.degrees = o.units == "deg";
       c.feed = need(apps::SensorFeed::open(f));
       c.feed_timeout_s = o.feed_timeout_ms * 1e-3;
-      std::printf("correct: feed listening on %s:%u (%zu values per datagram, %s)\n", f.listen.host.c_str(),
-                  static_cast<unsigned>(c.feed->port()), f.axes, f.degrees ? "deg" : "rad");
-      std::fflush(stdout);
+      std::fprintf(text_out(o), "correct: feed listening on %s:%u (%zu values per datagram, %s)\n", f.listen.host.c_str(),
+                   static_cast<unsigned>(c.feed->port()), f.axes, f.degrees ? "deg" : "rad");
+      std::fflush(text_out(o));
     }
+    c.limits.max_abs_rad = deg_to_rad(o.max_correction_deg);
+    c.limits.max_step_rad = deg_to_rad(o.max_correction_step_deg);
     c.amplitude_rad = deg_to_rad(o.amplitude_deg);
     c.frequency_hz = o.frequency_hz;
     c.open_time_s = o.open_time_s;
@@ -198,31 +233,14 @@ std::unique_ptr<apps::App> make_app(const ServeOptions& o) {
     }
     return std::make_unique<apps::HandoverApp>(std::move(h));
   }
-  if (o.app == "pid") {
-    apps::PidOptions p;
-    p.arm = o.arm;
-    p.amplitude_rad = deg_to_rad(o.amplitude_deg);
-    p.frequency_hz = o.frequency_hz;
-    p.open_time_s = o.open_time_s;
-    p.ramp_s = o.ramp_s;
-    p.dynamic_model_feedforward = !o.no_dynamic_model;
-    p.reduce_in_pc = o.reduce_in_pc;
-    const std::size_t n = std::max({o.kp.size(), o.kv.size(), o.ki.size()});
-    auto pick = [](const std::vector<double>& v, std::size_t i, double def) {
-      return v.empty() ? def : (i < v.size() ? v[i] : v.back());
-    };
-    for (std::size_t i = 0; i < n; ++i) {
-      const apps::PidGains d;
-      p.gains.push_back({pick(o.kp, i, d.kp), pick(o.kv, i, d.kv), pick(o.ki, i, d.ki)});
-    }
-    return std::make_unique<apps::PidApp>(std::move(p));
-  }
+  if (o.app == "pid") return std::make_unique<apps::PidApp>(pid_options(o));
   if (o.app == "contribute") {
     if (o.mode != 8 && o.mode != 9) throw bad("--app contribute: --mode must be 8 (velocity) or 9 (current)");
     apps::ContributeOptions c;
     c.arm = o.arm;
     c.mode = o.mode;
     c.amplitude = o.amplitude_deg;  // motor side for this app: turns/s (8) or A (9)
+    c.max_motor_speed = o.max_motor_speed;
     c.frequency_hz = o.frequency_hz;
     c.open_time_s = o.open_time_s;
     c.ramp_s = o.ramp_s;
@@ -235,11 +253,15 @@ json timing_json(const host::Server& server) {
   const auto& t = server.cycle().timing();
   const auto& h = t.cycle_times();
   auto s = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-9; };
+  // Figures relative to the controller's period are null while it is unknown.
+  auto relative = [&](const json& v) { return t.nominal_known() ? v : json(nullptr); };
   return json{{"cycles", t.cycles()},
+              {"nominal_period_s", relative(s(t.nominal_period_ns()))},
               {"worst_cycle_time_s", s(t.worst_cycle_time_ns())},
               {"inter_packet_period_s", {s(t.min_inter_step_ns()), s(t.max_inter_step_ns())}},
-              {"jitter_s", {s(t.min_jitter_ns()), s(t.max_jitter_ns())}},
-              {"jitter_percent", {t.min_percent_jitter(), t.max_percent_jitter()}},
+              {"inter_step_p50_s", s(t.inter_step_times().percentile(50))},
+              {"jitter_s", relative({s(t.min_jitter_ns()), s(t.max_jitter_ns())})},
+              {"jitter_percent", relative({t.min_percent_jitter(), t.max_percent_jitter()})},
               {"cycle_time_p50_s", s(h.percentile(50))},
               {"cycle_time_p99_s", s(h.percentile(99))},
               {"cycle_time_p999_s", s(h.percentile(99.9))},
@@ -248,10 +270,21 @@ json timing_json(const host::Server& server) {
               {"deadline_s", s(t.config().deadline_ns)}};
 }
 
-int run_serve(const ServeOptions& o) {
-  auto app = make_app(o);
+json session_json(const host::Server& server) {
+  const auto& c = server.counters();
+  const auto peer = server.peer();
+  const auto last = host::SessionPeer::unpack(c.last_foreign.load());
+  return json{{"controller", peer ? json(peer->to_string()) : json(nullptr)},
+              {"sessions", c.sessions.load()},
+              {"foreign", c.foreign.load()},
+              {"last_foreign_source", last ? json(last->to_string()) : json(nullptr)}};
+}
+
+host::ServerOptions server_options(const ServeOptions& o) {
   host::ServerOptions so;
-  so.listen = need(net::parse_endpoint(o.listen, host::kDefaultPort));
+  so.listen = need(net::parse_endpoint(o.listen, host::kManualPort));
+  if (!o.controller.empty()) so.controller = need(net::parse_endpoint(o.controller, 0));
+  so.period = std::chrono::nanoseconds(static_cast<std::int64_t>(o.period_ms * 1e6));
   if (o.numbering == "same") so.numbering = protocol::ReplyNumbering::same;
   else if (o.numbering == "next") so.numbering = protocol::ReplyNumbering::next;
   else throw bad("--numbering must be same or next");
@@ -263,6 +296,91 @@ int run_serve(const ServeOptions& o) {
   so.udp.busy_poll = o.busy_poll;
   if (o.max_step > 0)
     for (auto& a : so.safety.axes) a.max_step = static_cast<float>(o.max_step);
+  return so;
+}
+
+// The final report: one JSON document, or text lines.
+void print_report(const ServeOptions& o, const host::Server& server, const apps::App& app, const std::string& why,
+                  const apps::MoniCsvWriter* csv) {
+  if (o.json) {
+    const auto& c = server.counters();
+    json j{{"app", std::string(app.name())},
+           {"reason", why},
+           {"app_cycles", app.cycles()},
+           {"finished", app.finished()},
+           {"error", app.error()},
+           {"app_summary", app.summary()},
+           {"session", session_json(server)},
+           {"packets", c.packets.load()},
+           {"init_packets", c.init_packets.load()},
+           {"cyclic_packets", c.cyclic_packets.load()},
+           {"protocol_errors", c.protocol_errors.load()},
+           {"safe_replies", c.safe_replies.load()},
+           {"refused_mode_changes", c.refused_mode_changes.load()},
+           {"controller_late", c.controller_late.load()},
+           {"freezes", c.freezes.load()},
+           {"frozen_cycles", c.frozen_cycles.load()},
+           {"safety_fault", std::string(host::to_string(server.safety().reason()))},
+           {"currents_clamped", server.safety().counters().currents_clamped.load()},
+           {"timing", timing_json(server)}};
+    if (csv) j["csv_rows"] = csv->rows();
+    if (server.recorder()) j["pcap_written"] = server.recorder()->written();
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("stopped: %s\n%s%s", why.c_str(), server.summary().c_str(), app.summary().c_str());
+    if (csv) std::printf("CSV %s: %llu rows (moni type %d)\n", csv->path().c_str(), static_cast<unsigned long long>(csv->rows()),
+                         o.moni < 0 ? 0 : o.moni);
+    if (app.has_error()) std::printf("error: %s\n", app.error().c_str());
+  }
+  std::fflush(stdout);
+}
+
+// Active freezing driven from the command line: SIGUSR1 / SIGUSR2, or --freeze-at / --freeze-for;
+// state changes are printed.
+class FreezeControl {
+ public:
+  FreezeControl(const ServeOptions& o, host::Server& server, Clock::time_point start)
+      : o_(o), server_(server), start_(start), at_done_(o.freeze_at_s <= 0) {}
+  void poll(Clock::time_point now) {
+    std::FILE* out = text_out(o_);
+    const int sig = g_freeze_signal.exchange(0);
+    if (sig == 1) { std::fprintf(out, "freeze: requested (SIGUSR1)\n"); server_.request_freeze(); }
+    if (sig == 2) { std::fprintf(out, "freeze: released (SIGUSR2)\n"); server_.release_freeze(); }
+    if (!at_done_ && now - start_ >= std::chrono::duration<double>(o_.freeze_at_s)) {
+      at_done_ = true;
+      std::fprintf(out, "freeze: requested (--freeze-at %.3f s)\n", o_.freeze_at_s);
+      server_.request_freeze();
+    }
+    const auto st = server_.freeze_state();
+    if (st != shown_) {
+      std::fprintf(out, "freeze: %s\n", std::string(host::to_string(st)).c_str());
+      shown_ = st;
+      frozen_since_.reset();
+      if (st == host::FreezeState::frozen) frozen_since_ = now;
+    }
+    if (frozen_since_ && o_.freeze_for_s > 0 && server_.freeze_requested() &&
+        now - *frozen_since_ >= std::chrono::duration<double>(o_.freeze_for_s)) {
+      std::fprintf(out, "freeze: released (--freeze-for %.3f s)\n", o_.freeze_for_s);
+      server_.release_freeze();
+    }
+    std::fflush(out);
+  }
+
+ private:
+  const ServeOptions& o_;
+  host::Server& server_;
+  Clock::time_point start_;
+  bool at_done_;
+  host::FreezeState shown_ = host::FreezeState::off;
+  std::optional<Clock::time_point> frozen_since_;
+};
+
+Clock::duration seconds(double s) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
+
+int run_serve(const ServeOptions& o) {
+  auto app = make_app(o);
+  const host::ServerOptions so = server_options(o);
+  std::FILE* out = text_out(o);
 
   std::unique_ptr<apps::MoniCsvWriter> csv;
   if (!o.csv.empty()) {
@@ -276,62 +394,41 @@ int run_serve(const ServeOptions& o) {
   FreezeSignals freeze_signals;
 
   auto server = need(host::Server::start(*app, so));
-  std::printf("listening c4g %s\n", server->local_address().to_string().c_str());
-  std::fflush(stdout);
+  std::fprintf(out, "listening c4g %s\n", server->local_address().to_string().c_str());
+  std::fflush(out);
   for (const auto& step : server->realtime_report().steps)
     if (!step.granted) spdlog::warn("c4g serve: {} refused: {}", step.name, step.reason);
 
   const auto start = Clock::now();
-  auto next_status = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.status_interval_s));
+  auto next_status = start + seconds(o.status_interval_s);
+  std::optional<net::SocketAddress> shown_peer;
   auto pump = [&] {
+    if (const auto peer = server->peer(); peer && peer != shown_peer)
+      std::fprintf(out, "session: controller %s\n", peer->to_string().c_str());
+    shown_peer = server->peer();
     for (const auto& e : app->drain_events())
-      std::printf("event cycle %llu: %s\n", static_cast<unsigned long long>(e.cycle), app->describe(e).c_str());
+      std::fprintf(out, "event cycle %llu: %s\n", static_cast<unsigned long long>(e.cycle), app->describe(e).c_str());
     if (csv) app->drain_samples([&](const apps::Sample& s) { csv->write(s.cycle, s.wall_ns, s.request, s.reply); });
-    std::fflush(stdout);
+    std::fflush(out);
   };
   auto status_line = [&] {
     const auto& t = server->cycle().timing();
-    std::printf("status %s | %s | cycle time last %.1f us worst %.1f us, missed %llu\n", app->status().c_str(),
-                std::string(host::to_string(server->state())).c_str(), static_cast<double>(t.last_cycle_time_ns()) * 1e-3,
-                static_cast<double>(t.worst_cycle_time_ns()) * 1e-3, static_cast<unsigned long long>(t.missed_deadlines()));
+    std::fprintf(out, "status %s | %s | cycle time last %.1f us worst %.1f us, missed %llu | foreign %llu\n",
+                 app->status().c_str(), std::string(host::to_string(server->state())).c_str(),
+                 static_cast<double>(t.last_cycle_time_ns()) * 1e-3, static_cast<double>(t.worst_cycle_time_ns()) * 1e-3,
+                 static_cast<unsigned long long>(t.missed_deadlines()),
+                 static_cast<unsigned long long>(server->counters().foreign.load()));
   };
-
-  // Active freezing: SIGUSR1 / SIGUSR2, or --freeze-at / --freeze-for; state changes are printed.
-  host::FreezeState shown_freeze = host::FreezeState::off;
-  bool freeze_at_done = o.freeze_at_s <= 0;
-  std::optional<Clock::time_point> frozen_since;
-  auto freeze_control = [&](Clock::time_point now) {
-    const int sig = g_freeze_signal.exchange(0);
-    if (sig == 1) { std::printf("freeze: requested (SIGUSR1)\n"); server->request_freeze(); }
-    if (sig == 2) { std::printf("freeze: released (SIGUSR2)\n"); server->release_freeze(); }
-    if (!freeze_at_done && now - start >= std::chrono::duration<double>(o.freeze_at_s)) {
-      freeze_at_done = true;
-      std::printf("freeze: requested (--freeze-at %.3f s)\n", o.freeze_at_s);
-      server->request_freeze();
-    }
-    const auto st = server->freeze_state();
-    if (st != shown_freeze) {
-      std::printf("freeze: %s\n", std::string(host::to_string(st)).c_str());
-      shown_freeze = st;
-      frozen_since.reset();
-      if (st == host::FreezeState::frozen) frozen_since = now;
-    }
-    if (frozen_since && o.freeze_for_s > 0 && server->freeze_requested() &&
-        now - *frozen_since >= std::chrono::duration<double>(o.freeze_for_s)) {
-      std::printf("freeze: released (--freeze-for %.3f s)\n", o.freeze_for_s);
-      server->release_freeze();
-    }
-    std::fflush(stdout);
-  };
+  FreezeControl freeze(o, *server, start);
 
   std::string why = "stopped";
   while (true) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     pump();
     const auto now = Clock::now();
-    freeze_control(now);
+    freeze.poll(now);
     if (signals.count() > 0) { why = "signal"; break; }
-    if (o.duration_s > 0 && now - start >= std::chrono::duration<double>(o.duration_s)) { why = "duration reached"; break; }
+    if (o.duration_s > 0 && now - start >= seconds(o.duration_s)) { why = "duration reached"; break; }
     if (app->finished()) { why = "application finished"; break; }
     if (app->has_error()) {
       why = "application error";
@@ -341,7 +438,7 @@ int run_serve(const ServeOptions& o) {
     if (app->controller_exited()) { why = "controller ended the exchange (504)"; break; }
     if (o.status_interval_s > 0 && now >= next_status) {
       status_line();
-      next_status = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.status_interval_s));
+      next_status = now + seconds(o.status_interval_s);
     }
   }
 
@@ -350,19 +447,19 @@ int run_serve(const ServeOptions& o) {
   spdlog::info("c4g serve: stopping ({})", why);
   app->request_stop();
   if (server->freeze_requested()) {
-    std::printf("freeze: released (stopping)\n");
+    std::fprintf(out, "freeze: released (stopping)\n");
     server->release_freeze();
   }
   auto settled = [&] {
     return app->quiescent() || server->state() == host::ServerState::silent ||
            server->state() == host::ServerState::waiting || app->controller_exited();
   };
-  auto wait_until = [&](double seconds) {
-    const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  auto wait_until = [&](double s) {
+    const auto until = Clock::now() + seconds(s);
     while (!settled() && Clock::now() < until && signals.count() < 2) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
       pump();
-      freeze_control(Clock::now());
+      freeze.poll(Clock::now());
     }
     return settled();
   };
@@ -376,37 +473,8 @@ int run_serve(const ServeOptions& o) {
   if (csv) csv->flush();
 
   const bool faulted = server->safety().faulted() && server->safety().reason() != host::FaultReason::user_request;
-  const int rc = app->has_error() || faulted ? 1 : 0;
-  if (o.json) {
-    const auto& c = server->counters();
-    json j{{"app", std::string(app->name())},
-           {"reason", why},
-           {"app_cycles", app->cycles()},
-           {"finished", app->finished()},
-           {"error", app->error()},
-           {"packets", c.packets.load()},
-           {"init_packets", c.init_packets.load()},
-           {"cyclic_packets", c.cyclic_packets.load()},
-           {"protocol_errors", c.protocol_errors.load()},
-           {"safe_replies", c.safe_replies.load()},
-           {"refused_mode_changes", c.refused_mode_changes.load()},
-           {"controller_late", c.controller_late.load()},
-           {"freezes", c.freezes.load()},
-           {"frozen_cycles", c.frozen_cycles.load()},
-           {"safety_fault", std::string(host::to_string(server->safety().reason()))},
-           {"currents_clamped", server->safety().counters().currents_clamped.load()},
-           {"timing", timing_json(*server)}};
-    if (csv) j["csv_rows"] = csv->rows();
-    if (server->recorder()) j["pcap_written"] = server->recorder()->written();
-    std::printf("%s\n", j.dump(2).c_str());
-  } else {
-    std::printf("stopped: %s\n%s%s", why.c_str(), server->summary().c_str(), app->summary().c_str());
-    if (csv) std::printf("CSV %s: %llu rows (moni type %d)\n", csv->path().c_str(), static_cast<unsigned long long>(csv->rows()),
-                         o.moni < 0 ? 0 : o.moni);
-    if (app->has_error()) std::printf("error: %s\n", app->error().c_str());
-  }
-  std::fflush(stdout);
-  return rc;
+  print_report(o, *server, *app, why, csv.get());
+  return app->has_error() || faulted ? 1 : 0;
 }
 
 // The first 1200-byte UDP payload of a capture (Ethernet / IPv4 / UDP, as PcapRecorder and
@@ -436,7 +504,30 @@ std::vector<std::byte> init_from_pcap(const std::string& path) {
   return out;
 }
 
-int run_init_info(const std::string& file, bool from_pcap) {
+// The initialization packet as JSON: every field under its name in the controller's struct (arrays
+// for the per-axis ones), then the open axes as the axis map reads them.
+json init_json(const protocol::InitPacket& init, const Result<protocol::AxisMap>& map) {
+  json fields = json::object();
+  protocol::for_each_field(init, [&](std::string_view name, int index, const auto& v) {
+    const std::string key(name);
+    if (index < 0) fields[key] = v;
+    else fields[key].push_back(v);
+  });
+  json j{{"fields", fields}, {"open_axes", init.open_axes}, {"period_ms", init.period_ms}};
+  if (!map) {
+    j["axis_map_error"] = map.error().detail;
+    return j;
+  }
+  json axes = json::array();
+  for (std::size_t i = 0; i < map.value().count(); ++i) {
+    const auto ref = map.value().logical(i);
+    axes.push_back({{"open_axis", i + 1}, {"arm", ref.arm}, {"axis", ref.axis}});
+  }
+  j["axis_map"] = axes;
+  return j;
+}
+
+int run_init_info(const std::string& file, bool from_pcap, bool as_json) {
   std::vector<std::byte> bytes;
   if (from_pcap) {
     bytes = init_from_pcap(file);
@@ -447,8 +538,12 @@ int run_init_info(const std::string& file, bool from_pcap) {
     for (char c : raw) bytes.push_back(static_cast<std::byte>(c));
   }
   const auto init = need(protocol::decode_init(bytes));
-  std::printf("%s", protocol::to_string(init).c_str());
   auto map = protocol::AxisMap::from_init(init);
+  if (as_json) {
+    std::printf("%s\n", init_json(init, map).dump(2).c_str());
+    return map ? 0 : 1;
+  }
+  std::printf("%s", protocol::to_string(init).c_str());
   if (!map) {
     std::printf("axis map: %s\n", map.error().detail.c_str());
     return 1;
@@ -468,7 +563,9 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
 
   static ServeOptions so;
   auto* s = c4g->add_subcommand("serve", "serve the controller's packets with a built-in application (docs/c4g-cli.md)");
-  s->add_option("--listen", so.listen, "HOST:PORT to serve on (default the manual's 10.2.12.149:1000; port 0: any)");
+  s->add_option("--listen", so.listen, "HOST[:PORT] to serve on (default 127.0.0.1:11000; the manual's: 10.2.12.149:1000; a host alone: port 1000; port 0: any free)");
+  s->add_option("--controller", so.controller, "HOST[:PORT] of the controller: only it may start a session (default: the first well-formed packet's source; a host alone: any port)");
+  s->add_option("--period-ms", so.period_ms, "the controller's period for the timing figures until its initialization packet gives it [ms]")->check(positive());
   s->add_option("--app", so.app, "monitor (mode 0), echo (0'), stream (4/5), correct (7), pid (1/2), handover (every open phase: 4/5 and 7), contribute (8/9)")->required();
   s->add_option("--file", so.file, "stream: trajectory CSV; correct: correction values CSV");
   s->add_option("--segment", so.segments, "stream/handover: MOTION_TYPE=FILE.csv, the trajectory for that motion type (CMD byte of the arm); repeatable");
@@ -477,16 +574,19 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("--mode", so.mode, "stream: 4 (absolute targets) or 5 (increments); contribute: 8 (velocity) or 9 (current)");
   s->add_option("--units", so.units, "angles in the CSV: rad or deg (else the file's '# units:' line, else rad)");
   s->add_flag("--relative", so.relative, "stream: the trajectory is offsets from the robot's position at the start");
-  s->add_option("--start-tolerance", so.start_tolerance_deg, "stream: start-point tolerance [deg] (default 0.5)");
-  s->add_option("--max-motor-speed", so.max_motor_speed, "continuity limit [motor turns/s] (default 100)");
+  s->add_option("--start-tolerance", so.start_tolerance_deg, "stream: start-point tolerance [deg] (default 0.5)")->check(non_negative());
+  s->add_option("--max-motor-speed", so.max_motor_speed, "continuity limit [motor turns/s] (default 100)")->check(positive());
   s->add_option("--arm", so.arm, "the arm the application drives (default 1)")->check(CLI::Range(1, 4));
   s->add_option("--amplitude", so.amplitude_deg, "correct/pid: sine amplitude per axis [deg, link side]; contribute: [motor turns/s] (mode 8) or [A] (mode 9)")->delimiter(',');
-  s->add_option("--frequency", so.frequency_hz, "correct/pid: sine frequency per axis [Hz] (default 0.5)")->delimiter(',');
-  s->add_option("--open-time", so.open_time_s, "correct/pid: leave the open mode after this long [s] (0: until stopped); handover: hold / zero-correction / sine time per phase (default 0.5)");
-  s->add_option("--ramp", so.ramp_s, "fade in/out time of corrections and sines [s] (default 0.5)");
+  s->add_option("--frequency", so.frequency_hz, "correct/pid: sine frequency per axis [Hz] (default 0.5)")->delimiter(',')->check(non_negative());
+  s->add_option("--open-time", so.open_time_s, "correct/pid: leave the open mode after this long [s] (0: until stopped); handover: hold / zero-correction / sine time per phase (default 0.5)")->check(non_negative());
+  s->add_option("--ramp", so.ramp_s, "fade in/out time of corrections and sines [s] (default 0.5)")->check(non_negative());
   s->add_option("--feed", so.feed, "correct: live correction values over UDP on HOST:PORT (one datagram of numbers per measurement)");
+  s->add_option("--feed-from", so.feed_from, "correct: read the feed only from this sensor HOST[:PORT] (a host alone: any port); others are counted and ignored");
   s->add_option("--feed-axes", so.feed_axes, "correct: values per feed datagram (default 6)")->check(CLI::Range(1, 10));
-  s->add_option("--feed-timeout-ms", so.feed_timeout_ms, "correct: feed values older than this count as none (default 100)");
+  s->add_option("--feed-timeout-ms", so.feed_timeout_ms, "correct: feed values older than this count as none (default 100)")->check(positive());
+  s->add_option("--max-correction", so.max_correction_deg, "correct (and the pid sine): largest correction per axis [deg, link side] (default 5; one value: every axis); beyond it a feed reading is refused, a sine or file is refused at start")->delimiter(',')->check(positive());
+  s->add_option("--max-correction-step", so.max_correction_step_deg, "correct (and the pid sine): largest change of the correction per cycle and axis [deg, link side] (default 0.1); a feed slews at it, a sine or file that needs more is refused")->delimiter(',')->check(positive());
   s->add_option("--kp", so.kp, "pid: position gain per axis [1/s]")->delimiter(',');
   s->add_option("--kv", so.kv, "pid: velocity gain per axis [A/(turn/s)]")->delimiter(',');
   s->add_option("--ki", so.ki, "pid: velocity integral rate per axis [1/s]")->delimiter(',');
@@ -502,21 +602,23 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("--rt-priority", so.rt_priority, "SCHED_FIFO priority of the cycle thread (and mlockall)")->check(CLI::Range(0, 99));
   s->add_option("--cpu", so.cpus, "pin the cycle thread to this CPU (repeatable)");
   s->add_flag("--busy-poll", so.busy_poll, "spin on the socket instead of sleeping (a dedicated core)");
-  s->add_option("--max-step", so.max_step, "Safety: max change of a commanded position per cycle [motor turns] (0: off)");
-  s->add_option("--duration", so.duration_s, "stop after this many seconds (default: until Ctrl-C or the app finishes)");
-  s->add_option("--status-interval", so.status_interval_s, "seconds between status lines (0: none; default 1)");
-  s->add_option("--stop-timeout", so.stop_timeout_s, "seconds to wait for mode 0 when stopping before drive off (default 5)");
-  s->add_flag("--json", so.json, "print the final report as JSON");
-  s->add_option("--freeze-at", so.freeze_at_s, "active freezing (500) from this many seconds after start (also: SIGUSR1 freezes, SIGUSR2 releases)")->check(CLI::Range(0.0, 1e9));
-  s->add_option("--freeze-for", so.freeze_for_s, "release an active freezing this many seconds after the controller shows 500 (0: on SIGUSR2)")->check(CLI::Range(0.0, 1e9));
+  s->add_option("--max-step", so.max_step, "Safety: max change of a commanded position per cycle [motor turns] (0: off)")->check(non_negative());
+  s->add_option("--duration", so.duration_s, "stop after this many seconds (default: until Ctrl-C or the app finishes)")->check(non_negative());
+  s->add_option("--status-interval", so.status_interval_s, "seconds between status lines (0: none; default 1)")->check(non_negative());
+  s->add_option("--stop-timeout", so.stop_timeout_s, "seconds to wait for mode 0 when stopping before drive off (default 5)")->check(non_negative());
+  s->add_flag("--json", so.json, "print the final report as one JSON document on stdout (the other lines go to stderr)");
+  s->add_option("--freeze-at", so.freeze_at_s, "active freezing (500) from this many seconds after start (also: SIGUSR1 freezes, SIGUSR2 releases)")->check(non_negative());
+  s->add_option("--freeze-for", so.freeze_for_s, "release an active freezing this many seconds after the controller shows 500 (0: on SIGUSR2)")->check(non_negative());
   s->callback([] { exit_code() = run_serve(so); });
 
   static std::string init_file;
   static bool from_pcap = false;
+  static bool init_json_out = false;
   auto* i = c4g->add_subcommand("init-info", "print an initialization packet (1200-byte file, or the first one in a pcap)");
   i->add_option("file", init_file, "the file")->required();
   i->add_flag("--from-pcap", from_pcap, "the file is a capture: use its first 1200-byte UDP payload");
-  i->callback([] { exit_code() = run_init_info(init_file, from_pcap); });
+  i->add_flag("--json", init_json_out, "print the packet as one JSON document");
+  i->callback([] { exit_code() = run_init_info(init_file, from_pcap, init_json_out); });
 }
 
 }  // namespace axon::app

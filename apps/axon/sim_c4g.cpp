@@ -1,10 +1,12 @@
 // `axon sim c4g`: a simulated C4G robot controller that plays a robot program (scenario) and talks
 // to a PC server over the open interface's UDP protocol, as the real controller would.
+#include "c4g/host/server.hpp"
 #include "c4g/sim/client_runner.hpp"
 #include "c4g/sim/controller.hpp"
 #include "c4g/sim/robots.hpp"
 #include "c4g/sim/scenario.hpp"
 #include "c4g/sim/udp_client.hpp"
+#include "checks.hpp"
 #include "commands.hpp"
 #include "net/endpoint.hpp"
 #include "run.hpp"
@@ -25,7 +27,7 @@ namespace sim = c4g::sim;
 
 struct SimC4gOptions {
   std::string robot = "six-axis";
-  std::string server;
+  std::string server = fmt::format("{}:{}", c4g::host::kDefaultServerAddress, c4g::host::kDefaultPort);
   std::string bind;
   int period_ms = 0;
   std::string scenario;
@@ -58,7 +60,7 @@ int run_sim_c4g(const SimC4gOptions& o) {
   if (o.numbering == "next") co.numbering = c4g::protocol::ReplyNumbering::next;
   else if (o.numbering != "same") throw Exception(Error(CoreErrc::invalid_argument, "--numbering is same or next"));
   auto controller = need(sim::Controller::create(std::move(robot), scenario, co));
-  const auto server = need(net::parse_endpoint(o.server, 1000));
+  const auto server = need(net::parse_endpoint(o.server, c4g::host::kManualPort));
   std::optional<net::Endpoint> local;
   if (!o.bind.empty()) local = need(net::parse_endpoint(o.bind, 0));
   auto opened = sim::UdpClient::open(server, local);
@@ -153,12 +155,12 @@ void add_sim_c4g_command(CLI::App& sim_cmd) {
   static SimC4gOptions opts;
   auto* c = sim_cmd.add_subcommand("c4g", "simulated C4G controller (open interface client) playing a robot program");
   c->add_option("--robot", opts.robot, "robot model (six-axis)");
-  c->add_option("--server", opts.server, "the PC server HOST:PORT (port default 1000)")->required();
+  c->add_option("--server", opts.server, "the PC server HOST[:PORT] (default 127.0.0.1:11000, where `axon c4g serve` listens by default; a host alone: the manual's port 1000)");
   c->add_option("--bind", opts.bind, "local HOST:PORT of the controller (default: any)");
   c->add_option("--period-ms", opts.period_ms, "controller period, 1 or 2 ms (default: the robot's, 2)")->check(CLI::Range(1, 2));
   c->add_option("--scenario", opts.scenario, "scenario YAML (docs/c4g-simulator.md); default: drive on, mode 0, a move, run");
-  c->add_option("--duration", opts.duration_s, "stop after this many seconds (default: when the scenario ends or Ctrl-C)");
-  c->add_option("--reply-deadline-us", opts.reply_deadline_us, "reply deadline after each send (default: one period)");
+  c->add_option("--duration", opts.duration_s, "stop after this many seconds (default: when the scenario ends or Ctrl-C)")->check(non_negative());
+  c->add_option("--reply-deadline-us", opts.reply_deadline_us, "reply deadline after each send (default: one period)")->check(positive());
   c->add_option("--numbering", opts.numbering, "reply numbering expected: same (manual) or next (NUM + 1)");
   c->add_option("--sync-packets", opts.sync_packets, "answered sync packets before the initialization packet")->check(CLI::Range(0, 1000));
   c->add_flag("--json", opts.json, "print the summary (and events) as JSON");

@@ -23,6 +23,11 @@ ContributeApp::ContributeApp(ContributeOptions options) : options_(std::move(opt
     throw Exception(Error(CoreErrc::invalid_argument, "contribute: times must not be negative"));
   for (double v : options_.amplitude)
     if (!std::isfinite(v)) throw Exception(Error(CoreErrc::invalid_argument, "contribute: amplitudes must be finite"));
+  for (std::size_t j = 0; j < options_.amplitude.size() && options_.mode == 8; ++j)
+    if (!(std::fabs(options_.amplitude[j]) <= options_.max_motor_speed))
+      throw Exception(Error(CoreErrc::invalid_argument,
+                            fmt::format("contribute: a velocity amplitude of {:g} motor turns/s on axis {} exceeds "
+                                        "--max-motor-speed {:g}", options_.amplitude[j], j + 1, options_.max_motor_speed)));
 }
 
 void ContributeApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) {

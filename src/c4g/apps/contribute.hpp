@@ -25,6 +25,9 @@ struct ContributeOptions {
   std::vector<double> frequency_hz;   // per axis; one value: every axis; none: 0.5 Hz
   double open_time_s = 0;             // 0: until a stop request
   double ramp_s = 0.5;
+  // Mode 8: a velocity contribution above this [motor turns/s] is refused when the app is built
+  // (mode 9 currents are saturated to the initialization packet's limits by the server's Safety).
+  double max_motor_speed = 100.0;
 };
 
 class ContributeApp final : public App {

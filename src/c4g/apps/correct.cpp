@@ -14,6 +14,24 @@ namespace axon::c4g::apps {
 using protocol::code;
 using protocol::Mode;
 
+namespace {
+
+Exception refused(std::string text) { return Exception(Error(CoreErrc::invalid_argument, std::move(text))); }
+
+// The sine's amplitudes and the file's values within max_abs: checked when the app is built.
+void check_sources(const CorrectOptions& o) {
+  if (auto v = check_sine("correct", o.amplitude_rad, o.frequency_hz, o.limits); !v) throw Exception(v.error());
+  if (!o.values) return;
+  const Trajectory& t = *o.values;
+  for (std::size_t r = 0; r < t.rows(); ++r)
+    for (std::size_t j = 0; j < t.axes(); ++j)
+      if (!(std::fabs(t.value(r, j)) <= o.limits.max_abs(j)))
+        throw refused(fmt::format("correct: the file's row {} (t={:g} s) asks {:g} deg on axis {}, beyond the correction limit "
+                                  "{:g} deg (--max-correction)", r + 1, t.time(r), t.value(r, j) * kRadToDeg, j + 1,
+                                  o.limits.max_abs(j) * kRadToDeg));
+}
+}  // namespace
+
 CorrectApp::CorrectApp(CorrectOptions options) : options_(std::move(options)) {
   for (auto& a : applied_) a.store(0, std::memory_order_relaxed);
   const int sources = (options_.values ? 1 : 0) + (options_.feed ? 1 : 0) + (options_.amplitude_rad.empty() ? 0 : 1);
@@ -23,6 +41,8 @@ CorrectApp::CorrectApp(CorrectOptions options) : options_(std::move(options)) {
     throw Exception(Error(CoreErrc::invalid_argument, "correct: the feed timeout must be positive"));
   if (options_.ramp_s < 0 || options_.open_time_s < 0)
     throw Exception(Error(CoreErrc::invalid_argument, "correct: times must not be negative"));
+  if (auto v = validate(options_.limits); !v) throw Exception(v.error());
+  check_sources(options_);
 }
 
 void CorrectApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) {
@@ -86,6 +106,37 @@ void CorrectApp::setup(const protocol::InitPacket& init, const protocol::AxisMap
       }
     }
   }
+  if (!options_.feed && !check_steps(period)) set_phase(Phase::refused);
+}
+
+bool CorrectApp::check_steps(double period) noexcept {
+  const std::size_t n = view_->count;
+  const double fade = fade_per_cycle(period, options_.ramp_s);
+  for (std::size_t j = 0; j < n; ++j) {
+    double step = 0;  // bound on the change per cycle, link side
+    if (options_.values) {
+      const Trajectory& f = *options_.values;
+      double peak = 0, prev = 0;
+      const auto rows = static_cast<std::size_t>(std::ceil(f.end_time() / period)) + 1;
+      std::array<double, protocol::kAxesPerArm> pos{}, vel{};
+      for (std::size_t k = 1; k <= rows; ++k) {
+        f.sample(static_cast<double>(k) * period, std::span<double>(pos.data(), n), std::span<double>(vel.data(), n));
+        step = std::max(step, std::fabs(pos[j] - prev));
+        peak = std::max(peak, std::fabs(pos[j]));
+        prev = pos[j];
+      }
+      step += peak * fade;
+    } else {
+      step = sine_step_bound(amplitude_[j], frequency_[j], period, options_.ramp_s);
+    }
+    if (step > options_.limits.max_step(j) * (1 + 1e-9)) {
+      fail("correct: the correction can change by %.4f deg in one cycle on axis %zu (fades included), beyond the limit "
+           "%.4f deg per cycle (--max-correction-step)",
+           step * kRadToDeg, j + 1, options_.limits.max_step(j) * kRadToDeg);
+      return false;
+    }
+  }
+  return true;
 }
 
 void CorrectApp::correction(double t, double env, protocol::ArmTransform::Vector& link) const noexcept {
@@ -100,9 +151,25 @@ void CorrectApp::correction(double t, double env, protocol::ArmTransform::Vector
   }
 }
 
+void CorrectApp::take_reading() noexcept {
+  if (!options_.feed->latest(incoming_) || incoming_.sequence == seen_sequence_) return;  // torn or nothing new
+  seen_sequence_ = incoming_.sequence;
+  for (std::size_t j = 0; j < view_->count; ++j) {
+    if (std::fabs(incoming_.values[j]) <= options_.limits.max_abs(j)) continue;  // false for NaN too
+    refused_axis_.store(static_cast<int>(j), std::memory_order_relaxed);
+    refused_value_.store(incoming_.values[j], std::memory_order_relaxed);
+    refused_samples_.fetch_add(1, std::memory_order_relaxed);
+    if (!refusing_) note(kNoteFeedRefused);
+    refusing_ = true;
+    return;
+  }
+  refusing_ = false;
+  reading_ = incoming_;
+}
+
 void CorrectApp::feed_target(double env, protocol::ArmTransform::Vector& link) noexcept {
   const std::size_t n = view_->count;
-  options_.feed->latest(reading_);  // on a torn read the previous reading stays
+  take_reading();
   timespec now{};
   clock_gettime(CLOCK_MONOTONIC, &now);
   const std::int64_t now_ns = static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
@@ -114,6 +181,35 @@ void CorrectApp::feed_target(double env, protocol::ArmTransform::Vector& link) n
   }
   if (stale) stale_cycles_.fetch_add(1, std::memory_order_relaxed);
   for (std::size_t j = 0; j < n; ++j) link[static_cast<Eigen::Index>(j)] = stale ? 0.0 : env * reading_.values[j];
+}
+
+void CorrectApp::slew(protocol::ArmTransform::Vector& link) noexcept {
+  bool cut = false;
+  for (std::size_t j = 0; j < view_->count; ++j) {
+    auto& x = link[static_cast<Eigen::Index>(j)];
+    const double limit = options_.limits.max_step(j);
+    const double step = std::clamp(x - link_last_[j], -limit, limit);
+    cut = cut || step != x - link_last_[j];
+    x = link_last_[j] + step;
+  }
+  if (cut) slewed_cycles_.fetch_add(1, std::memory_order_relaxed);
+}
+
+int CorrectApp::out_of_bounds(const protocol::ArmTransform::Vector& link) const noexcept {
+  for (std::size_t j = 0; j < view_->count; ++j) {
+    const double x = link[static_cast<Eigen::Index>(j)];
+    // A slewed step may round just above the limit.
+    if (!(std::fabs(x) <= options_.limits.max_abs(j)) ||
+        !(std::fabs(x - link_last_[j]) <= options_.limits.max_step(j) * (1 + 1e-9)))
+      return static_cast<int>(j);
+  }
+  return -1;
+}
+
+void CorrectApp::refuse_now(host::ReplyBuilder& reply) noexcept {
+  set_phase(Phase::refused);
+  for (std::size_t i = 0; i < view_->count; ++i) reply.axis(view_->first + i).d1 = 0;
+  exit_from_open(reply, view_->arm);
 }
 
 void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
@@ -142,6 +238,7 @@ void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) 
       t_ = 0;
       ticks_ = 0;
       last_ = {};
+      link_last_ = {};
       for (auto& a : applied_) a.store(0, std::memory_order_relaxed);
       runs_.fetch_add(1, std::memory_order_relaxed);
       set_phase(Phase::correcting);
@@ -190,9 +287,26 @@ void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) 
       ph = Phase::exiting;
     }
   }
+  emit(env, ph, reply);
+}
+
+void CorrectApp::emit(double env, Phase ph, host::ReplyBuilder& reply) noexcept {
+  const std::size_t n = view_->count, first = view_->first;
+  const double period = view_->period_s;
   protocol::ArmTransform::Vector link(static_cast<Eigen::Index>(n));
-  if (options_.feed) feed_target(env, link);
-  else correction(t_, env, link);
+  if (options_.feed) {
+    feed_target(env, link);
+    slew(link);
+  } else {
+    correction(t_, env, link);
+  }
+  if (const int j = out_of_bounds(link); j >= 0) {
+    fail("correct: the correction on axis %d (%.4f deg, %.4f deg since the last cycle) breaks its limits (%.4f deg, "
+         "%.4f deg per cycle)", j + 1, link[j] * kRadToDeg, (link[j] - link_last_[static_cast<std::size_t>(j)]) * kRadToDeg,
+         options_.limits.max_abs(static_cast<std::size_t>(j)) * kRadToDeg, options_.limits.max_step(static_cast<std::size_t>(j)) * kRadToDeg);
+    refuse_now(reply);
+    return;
+  }
   auto motor = view_->transform.motor_velocity(link);
   const double max_step = options_.max_motor_speed * period;
   if (options_.feed) {
@@ -212,9 +326,7 @@ void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) 
     const double inc = motor[static_cast<Eigen::Index>(j)] - last_[j];
     if (!(std::fabs(inc) <= max_step * (1 + 1e-9))) {  // a slewed step may round just above the limit
       fail("correct: increment of %.4f motor turns on axis %zu exceeds %.4f", inc, j + 1, max_step);
-      set_phase(Phase::refused);
-      for (std::size_t i = 0; i < n; ++i) reply.axis(first + i).d1 = 0;
-      exit_from_open(reply, view_->arm);
+      refuse_now(reply);
       return;
     }
   }
@@ -223,6 +335,7 @@ void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) 
     reply.axis(first + j).d1 = static_cast<float>(c - last_[j]);
     applied_[j].store(c, std::memory_order_relaxed);
     last_[j] = c;
+    link_last_[j] = link[static_cast<Eigen::Index>(j)];
   }
   if (ph == Phase::exiting) exit_from_open(reply, view_->arm);
 }
@@ -235,6 +348,9 @@ std::string CorrectApp::note_text(std::int32_t c) const {
     case kNoteFeedStale:
       return fmt::format("correct: no feed values for {:.0f} ms: correction returning to zero", options_.feed_timeout_s * 1e3);
     case kNoteFeedBack: return "correct: feed values again";
+    case kNoteFeedRefused:
+      return "correct: feed reading refused: a value is beyond the correction limit (the correction keeps the last good "
+             "reading; the summary names the last one refused)";
     default: return App::note_text(c);
   }
 }
@@ -252,9 +368,17 @@ std::string CorrectApp::summary() const {
   std::string out = App::summary() + fmt::format("correct: {:.3f} s corrected, phase {}\n",
                                                 elapsed_.load(std::memory_order_relaxed), names[static_cast<int>(phase())]);
   if (options_.feed) {
-    out += fmt::format("correct: feed on port {}: {} datagrams accepted, {} rejected, {} stale cycles\n", options_.feed->port(),
-                       options_.feed->accepted(), options_.feed->rejected(), stale_cycles());
+    out += fmt::format("correct: feed on port {}: {} datagrams accepted, {} rejected, {} from other senders ignored, "
+                       "{} readings refused beyond the limits, {} stale cycles, {} cycles slewed\n", options_.feed->port(),
+                       options_.feed->accepted(), options_.feed->rejected(), options_.feed->foreign(), refused_samples(),
+                       stale_cycles(), slewed_cycles());
     if (const auto e = options_.feed->last_error(); !e.empty()) out += "correct: last rejected datagram " + e + "\n";
+    if (refused_samples() > 0) {
+      const int j = refused_axis_.load(std::memory_order_relaxed);
+      out += fmt::format("correct: last refused reading: axis {} = {:g} deg, beyond the correction limit {:g} deg\n", j + 1,
+                         refused_value_.load(std::memory_order_relaxed) * kRadToDeg,
+                         options_.limits.max_abs(static_cast<std::size_t>(j)) * kRadToDeg);
+    }
   }
   return out;
 }

@@ -35,6 +35,8 @@ PidApp::PidApp(PidOptions options) : options_(std::move(options)) {
   for (const auto& g : options_.gains)
     if (!(g.kp >= 0 && g.kv >= 0 && g.ki >= 0))
       throw Exception(Error(CoreErrc::invalid_argument, "pid: gains must not be negative"));
+  if (auto v = validate(options_.limits); !v) throw Exception(v.error());
+  if (auto v = check_sine("pid", options_.amplitude_rad, options_.frequency_hz, options_.limits); !v) throw Exception(v.error());
 }
 
 void PidApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) {
@@ -56,6 +58,13 @@ void PidApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& ax
     amplitude_[j] = a.empty() ? 0.0 : (a.size() == 1 ? a[0] : (j < a.size() ? a[j] : 0.0));
     frequency_[j] = f.empty() ? 0.5 : (f.size() == 1 ? f[0] : (j < f.size() ? f[j] : 0.0));
     limit_[j] = std::fabs(limits[view_->first + j]);
+    const double step = sine_step_bound(amplitude_[j], frequency_[j], view_->period_s, options_.ramp_s);
+    if (step > options_.limits.max_step(j) * (1 + 1e-9)) {
+      fail("pid: the sine can change by %.4f deg in one cycle on axis %zu (fades included), beyond the limit %.4f deg per "
+           "cycle (--max-correction-step)", step * kRadToDeg, j + 1, options_.limits.max_step(j) * kRadToDeg);
+      set_phase(Phase::refused);
+      return;
+    }
   }
 }
 

@@ -36,6 +36,7 @@
 #pragma once
 
 #include "c4g/apps/app.hpp"
+#include "c4g/apps/correction_limits.hpp"
 
 #include <vector>
 
@@ -60,6 +61,10 @@ struct PidOptions {
   std::vector<PidGains> gains;  // per axis; one entry: every axis; empty: defaults
   std::vector<double> amplitude_rad;  // mode 1 sine, link side; empty: hold
   std::vector<double> frequency_hz;
+  // The sine's bounds (an offset from the hold point, as a correction): an amplitude beyond max_abs
+  // is refused when the app is built, a sine changing faster than max_step per cycle (fades
+  // included) when the initialization packet gives the period.
+  CorrectionLimits limits;
   bool dynamic_model_feedforward = true;
   double open_time_s = 0;  // mode 1: leave after this long (0: until a stop request)
   double ramp_s = 0.5;

@@ -25,8 +25,9 @@ Result<void> parse_feed_datagram(std::string_view text, std::span<double> out, b
     const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
     if (ec != std::errc{} || ptr != token.data() + token.size())
       return Error(CoreErrc::invalid_argument, fmt::format("value {} \"{}\" is not a number", count + 1, token.substr(0, 40)));
+    if (degrees) v *= std::numbers::pi / 180.0;  // one factor: 1e308 deg stays finite in rad
     if (!std::isfinite(v)) return Error(CoreErrc::invalid_argument, fmt::format("value {} is not finite", count + 1));
-    out[count++] = degrees ? v * std::numbers::pi / 180.0 : v;
+    out[count++] = v;
     i = end;
   }
   if (count != out.size())
@@ -37,15 +38,23 @@ Result<void> parse_feed_datagram(std::string_view text, std::span<double> out, b
 Result<std::unique_ptr<SensorFeed>> SensorFeed::open(const SensorFeedOptions& options) {
   if (options.axes == 0 || options.axes > kMaxAxes)
     return Error(CoreErrc::invalid_argument, fmt::format("sensor feed: {} axes (1..{})", options.axes, kMaxAxes));
+  net::SocketAddress source;  // anyone
+  if (!options.source.host.empty()) {
+    auto resolved = net::resolve_ipv4(options.source);
+    if (!resolved) return Error(resolved.error().code, "sensor feed source: " + resolved.error().detail);
+    if (resolved.value().ip == 0)
+      return Error(CoreErrc::invalid_argument, fmt::format("sensor feed: the source '{}' names no host", options.source.to_string()));
+    source = resolved.value();
+  }
   net::UdpOptions uo;
   uo.kernel_timestamps = false;
   auto socket = net::UdpSocket::open(options.listen, uo);
   if (!socket) return Error(socket.error().code, "sensor feed: " + socket.error().detail);
-  return std::unique_ptr<SensorFeed>(new SensorFeed(std::move(socket).value(), options));
+  return std::unique_ptr<SensorFeed>(new SensorFeed(std::move(socket).value(), options, source));
 }
 
-SensorFeed::SensorFeed(net::UdpSocket socket, SensorFeedOptions options)
-    : socket_(std::move(socket)), options_(std::move(options)) {
+SensorFeed::SensorFeed(net::UdpSocket socket, SensorFeedOptions options, net::SocketAddress source)
+    : socket_(std::move(socket)), options_(std::move(options)), source_(source) {
   for (auto& v : values_) v.store(0, std::memory_order_relaxed);
   thread_ = std::thread([this] { run(); });
 }
@@ -66,6 +75,10 @@ void SensorFeed::run() {
       continue;  // counted by the socket (receive_errors)
     }
     const auto& d = got.value();
+    if (!source_.admits(d.from)) {
+      foreign_.fetch_add(1, std::memory_order_relaxed);
+      continue;
+    }
     const std::string_view text(reinterpret_cast<const char*>(buffer.data()), d.size);
     auto parsed = d.truncated() ? Result<void>(Error(CoreErrc::invalid_argument, "datagram longer than 1500 bytes"))
                                 : parse_feed_datagram(text, std::span<double>(values.data(), options_.axes), options_.degrees);

@@ -6,11 +6,14 @@
 // "0.001 0 -0.0005 0 0 0". Units are radians, or degrees when the feed is opened with
 // `degrees = true`. A datagram with the wrong number of values, something that is not a number, or
 // a non-finite value is rejected and counted (last_error() says why); the previous values stay.
+// With `source` set, datagrams from any other sender are foreign: counted (foreign()) and dropped
+// unread, as the server does with a stranger's packets.
 //
 // Threads: a receive thread owns the socket and publishes through a sequence lock (atomics only).
 // latest() runs on the cycle thread: no allocation, no lock, bounded retries.
 #pragma once
 
+#include "c4g/host/session_peer.hpp"
 #include "core/error.hpp"
 #include "net/endpoint.hpp"
 #include "net/udp_socket.hpp"
@@ -28,6 +31,7 @@ namespace axon::c4g::apps {
 
 struct SensorFeedOptions {
   net::Endpoint listen{"127.0.0.1", 0};
+  net::Endpoint source{"", 0};  // the sensor's HOST[:PORT]: only it is read (empty host: anyone; port 0: any port)
   std::size_t axes = 6;       // values per datagram
   bool degrees = false;
 };
@@ -59,10 +63,11 @@ class SensorFeed {
   [[nodiscard]] std::size_t axes() const noexcept { return options_.axes; }
   [[nodiscard]] std::uint64_t accepted() const noexcept { return accepted_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t rejected() const noexcept { return rejected_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t foreign() const noexcept { return foreign_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::string last_error() const;
 
  private:
-  SensorFeed(net::UdpSocket socket, SensorFeedOptions options);
+  SensorFeed(net::UdpSocket socket, SensorFeedOptions options, net::SocketAddress source);
   void run();
   void publish(std::span<const double> values, std::int64_t steady_ns) noexcept;
 
@@ -71,7 +76,8 @@ class SensorFeed {
   std::atomic<std::uint64_t> seq_{0};  // odd while the writer is in the middle of an update
   std::array<std::atomic<double>, kMaxAxes> values_{};
   std::atomic<std::int64_t> stamp_{0};
-  std::atomic<std::uint64_t> accepted_{0}, rejected_{0};
+  std::atomic<std::uint64_t> accepted_{0}, rejected_{0}, foreign_{0};
+  host::SessionPeer source_;  // only its admits(): the allowed sender
   mutable std::mutex error_mutex_;  // receive thread and readers of last_error(), never the cycle
   std::string last_error_;
   std::atomic<bool> stopping_{false};

@@ -67,10 +67,24 @@ void CycleThread::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
+Result<net::Datagram> CycleThread::receive_until(std::int64_t deadline_ns) {
+  if (deadline_ns < 0) return socket_.receive(rx_, std::chrono::nanoseconds(-1));
+  const std::int64_t left = deadline_ns - clock_ns(CLOCK_MONOTONIC);
+  // Past the deadline: a timeout even if datagrams are queued (a flood of refused ones must not
+  // hide the silence of the accepted sender).
+  if (left <= 0) return Error(net::NetErrc::timeout);
+  return socket_.receive(rx_, std::chrono::nanoseconds(left));
+}
+
 void CycleThread::run() {
   bool first = true;
+  auto deadline_after = [&](std::int64_t from_ns) -> std::int64_t {
+    const auto wait = first ? options_.first_packet_timeout : options_.cycle_timeout;
+    return wait.count() < 0 ? -1 : from_ns + wait.count();
+  };
+  std::int64_t deadline = deadline_after(clock_ns(CLOCK_MONOTONIC));
   while (!stop_.load(std::memory_order_acquire)) {
-    auto r = socket_.receive(rx_, first ? options_.first_packet_timeout : options_.cycle_timeout);
+    auto r = receive_until(deadline);
     if (!r) {
       if (r.error() == net::NetErrc::interrupted) break;
       if (r.error() == net::NetErrc::timeout) {
@@ -78,39 +92,49 @@ void CycleThread::run() {
         // A silence is not a jitter sample: the next inter-step series starts afresh.
         timing_.restart_inter_step();
         handler_.on_timeout(first);
+        deadline = deadline_after(clock_ns(CLOCK_MONOTONIC));
       } else {
         bump(counters_.receive_errors);
       }
       continue;
     }
     const net::Datagram& d = r.value();
+    if (!handler_.accepts(std::span<const std::byte>(rx_.data(), d.size), d)) {
+      bump(counters_.refused);
+      continue;
+    }
     first = false;
-    const std::span<const std::byte> request(rx_.data(), d.size);
-    if (recorder_) recorder_->record(d.from, d.to, request, d.wall_ns);
-    if (d.kernel_timestamp) wakeup_.add(d.wakeup_latency_ns);
-
-    const std::size_t n = std::min(handler_.on_packet(request, d, tx_), tx_.size());
-    bump(counters_.cycles);
-    if (n == 0) {
-      bump(counters_.silent);
-      continue;
-    }
-    const std::span<const std::byte> reply(tx_.data(), n);
-    // The capture stamps the answer as it leaves: before the send, so that it never appears after
-    // a next request the peer sent in reaction to it.
-    const std::int64_t wall_send = recorder_ ? clock_ns(CLOCK_REALTIME) : 0;
-    auto sent = socket_.send_to(reply, d.from);
-    const std::int64_t t2 = clock_ns(CLOCK_MONOTONIC);
-    const std::int64_t wall2 = clock_ns(CLOCK_REALTIME);
-    if (!sent) {
-      bump(counters_.send_errors);
-      continue;
-    }
-    bump(counters_.replies);
-    timing_.record(d.steady_ns, t2);
-    reply_latency_.add(wall2 - d.wall_ns);
-    if (recorder_) recorder_->record(d.to, d.from, reply, wall_send);
+    deadline = deadline_after(d.steady_ns);
+    serve(d);
   }
+}
+
+void CycleThread::serve(const net::Datagram& d) {
+  const std::span<const std::byte> request(rx_.data(), d.size);
+  if (recorder_) recorder_->record(d.from, d.to, request, d.wall_ns);
+  if (d.kernel_timestamp) wakeup_.add(d.wakeup_latency_ns);
+
+  const std::size_t n = std::min(handler_.on_packet(request, d, tx_), tx_.size());
+  bump(counters_.cycles);
+  if (n == 0) {
+    bump(counters_.silent);
+    return;
+  }
+  const std::span<const std::byte> reply(tx_.data(), n);
+  // The capture stamps the answer as it leaves: before the send, so that it never appears after
+  // a next request the peer sent in reaction to it.
+  const std::int64_t wall_send = recorder_ ? clock_ns(CLOCK_REALTIME) : 0;
+  auto sent = socket_.send_to(reply, d.from);
+  const std::int64_t t2 = clock_ns(CLOCK_MONOTONIC);
+  const std::int64_t wall2 = clock_ns(CLOCK_REALTIME);
+  if (!sent) {
+    bump(counters_.send_errors);
+    return;
+  }
+  bump(counters_.replies);
+  timing_.record(d.steady_ns, t2);
+  reply_latency_.add(wall2 - d.wall_ns);
+  if (recorder_) recorder_->record(d.to, d.from, reply, wall_send);
 }
 
 std::string CycleThread::summary() const {
@@ -123,9 +147,9 @@ std::string CycleThread::summary() const {
   };
   pct("Wake-up latency (arrival to user)", wakeup_);
   pct("Reply latency (arrival to sent)", reply_latency_);
-  fmt::format_to(it, "Packets {} answered {} unanswered {} timeouts {} send errors {} receive errors {}\n",
-                 counters_.cycles.load(), counters_.replies.load(), counters_.silent.load(), counters_.timeouts.load(),
-                 counters_.send_errors.load(), counters_.receive_errors.load());
+  fmt::format_to(it, "Packets {} answered {} unanswered {} refused {} timeouts {} send errors {} receive errors {}\n",
+                 counters_.cycles.load(), counters_.replies.load(), counters_.silent.load(), counters_.refused.load(),
+                 counters_.timeouts.load(), counters_.send_errors.load(), counters_.receive_errors.load());
   return out;
 }
 

@@ -34,11 +34,18 @@ namespace axon::c4g::host {
 class CycleHandler {
  public:
   virtual ~CycleHandler() = default;
-  // One received datagram (possibly truncated: info.truncated()). Writes the answer into `reply`
+  // Whether a received datagram is the handler's business at all. A refused datagram (a foreign
+  // sender) leaves no trace in the cycle: no on_packet, no reply, no timing or latency sample, no
+  // capture, and it does not postpone the cycle timeout.
+  virtual bool accepts(std::span<const std::byte> request, const net::Datagram& info) noexcept {
+    (void)request, (void)info;
+    return true;
+  }
+  // One accepted datagram (possibly truncated: info.truncated()). Writes the answer into `reply`
   // and returns its length; 0 sends nothing.
   virtual std::size_t on_packet(std::span<const std::byte> request, const net::Datagram& info,
                                 std::span<std::byte> reply) noexcept = 0;
-  // Nothing arrived within the timeout; `before_first` while no packet has arrived yet.
+  // No accepted datagram within the timeout; `before_first` while none has been accepted yet.
   virtual void on_timeout(bool before_first) noexcept { (void)before_first; }
 };
 
@@ -53,7 +60,8 @@ struct CycleOptions {
 };
 
 struct CycleCounters {
-  std::atomic<std::uint64_t> cycles{0};          // datagrams handled
+  std::atomic<std::uint64_t> cycles{0};          // accepted datagrams handled
+  std::atomic<std::uint64_t> refused{0};         // datagrams the handler refused (accepts() false)
   std::atomic<std::uint64_t> replies{0};         // answers sent
   std::atomic<std::uint64_t> silent{0};          // datagrams the handler chose not to answer
   std::atomic<std::uint64_t> timeouts{0};        // waits that ended without a packet
@@ -79,6 +87,8 @@ class CycleThread {
   [[nodiscard]] net::SocketAddress local_address() const noexcept { return socket_.local_address(); }
   [[nodiscard]] const net::UdpSocket& socket() const noexcept { return socket_; }
   [[nodiscard]] const TimingStats& timing() const noexcept { return timing_; }
+  // The controller's inter-packet period the timing figures compare against (any thread).
+  void set_nominal_period(std::int64_t ns) noexcept { timing_.set_nominal_period_ns(ns); }
   [[nodiscard]] const core::LatencyHistogram& wakeup_latency() const noexcept { return wakeup_; }
   [[nodiscard]] const core::LatencyHistogram& reply_latency() const noexcept { return reply_latency_; }
   [[nodiscard]] const CycleCounters& counters() const noexcept { return counters_; }
@@ -89,6 +99,9 @@ class CycleThread {
 
  private:
   void run();
+  // Waits for the next datagram until `deadline_ns` (CLOCK_MONOTONIC; < 0: no deadline).
+  Result<net::Datagram> receive_until(std::int64_t deadline_ns);
+  void serve(const net::Datagram& d);
 
   net::UdpSocket socket_;
   CycleHandler& handler_;

@@ -52,6 +52,31 @@ bool every_axis_in(const protocol::Packet& p, std::int32_t mode) noexcept {
   return p.count > 0;
 }
 
+// A datagram that may start a session: a cyclic packet or an initialization packet that decodes.
+bool well_formed(std::span<const std::byte> in, const net::Datagram& info) noexcept {
+  if (info.truncated()) return false;
+  switch (protocol::classify(in.size())) {
+    case protocol::DatagramKind::cyclic: {
+      protocol::Packet p;
+      return protocol::decode_packet(in, p).ok();
+    }
+    case protocol::DatagramKind::init:
+      try {  // decoding the initialization packet may allocate (error texts); once per session
+        return static_cast<bool>(protocol::decode_init(in));
+      } catch (...) {
+        return false;
+      }
+    case protocol::DatagramKind::unknown: break;
+  }
+  return false;
+}
+
+std::string describe_allowed(const net::SocketAddress& a) {
+  if (a.ip == 0) return "learned from its first packet";
+  if (a.port != 0) return a.to_string();
+  return fmt::format("{}.{}.{}.{} (any port)", a.ip >> 24, (a.ip >> 16) & 0xff, (a.ip >> 8) & 0xff, a.ip & 0xff);
+}
+
 std::int32_t read_i32(std::span<const std::byte> in, std::size_t offset) noexcept {
   std::uint32_t v = 0;
   for (int i = 3; i >= 0; --i) v = (v << 8) | std::to_integer<std::uint32_t>(in[offset + static_cast<std::size_t>(i)]);
@@ -59,25 +84,37 @@ std::int32_t read_i32(std::span<const std::byte> in, std::size_t offset) noexcep
 }
 }  // namespace
 
-Server::Server(Controller& controller, const ServerOptions& options)
-    : controller_(controller), options_(options), safety_(options.safety), switch_(options.soft_switch) {}
+Server::Server(Controller& controller, const ServerOptions& options, net::SocketAddress allowed)
+    : controller_(controller), options_(options), safety_(options.safety), peer_(allowed), switch_(options.soft_switch) {}
 
 Result<std::unique_ptr<Server>> Server::start(Controller& controller, const ServerOptions& options) {
   AXON_TRY(protocol::validate(options.soft_switch));
-  std::unique_ptr<Server> s(new Server(controller, options));
+  if (options.period.count() < 0)
+    return Error(CoreErrc::invalid_argument, "c4g server: the controller's period must be > 0 (or 0: from its initialization packet)");
+  net::SocketAddress allowed;  // anyone
+  if (!options.controller.host.empty()) {
+    AXON_TRY(resolved, net::resolve_ipv4(options.controller));
+    if (resolved.ip == 0)
+      return Error(CoreErrc::invalid_argument, fmt::format("c4g server: the controller address '{}' names no host",
+                                                           options.controller.to_string()));
+    allowed = resolved;
+  }
+  std::unique_ptr<Server> s(new Server(controller, options, allowed));
   AXON_TRY(socket, net::UdpSocket::open(options.listen, options.udp));
   if (!options.pcap_path.empty()) {
     AXON_TRY(rec, PcapRecorder::open(options.pcap_path, options.pcap));
     s->recorder_ = std::move(rec);
   }
   CycleOptions cycle = options.cycle;
+  if (options.period.count() > 0) cycle.timing.nominal_period_ns = options.period.count();
   cycle.max_reply = std::max(cycle.max_reply, protocol::kMaxPacketSize);
   cycle.max_datagram = std::max(cycle.max_datagram, protocol::kInitPacketSize + 1);
   CycleHandler& handler = *s;
   s->cycle_ = std::make_unique<CycleThread>(std::move(socket), handler, cycle, s->recorder_.get());
   s->cycle_->start();
-  spdlog::info("c4g server listening on {} (replies numbered {})", s->local_address().to_string(),
-               options.numbering == protocol::ReplyNumbering::same ? "as received" : "NUM + 1");
+  spdlog::info("c4g server listening on {} (replies numbered {}; controller {})", s->local_address().to_string(),
+               options.numbering == protocol::ReplyNumbering::same ? "as received" : "NUM + 1",
+               describe_allowed(allowed));
   return s;
 }
 
@@ -89,6 +126,16 @@ void Server::stop() {
   state_.store(ServerState::stopped, std::memory_order_release);
 }
 
+std::string Server::foreign_source_text() const {
+  const auto last = SessionPeer::unpack(counters_.last_foreign.load(std::memory_order_relaxed));
+  return last ? fmt::format(" (last from {})", last->to_string()) : std::string();
+}
+
+double Server::period_s() const noexcept {
+  const std::int64_t ns = period_ns();
+  return ns > 0 ? static_cast<double>(ns) * 1e-9 : 0.002;  // unknown: the controllers' usual 2 ms
+}
+
 std::optional<protocol::InitPacket> Server::init() const {
   std::lock_guard lock(init_mutex_);
   return init_copy_;
@@ -97,7 +144,27 @@ std::optional<protocol::InitPacket> Server::init() const {
 void Server::on_timeout(bool before_first) noexcept {
   if (before_first) return;
   state_.store(ServerState::silent, std::memory_order_release);
+  peer_.forget();  // the session is over: the controller may come back from another port
   controller_.on_silence();
+}
+
+bool Server::accepts(std::span<const std::byte> in, const net::Datagram& info) noexcept {
+  if (peer_.matches(info.from)) return true;
+  if (peer_.known() || !peer_.admits(info.from)) {
+    bump(counters_.foreign);
+    counters_.last_foreign.store(SessionPeer::pack(info.from), std::memory_order_relaxed);
+    return false;
+  }
+  // No session yet: only a well-formed packet starts one; anything else is dropped (it would be
+  // answered with drive off inside a session) and latches nothing.
+  if (!well_formed(in, info)) {
+    bump(counters_.protocol_errors);
+    bump(counters_.unanswered);
+    return false;
+  }
+  peer_.learn(info.from);
+  bump(counters_.sessions);
+  return true;
 }
 
 std::size_t Server::on_packet(std::span<const std::byte> in, const net::Datagram& info, std::span<std::byte> out) noexcept {
@@ -136,6 +203,7 @@ std::size_t Server::answer_init(std::span<const std::byte> in, std::span<std::by
     }
     init_ = std::move(decoded).value();
     have_init_ = true;
+    cycle_->set_nominal_period(static_cast<std::int64_t>(init_.period_ms) * 1'000'000);
     auto map = protocol::AxisMap::from_init(init_);
     have_axes_ = static_cast<bool>(map);
     if (have_axes_) {
@@ -336,7 +404,7 @@ std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Data
   const bool freezing = update_freeze(request_);
   build_safe_reply(request_, safe_);
   reply_ = safe_;
-  switch_.update(request_, have_init_ && init_.period_ms > 0 ? init_.period_ms * 1e-3 : 0.002);
+  switch_.update(request_, period_s());
   bool used_controller = false;
   safety_.begin_cycle();
   if (!safety_.faulted()) {
@@ -379,6 +447,10 @@ std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Data
 std::string Server::summary() const {
   std::string out = fmt::format("State: {}\n", to_string(state()));
   auto it = std::back_inserter(out);
+  const auto peer = peer_.current();
+  fmt::format_to(it, "Controller: {} ({}), sessions {}; foreign datagrams ignored {}{}\n",
+                 peer ? peer->to_string() : std::string("none yet"), describe_allowed(peer_.allowed()),
+                 counters_.sessions.load(), counters_.foreign.load(), foreign_source_text());
   fmt::format_to(it,
                  "Packets {} (init {}, cyclic {}), protocol errors {}, unanswered {}, controller exceptions {}, "
                  "late {}, refused mode changes {}, safe replies {}, frozen cycles {} (freezes {}, now {})\n",

@@ -7,7 +7,12 @@
 // and should not allocate; the Server catches its exceptions and times it (see docs/c4g-server.md
 // for why inline rather than on a worker thread with a deadline).
 //
-// Packets:
+// Session (session_peer.hpp): the server answers one controller. Its address is fixed by
+// ServerOptions::controller or by the first well-formed packet; datagrams from anyone else are
+// counted (ServerCounters::foreign) and otherwise ignored: no reply, no state change, no safety
+// latch, no timing sample.
+//
+// Packets (from the session's controller):
 //   - the initialization packet (1200 bytes): decoded, kept (init()), turned into an AxisMap and
 //     the Safety thresholds/limits; answered with a cyclic packet of its axis count carrying its
 //     protocol number and the start-up modes, data zero (the manual does not define this answer;
@@ -27,6 +32,7 @@
 #include "c4g/host/cycle_thread.hpp"
 #include "c4g/host/pcap_recorder.hpp"
 #include "c4g/host/safety.hpp"
+#include "c4g/host/session_peer.hpp"
 #include "c4g/host/switch_tracker.hpp"
 #include "c4g/protocol/axis_map.hpp"
 #include "c4g/protocol/init_packet.hpp"
@@ -45,9 +51,13 @@
 namespace axon::c4g::host {
 
 // The manual's addresses: the PC serves on 10.2.12.149, the controller sends from 10.2.12.150,
-// port 1000 (field notes).
-inline constexpr const char* kDefaultServerAddress = "10.2.12.149";
-inline constexpr std::uint16_t kDefaultPort = 1000;
+// port 1000 (field notes). A host given without a port gets kManualPort.
+inline constexpr const char* kManualServerAddress = "10.2.12.149";
+inline constexpr std::uint16_t kManualPort = 1000;
+// Unless told otherwise the server listens on loopback, on a port an unprivileged user may bind
+// (the manual's 1000 needs root); `axon sim c4g` sends there by default.
+inline constexpr const char* kDefaultServerAddress = "127.0.0.1";
+inline constexpr std::uint16_t kDefaultPort = 11000;
 
 // What the Controller sees of one cycle.
 struct CycleContext {
@@ -98,6 +108,13 @@ class Controller {
 
 struct ServerOptions {
   net::Endpoint listen{kDefaultServerAddress, kDefaultPort};
+  // The controller's address: only it may start a session. Empty host: any host; port 0: any port
+  // of that host. Either way the session then sticks to the first well-formed packet's exact
+  // source (session_peer.hpp).
+  net::Endpoint controller{"", 0};
+  // The controller's period for the timing figures until its initialization packet tells (0:
+  // unknown until then); the initialization packet's period wins.
+  std::chrono::nanoseconds period{0};
   protocol::ReplyNumbering numbering = protocol::ReplyNumbering::same;
   net::UdpOptions udp;
   CycleOptions cycle;
@@ -123,10 +140,13 @@ enum class ServerState : std::uint8_t {
 std::string_view to_string(ServerState s) noexcept;
 
 struct ServerCounters {
-  std::atomic<std::uint64_t> packets{0};           // datagrams received
+  std::atomic<std::uint64_t> packets{0};           // datagrams received from the session's controller
+  std::atomic<std::uint64_t> foreign{0};           // datagrams from any other source: ignored
+  std::atomic<std::uint64_t> last_foreign{SessionPeer::kNone};  // its source (SessionPeer::pack)
+  std::atomic<std::uint64_t> sessions{0};          // sessions started (a peer fixed)
   std::atomic<std::uint64_t> init_packets{0};
   std::atomic<std::uint64_t> cyclic_packets{0};
-  std::atomic<std::uint64_t> protocol_errors{0};   // datagrams that did not decode
+  std::atomic<std::uint64_t> protocol_errors{0};   // datagrams that did not decode (before a session too)
   std::atomic<std::uint64_t> unanswered{0};        // datagrams with no answer (unknown size)
   std::atomic<std::uint64_t> controller_exceptions{0};
   std::atomic<std::uint64_t> controller_late{0};
@@ -159,6 +179,11 @@ class Server : private CycleHandler {
 
   [[nodiscard]] net::SocketAddress local_address() const noexcept { return cycle_->local_address(); }
   [[nodiscard]] ServerState state() const noexcept { return state_.load(std::memory_order_acquire); }
+  // The session's controller (any thread): nullopt until the first well-formed packet.
+  [[nodiscard]] std::optional<net::SocketAddress> peer() const noexcept { return peer_.current(); }
+  [[nodiscard]] const SessionPeer& session_peer() const noexcept { return peer_; }
+  // The controller's period the timing figures use (any thread); 0 while unknown.
+  [[nodiscard]] std::int64_t period_ns() const noexcept { return cycle_->timing().nominal_period_ns(); }
   // The last initialization packet received (copy; any thread).
   [[nodiscard]] std::optional<protocol::InitPacket> init() const;
   [[nodiscard]] const protocol::Packet& last_request_unsafe() const noexcept { return request_; }  // cycle thread only
@@ -170,6 +195,8 @@ class Server : private CycleHandler {
   [[nodiscard]] const core::RealtimeReport& realtime_report() const noexcept { return cycle_->realtime_report(); }
   [[nodiscard]] const PcapRecorder* recorder() const noexcept { return recorder_.get(); }
   [[nodiscard]] std::string summary() const;
+  // " (last from HOST:PORT)" when foreign datagrams came, else empty.
+  [[nodiscard]] std::string foreign_source_text() const;
 
   // ---- active freezing (500) ----
   // request_freeze(): from the next packet in which every axis is in mode 0 (drives on or off, not
@@ -206,10 +233,12 @@ class Server : private CycleHandler {
   bool wait_frozen(std::chrono::nanoseconds timeout) const;
 
  private:
-  Server(Controller& controller, const ServerOptions& options);
+  Server(Controller& controller, const ServerOptions& options, net::SocketAddress allowed);
+  bool accepts(std::span<const std::byte> request, const net::Datagram& info) noexcept override;
   std::size_t on_packet(std::span<const std::byte> request, const net::Datagram& info,
                         std::span<std::byte> reply) noexcept override;
   void on_timeout(bool before_first) noexcept override;
+  [[nodiscard]] double period_s() const noexcept;
 
   std::size_t answer_init(std::span<const std::byte> in, std::span<std::byte> out) noexcept;
   std::size_t answer_cyclic(std::span<const std::byte> in, const net::Datagram& info, std::span<std::byte> out) noexcept;
@@ -227,6 +256,7 @@ class Server : private CycleHandler {
   std::unique_ptr<PcapRecorder> recorder_;
   std::unique_ptr<CycleThread> cycle_;
   Safety safety_;
+  SessionPeer peer_;
   ServerCounters counters_;
   std::atomic<ServerState> state_{ServerState::waiting};
   std::atomic<bool> freeze_wanted_{false};

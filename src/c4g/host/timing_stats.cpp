@@ -8,6 +8,7 @@ namespace axon::c4g::host {
 
 TimingStats::TimingStats(const TimingConfig& config)
     : config_(config),
+      nominal_(config.nominal_period_ns > 0 ? config.nominal_period_ns : 0),
       cycle_hist_(config.bucket_width_ns, config.buckets),
       inter_hist_(config.bucket_width_ns, config.buckets) {}
 
@@ -50,16 +51,16 @@ void TimingStats::reset() noexcept {
 }
 
 std::int64_t TimingStats::min_jitter_ns() const noexcept {
-  return inter_steps() ? min_inter_step_ns() - config_.nominal_period_ns : 0;
+  return inter_steps() && nominal_known() ? min_inter_step_ns() - nominal_period_ns() : 0;
 }
 std::int64_t TimingStats::max_jitter_ns() const noexcept {
-  return inter_steps() ? max_inter_step_ns() - config_.nominal_period_ns : 0;
+  return inter_steps() && nominal_known() ? max_inter_step_ns() - nominal_period_ns() : 0;
 }
 double TimingStats::min_percent_jitter() const noexcept {
-  return static_cast<double>(min_jitter_ns()) / static_cast<double>(config_.nominal_period_ns) * 100.0;
+  return nominal_known() ? static_cast<double>(min_jitter_ns()) / static_cast<double>(nominal_period_ns()) * 100.0 : 0.0;
 }
 double TimingStats::max_percent_jitter() const noexcept {
-  return static_cast<double>(max_jitter_ns()) / static_cast<double>(config_.nominal_period_ns) * 100.0;
+  return nominal_known() ? static_cast<double>(max_jitter_ns()) / static_cast<double>(nominal_period_ns()) * 100.0 : 0.0;
 }
 
 namespace {
@@ -69,15 +70,20 @@ double s(std::int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 std::string TimingStats::summary() const {
   std::string out;
   auto it = std::back_inserter(out);
-  fmt::format_to(it, "Nominal inter-packet period       = {:.9f} s\n", s(config_.nominal_period_ns));
+  if (nominal_known())
+    fmt::format_to(it, "Nominal inter-packet period       = {:.9f} s\n", s(nominal_period_ns()));
+  else
+    fmt::format_to(it, "Nominal inter-packet period       = unknown (no initialization packet)\n");
   fmt::format_to(it, "Cycles                            = {}\n", cycles());
   fmt::format_to(it, "Worst cycle time                  = {:.9f} s\n", s(worst_cycle_time_ns()));
   if (inter_steps() == 0) {
     fmt::format_to(it, "Measured inter-packet period range = (needs two cycles)\n");
   } else {
     fmt::format_to(it, "Measured inter-packet period range = [{:+.9f}; {:+.9f}] s\n", s(min_inter_step_ns()), s(max_inter_step_ns()));
-    fmt::format_to(it, "Jitter range                      = [{:+.9f}; {:+.9f}] s\n", s(min_jitter_ns()), s(max_jitter_ns()));
-    fmt::format_to(it, "Percentage jitter range           = [{:+.9f}; {:+.9f}] %\n", min_percent_jitter(), max_percent_jitter());
+    if (nominal_known()) {
+      fmt::format_to(it, "Jitter range                      = [{:+.9f}; {:+.9f}] s\n", s(min_jitter_ns()), s(max_jitter_ns()));
+      fmt::format_to(it, "Percentage jitter range           = [{:+.9f}; {:+.9f}] %\n", min_percent_jitter(), max_percent_jitter());
+    }
   }
   auto pct = [&](const char* name, const core::LatencyHistogram& h) {
     fmt::format_to(it, "{:<34}= p50 {:.6f} p99 {:.6f} p99.9 {:.6f} max {:.6f} ms (n {})\n", name,

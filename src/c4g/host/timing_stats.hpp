@@ -12,6 +12,11 @@
 // time (percentiles p50/p99/p99.9 and max) and a count of cycles whose cycle time exceeded a
 // configurable deadline (the manual's T_CYCLE1, 500-600 us).
 //
+// The nominal period is the controller's (1 or 2 ms, from its initialization packet): the Server
+// sets it when that packet arrives (set_nominal_period_ns), the configuration only gives the value
+// to use until then (0: unknown). The measured times are kept raw, so every figure relative to the
+// nominal period (jitter, percentage jitter) is computed when read, against the period in force.
+//
 // record() is for one thread (the cycle thread): no allocation, no lock. Everything else may be
 // read from any thread while it runs.
 #pragma once
@@ -25,7 +30,7 @@
 namespace axon::c4g::host {
 
 struct TimingConfig {
-  std::int64_t nominal_period_ns = 1'000'000;  // the controller's inter-packet period (T_SMP+, 1 ms)
+  std::int64_t nominal_period_ns = 0;          // the controller's inter-packet period; 0: unknown until set
   std::int64_t deadline_ns = 500'000;          // answer deadline counted as missed above this
   std::int64_t bucket_width_ns = 1'000;        // histogram resolution
   std::size_t buckets = 20'000;                // histogram range = width * buckets (20 ms)
@@ -43,6 +48,10 @@ class TimingStats {
   void reset() noexcept;
 
   [[nodiscard]] const TimingConfig& config() const noexcept { return config_; }
+  // Any thread. ns <= 0: unknown (the jitter figures are then 0 and the summary says so).
+  void set_nominal_period_ns(std::int64_t ns) noexcept { put(nominal_, ns > 0 ? ns : std::int64_t{0}); }
+  [[nodiscard]] std::int64_t nominal_period_ns() const noexcept { return load(nominal_); }
+  [[nodiscard]] bool nominal_known() const noexcept { return nominal_period_ns() > 0; }
   [[nodiscard]] std::uint64_t cycles() const noexcept { return load(cycles_); }
   [[nodiscard]] std::int64_t last_cycle_time_ns() const noexcept { return load(last_cycle_); }
   [[nodiscard]] std::int64_t worst_cycle_time_ns() const noexcept { return load(worst_cycle_); }
@@ -50,6 +59,7 @@ class TimingStats {
   [[nodiscard]] std::int64_t last_inter_step_ns() const noexcept { return load(last_inter_step_); }
   [[nodiscard]] std::int64_t min_inter_step_ns() const noexcept { return load(min_inter_step_); }
   [[nodiscard]] std::int64_t max_inter_step_ns() const noexcept { return load(max_inter_step_); }
+  // Relative to the nominal period; 0 while it is unknown or before two cycles.
   [[nodiscard]] std::int64_t min_jitter_ns() const noexcept;
   [[nodiscard]] std::int64_t max_jitter_ns() const noexcept;
   [[nodiscard]] double min_percent_jitter() const noexcept;
@@ -73,6 +83,7 @@ class TimingStats {
   }
 
   TimingConfig config_;
+  std::atomic<std::int64_t> nominal_{0};
   bool have_t1_ = false;  // writer only
   std::int64_t last_t1_ = 0;
   std::atomic<std::uint64_t> cycles_{0};

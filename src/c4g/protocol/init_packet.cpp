@@ -22,8 +22,9 @@ Result<void> validate(const InitPacket& p) {
                                                             p.fields_per_packet, p.fields_per_axis));
   if (p.open_axes < 1 || p.open_axes > static_cast<std::int32_t>(kMaxAxes))
     return Error(ProtocolErrc::too_many_axes, fmt::format("c4g initialization packet: nAxOpen = {}", p.open_axes));
-  if (p.period_ms < 1)
-    return Error(ProtocolErrc::value_out_of_range, fmt::format("c4g initialization packet: period = {} ms", p.period_ms));
+  if (p.period_ms < 1 || p.period_ms > kMaxPeriodMs)
+    return Error(ProtocolErrc::value_out_of_range,
+                 fmt::format("c4g initialization packet: period = {} ms (1..{})", p.period_ms, kMaxPeriodMs));
   std::size_t i = 0;
   std::size_t bad = kInitFieldCount;
   for_each_field(p, [&](std::string_view, int, const auto& v) {

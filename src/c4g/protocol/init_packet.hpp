@@ -25,6 +25,9 @@ namespace axon::c4g::protocol {
 inline constexpr std::size_t kInitFieldCount = 300;
 inline constexpr std::size_t kInitPacketSize = 4 * kInitFieldCount;  // 1200
 inline constexpr std::int32_t kModeUnspecified = 0xFF;  // start-up mode "open, mode not given"
+// The controller's period is 1 ms in the manual (2 ms on some); everything derived from it (time,
+// per-cycle step limits of the applications) would scale with a wild value, so 1..10 ms is accepted.
+inline constexpr std::int32_t kMaxPeriodMs = 10;
 
 using ArmInts = std::array<std::array<std::int32_t, kAxesPerArm>, kMaxArms>;
 using ArmFloats = std::array<std::array<float, kAxesPerArm>, kMaxArms>;
@@ -96,7 +99,7 @@ void for_each_field(P& p, F&& f) {
 }
 
 // Format checks shared by encode and decode: 3 packet and 9 axis fields, 1..20 open axes, a period
-// of at least 1 ms, finite floats. (The consistency of the open-axis lists is AxisMap's job.)
+// of 1..kMaxPeriodMs ms, finite floats. (The consistency of the open-axis lists is AxisMap's job.)
 Result<void> validate(const InitPacket& p);
 
 Result<void> encode_init(const InitPacket& p, std::span<std::byte> out);  // out.size() >= 1200

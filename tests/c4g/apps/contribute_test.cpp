@@ -85,6 +85,16 @@ TEST(ContributeApp, RejectsOtherModesAndMissingAmplitudes) {
   EXPECT_THROW(ContributeApp{o}, Exception);
   o.amplitude = {std::nan("")};
   EXPECT_THROW(ContributeApp{o}, Exception);
+  o.mode = 8;
+  o.amplitude = {1, 9999};  // motor turns/s
+  try {
+    ContributeApp app(o);
+    FAIL() << "a 9999 turns/s velocity contribution was accepted";
+  } catch (const Exception& e) {
+    EXPECT_NE(std::string(e.what()).find("9999 motor turns/s on axis 2 exceeds --max-motor-speed 100"), std::string::npos) << e.what();
+  }
+  o.max_motor_speed = 10000;
+  EXPECT_NO_THROW(ContributeApp{o});
 }
 
 }  // namespace

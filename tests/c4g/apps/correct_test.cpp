@@ -3,6 +3,7 @@
 #include "harness.hpp"
 
 #include <cmath>
+#include <limits>
 
 using namespace axon::c4g;
 using namespace axon::c4g::apps;
@@ -93,6 +94,8 @@ TEST(CorrectApp, RefusesACorrectionTooFastForTheMotors) {
   o.amplitude_rad = {30 * kDeg};
   o.frequency_hz = {5.0};  // about 76 motor turns/s on axis 1 at the peak (ratio 181)
   o.max_motor_speed = 50;
+  o.limits.max_abs_rad = {40 * kDeg};  // the correction bounds allow it: the motors' limit decides
+  o.limits.max_step_rad = {2 * kDeg};
   CorrectApp app(o);
   Harness h;
   h.start(app);
@@ -132,4 +135,81 @@ TEST(CorrectApp, StopRequestFadesOut) {
   for (; k < 1000 && !h.exit_requested(); ++k) h.run(app);
   EXPECT_NEAR(k, 26, 1);
   EXPECT_NEAR(app.applied(0), 0.0, 1e-9);
+}
+
+TEST(CorrectLimits, DefaultsAndValidation) {
+  CorrectionLimits l;
+  EXPECT_NEAR(l.max_abs(0), 5 * kDeg, 1e-12);
+  EXPECT_NEAR(l.max_step(5), 0.1 * kDeg, 1e-12);
+  EXPECT_TRUE(validate(l));
+  l.max_abs_rad = {1 * kDeg, 2 * kDeg};
+  EXPECT_NEAR(l.max_abs(0), 1 * kDeg, 1e-12);
+  EXPECT_NEAR(l.max_abs(4), 2 * kDeg, 1e-12);  // the last value applies to the axes after it
+  for (double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    l.max_step_rad = {bad};
+    auto v = validate(l);
+    ASSERT_FALSE(v) << bad;
+    EXPECT_NE(v.error().detail.find("must be > 0"), std::string::npos) << v.error().detail;
+  }
+  l.max_step_rad = {};
+  EXPECT_FALSE(validate(l));
+}
+
+TEST(CorrectLimits, ASineBeyondTheLimitIsRefusedWhenBuilt) {
+  CorrectOptions o;
+  o.amplitude_rad = {0, 90 * kDeg};
+  try {
+    CorrectApp app(o);
+    FAIL() << "a 90 deg sine was accepted";
+  } catch (const axon::Exception& e) {
+    EXPECT_NE(std::string(e.what()).find("sine amplitude 90 deg on axis 2 exceeds the correction limit 5 deg"), std::string::npos)
+        << e.what();
+  }
+  o.amplitude_rad = {std::nan("")};
+  EXPECT_THROW(CorrectApp{o}, axon::Exception);
+  o.amplitude_rad = {1 * kDeg};
+  o.frequency_hz = {-1};
+  EXPECT_THROW(CorrectApp{o}, axon::Exception);
+}
+
+TEST(CorrectLimits, AFileBeyondTheLimitIsRefusedWhenBuilt) {
+  CorrectOptions o;
+  o.values = std::make_shared<Trajectory>(
+      Trajectory::parse("# units: deg\nt,a,b,c,d,e,f\n0,0,0,0,0,0,0\n1,0,0,9999,0,0,0\n", "f").value());
+  try {
+    CorrectApp app(o);
+    FAIL() << "a 9999 deg file was accepted";
+  } catch (const axon::Exception& e) {
+    EXPECT_NE(std::string(e.what()).find("row 2 (t=1 s) asks 9999 deg on axis 3"), std::string::npos) << e.what();
+  }
+}
+
+TEST(CorrectLimits, ASineTooFastPerCycleIsRefusedAtTheInitializationPacket) {
+  CorrectOptions o;
+  o.amplitude_rad = {4 * kDeg};
+  o.frequency_hz = {5.0};  // 2 pi 5 Hz 4 deg = 126 deg/s: 0.25 deg per 2 ms cycle
+  CorrectApp app(o);
+  Harness h;
+  h.start(app);
+  EXPECT_EQ(app.phase(), CorrectApp::Phase::refused);
+  EXPECT_NE(app.error().find("in one cycle on axis 1"), std::string::npos) << app.error();
+  h.set_modes(code(Mode::mode7));
+  h.run(app);
+  EXPECT_EQ(h.rep.axes[0].d1, 0.0f);
+  EXPECT_TRUE(h.exit_requested());
+}
+
+TEST(CorrectLimits, AShortFadeCountsAgainstTheStepLimit) {
+  CorrectOptions o;
+  o.amplitude_rad = {4 * kDeg};
+  o.frequency_hz = {0.1};
+  o.ramp_s = 0.01;  // 4 deg faded out in 5 cycles: 0.8 deg per cycle
+  CorrectApp app(o);
+  Harness h;
+  h.start(app);
+  EXPECT_EQ(app.phase(), CorrectApp::Phase::refused);
+  o.ramp_s = 0.5;  // 0.016 deg per cycle
+  CorrectApp slow(o);
+  h.start(slow);
+  EXPECT_EQ(slow.phase(), CorrectApp::Phase::waiting);
 }

@@ -163,3 +163,24 @@ TEST(PidApp, ReportsAnArmWithoutOpenAxes) {
   EXPECT_TRUE(app.has_error());
   EXPECT_TRUE(app.drive_off_on_error());
 }
+
+TEST(PidApp, ASineBeyondTheLimitsIsRefused) {
+  PidOptions o;
+  o.amplitude_rad = {9999 * kDeg};
+  try {
+    PidApp app(o);
+    FAIL() << "a 9999 deg sine was accepted";
+  } catch (const axon::Exception& e) {
+    EXPECT_NE(std::string(e.what()).find("pid: the sine amplitude 9999 deg on axis 1 exceeds the correction limit 5 deg"),
+              std::string::npos) << e.what();
+  }
+  o.amplitude_rad = {std::nan("")};
+  EXPECT_THROW(PidApp{o}, axon::Exception);
+  o.amplitude_rad = {4 * kDeg};
+  o.frequency_hz = {5.0};  // 0.25 deg per 2 ms cycle
+  PidApp fast(o);
+  Harness h;
+  h.start(fast);
+  EXPECT_EQ(fast.phase(), PidApp::Phase::refused);
+  EXPECT_NE(fast.error().find("in one cycle on axis 1"), std::string::npos) << fast.error();
+}

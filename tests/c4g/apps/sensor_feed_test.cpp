@@ -88,6 +88,25 @@ TEST(SensorFeed, PublishesTheLatestValuesAndCountsRejects) {
   EXPECT_NE(feed->last_error().find("not a number"), std::string::npos);
 }
 
+TEST(SensorFeed, WithASourceOnlyThatSenderIsRead) {
+  Sender sensor(0), stranger(0);
+  SensorFeedOptions o;
+  o.listen = net::Endpoint{"127.0.0.1", 0};
+  o.axes = 1;
+  o.source = net::Endpoint{"127.0.0.1", sensor.socket.local_port()};
+  auto feed = SensorFeed::open(o).value();
+  sensor.to.port = stranger.to.port = feed->port();
+  stranger.send("0.7");
+  sensor.send("0.1");
+  ASSERT_TRUE(eventually([&] { return feed->accepted() == 1 && feed->foreign() == 1; }));
+  SensorFeed::Reading r;
+  ASSERT_TRUE(feed->latest(r));
+  EXPECT_EQ(r.values[0], 0.1);
+  EXPECT_EQ(feed->rejected(), 0u);
+  o.source = net::Endpoint{"0.0.0.0", 0};
+  EXPECT_FALSE(SensorFeed::open(o));  // names no host
+}
+
 TEST(SensorFeed, RejectsImpossibleAxisCounts) {
   SensorFeedOptions o;
   o.axes = 0;
@@ -110,6 +129,8 @@ TEST(CorrectFeed, SlewsToTheSensorValuesWithinTheSpeedLimit) {
   o.feed = feed;
   o.feed_timeout_s = 60;  // no staleness in this test
   o.max_motor_speed = 10;  // 0.02 turns per 2 ms cycle
+  o.limits.max_abs_rad = {30 * kDeg};  // the correction bounds allow it: the motors' limit decides
+  o.limits.max_step_rad = {1.0};
   CorrectApp app(o);
   Harness h;
   h.start(app);
@@ -189,6 +210,60 @@ TEST(CorrectFeed, StopFadesToZeroThenExits) {
   EXPECT_TRUE(h.exit_requested());
   EXPECT_NEAR(k, 51, 2);  // the 0.1 s fade at 2 ms
   EXPECT_NEAR(sum, 0.0, 1e-6);
+}
+
+TEST(CorrectFeed, ReadingsBeyondTheLimitAreRefusedAndNeverApplied) {
+  std::shared_ptr<SensorFeed> feed = open_feed();
+  Sender tx(feed->port());
+  CorrectOptions o;
+  o.feed = feed;
+  o.feed_timeout_s = 60;
+  CorrectApp app(o);
+  Harness h;
+  h.start(app);
+  h.set_modes(code(Mode::mode7));
+  tx.send(fmt::format("{} 0 0 0 0 0", 1 * kDeg));
+  ASSERT_TRUE(eventually([&] { return feed->accepted() == 1; }));
+  double sum = 0;
+  for (int k = 0; k < 20; ++k) sum += h.run(app).axes[0].d1;
+  EXPECT_NEAR(sum, motor_of(h, 0, 1 * kDeg, 0), 1e-5);
+  // 90 deg, 9999 deg and 1e308 deg: each refused, the correction stays at the last good reading.
+  for (const std::string& bad : {fmt::format("{} 0 0 0 0 0", 90 * kDeg), fmt::format("0 {} 0 0 0 0", 9999 * kDeg),
+                                std::string("0 0 1e306 0 0 0")}) {
+    const auto before = feed->accepted();
+    tx.send(bad);
+    ASSERT_TRUE(eventually([&] { return feed->accepted() == before + 1; }));
+    for (int k = 0; k < 20; ++k) {
+      const auto& r = h.run(app);
+      for (std::size_t j = 0; j < 6; ++j) {
+        ASSERT_TRUE(std::isfinite(r.axes[j].d1));
+        if (j == 0) {
+          sum += r.axes[j].d1;
+        } else {
+          EXPECT_EQ(r.axes[j].d1, 0.0f);
+        }
+      }
+    }
+    EXPECT_NEAR(sum, motor_of(h, 0, 1 * kDeg, 0), 1e-5) << bad;
+  }
+  EXPECT_EQ(app.refused_samples(), 3u);
+  EXPECT_FALSE(app.has_error());
+  EXPECT_EQ(app.phase(), CorrectApp::Phase::correcting);
+  const auto texts = event_texts(app);
+  EXPECT_TRUE(contains(texts, "feed reading refused: a value is beyond the correction limit")) << texts.size();
+  EXPECT_NE(app.summary().find("3 readings refused beyond the limits"), std::string::npos) << app.summary();
+  EXPECT_NE(app.summary().find("last refused reading: axis 3 = 5.72958e+307 deg, beyond the correction limit 5 deg"),
+            std::string::npos) << app.summary();
+  // A good reading again: followed, at most 0.1 deg per cycle.
+  tx.send(fmt::format("{} 0 0 0 0 0", 3 * kDeg));
+  ASSERT_TRUE(eventually([&] { return feed->accepted() == 5; }));
+  for (int k = 0; k < 30; ++k) {
+    const double d = h.run(app).axes[0].d1;
+    EXPECT_LE(std::fabs(d), std::fabs(motor_of(h, 0, 0.1 * kDeg, 0)) * (1 + 1e-5));
+    sum += d;
+  }
+  EXPECT_NEAR(sum, motor_of(h, 0, 3 * kDeg, 0), 1e-5);
+  EXPECT_GT(app.slewed_cycles(), 0u);
 }
 
 TEST(CorrectFeed, ExactlyOneSourceIsRequired) {

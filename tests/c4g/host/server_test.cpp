@@ -13,6 +13,7 @@
 #include <functional>
 #include <limits>
 #include <thread>
+#include <vector>
 #include <unistd.h>
 #include <fmt/format.h>
 #include <stdexcept>
@@ -56,6 +57,8 @@ protocol::Packet cyclic(std::int32_t num, std::int32_t mode, std::size_t axes = 
 class Peer {
  public:
   explicit Peer(net::SocketAddress server) : server_(server), socket_(net::UdpSocket::open(net::SocketAddress{0x7f000001, 0}).value()) {}
+  [[nodiscard]] net::SocketAddress local() const { return socket_.local_address(); }
+  void aim_at(net::SocketAddress server) { server_ = server; }
 
   void send_raw(std::span<const std::byte> bytes) { ASSERT_TRUE(socket_.send_to(bytes, server_)); }
   void send(const protocol::Packet& p) {
@@ -126,11 +129,12 @@ struct Rig {
 
 }  // namespace
 
-TEST(Server, DefaultAddressIsTheManuals) {
+TEST(Server, DefaultAddressIsLoopbackOnAnUnprivilegedPort) {
   ServerOptions o;
-  EXPECT_EQ(o.listen.host, "10.2.12.149");
-  EXPECT_EQ(o.listen.port, 1000);
+  EXPECT_EQ(o.listen.host, "127.0.0.1");
+  EXPECT_GE(o.listen.port, 1024);  // a user without privileges may bind it
   EXPECT_EQ(o.numbering, protocol::ReplyNumbering::same);
+  EXPECT_TRUE(o.controller.host.empty());  // learned from the first packet
 }
 
 TEST(Server, AnswersPacketsBeforeTheInitializationPacketWithTheirNumber) {
@@ -414,4 +418,153 @@ TEST(Server, RecordsTheExchangeAndSummarizes) {
     EXPECT_EQ(rig.server->state(), ServerState::stopped);
   }
   std::filesystem::remove(o.pcap_path);
+}
+
+namespace {
+// A cyclic packet of `axes` axes with NaN in D1 of the first axis (it fails to decode).
+std::vector<std::byte> poisoned(std::int32_t num, std::int32_t mode, std::size_t axes = 2) {
+  std::vector<std::byte> buf(protocol::packet_size(axes));
+  EXPECT_TRUE(protocol::encode_packet(cyclic(num, mode, axes), buf).ok());
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(buf.data() + 12 + 4, &nan, 4);
+  return buf;
+}
+}  // namespace
+
+TEST(Server, ForeignPacketsAreCountedAndChangeNothing) {
+  Rig rig;
+  rig.init();
+  for (int i = 0; i < 5; ++i) ASSERT_EQ(rig.peer.ask(cyclic(i, code(Mode::mode4))).num, i);
+  const auto packets_before = rig.server->counters().packets.load();
+  const auto inits_before = rig.controller.inits.load();
+
+  Peer stranger(rig.server->local_address());  // another port on the same host
+  stranger.send_raw(poisoned(900, code(Mode::mode7)));   // would latch a fault inside the session
+  stranger.send(cyclic(901, code(Mode::mode0)));         // well formed, still not the controller's
+  stranger.send(make_init(55));                          // would reset the session
+  EXPECT_EQ(stranger.answer(100ms).count, 0u);           // no reply to any of them
+
+  // The session carries on as if nothing came.
+  const auto a = rig.peer.ask(cyclic(6, code(Mode::mode4)));
+  EXPECT_EQ(a.num, 6);
+  EXPECT_EQ(a.axes[0].mode, code(Mode::mode4));
+  EXPECT_FALSE(rig.server->safety().faulted());
+  EXPECT_EQ(rig.server->counters().foreign.load(), 3u);
+  EXPECT_EQ(rig.server->counters().packets.load(), packets_before + 1);
+  EXPECT_EQ(rig.server->counters().protocol_errors.load(), 0u);
+  EXPECT_EQ(rig.controller.inits.load(), inits_before);
+  EXPECT_EQ(rig.server->init()->protocol_number, 10);
+  EXPECT_EQ(rig.server->cycle().counters().refused.load(), 3u);
+  EXPECT_EQ(rig.server->peer(), rig.peer.local());
+  const auto last = SessionPeer::unpack(rig.server->counters().last_foreign.load());
+  ASSERT_TRUE(last.has_value());
+  EXPECT_EQ(*last, stranger.local());
+  EXPECT_NE(rig.server->summary().find("foreign datagrams ignored 3 (last from " + stranger.local().to_string()),
+            std::string::npos) << rig.server->summary();
+  rig.server->stop();  // the timing sample of a cycle is taken after its reply left
+  EXPECT_EQ(rig.server->cycle().timing().cycles(), 7u);  // init, 5 + 1 cyclic: none of the stranger's
+}
+
+TEST(Server, JunkBeforeTheControllerNeitherStartsASessionNorLatches) {
+  Rig rig;
+  Peer stranger(rig.server->local_address());
+  stranger.send_raw(poisoned(1, code(Mode::mode0), 6));  // a 228-byte datagram that does not decode
+  EXPECT_EQ(stranger.answer(100ms).count, 0u);
+  EXPECT_FALSE(rig.server->peer().has_value());
+  EXPECT_FALSE(rig.server->safety().faulted());
+  EXPECT_EQ(rig.server->counters().protocol_errors.load(), 1u);
+  EXPECT_EQ(rig.server->state(), ServerState::waiting);
+  // The controller's first (sync) packet starts the session, answered.
+  EXPECT_EQ(rig.peer.ask(cyclic(3, 0, 6)).num, 3);
+  EXPECT_EQ(rig.server->peer(), rig.peer.local());
+  rig.init();
+  EXPECT_FALSE(rig.server->safety().faulted());
+}
+
+TEST(Server, ControllerOptionAdmitsOnlyThatAddress) {
+  Peer controller(net::SocketAddress{0x7f000001, 9});
+  Peer stranger(net::SocketAddress{0x7f000001, 9});
+  auto o = loopback_options();
+  o.controller = net::Endpoint{"127.0.0.1", controller.local().port};
+  ScriptedController law;
+  auto server = Server::start(law, o).value();
+  controller.aim_at(server->local_address());
+  stranger.aim_at(server->local_address());
+  stranger.send(cyclic(1, 0));  // well formed, first, but not the configured controller
+  EXPECT_EQ(stranger.answer(100ms).count, 0u);
+  EXPECT_FALSE(server->peer().has_value());
+  EXPECT_EQ(controller.ask(cyclic(2, 0)).num, 2);
+  EXPECT_EQ(server->peer(), controller.local());
+  EXPECT_EQ(server->counters().foreign.load(), 1u);
+}
+
+TEST(Server, ControllerHostWithoutPortAdmitsAnyPortOfIt) {
+  auto o = loopback_options();
+  o.controller = net::Endpoint{"127.0.0.1", 0};
+  Rig rig(o);
+  EXPECT_EQ(rig.peer.ask(cyclic(2, 0)).num, 2);
+  o.controller = net::Endpoint{"0.0.0.0", 0};
+  ScriptedController law;
+  EXPECT_FALSE(Server::start(law, o));  // names no host
+}
+
+TEST(Server, ASilentSessionEndsAndTheNextControllerMayStartOne) {
+  auto o = loopback_options();
+  o.cycle.cycle_timeout = 20ms;
+  Rig rig(o);
+  rig.init();
+  Peer restarted(rig.server->local_address());  // the controller back from another port
+  EXPECT_EQ(restarted.ask(cyclic(1, 0)).count, 0u);  // while the session lives: foreign
+  while (rig.server->state() != ServerState::silent) std::this_thread::sleep_for(1ms);
+  EXPECT_FALSE(rig.server->peer().has_value());
+  EXPECT_EQ(restarted.ask(cyclic(2, 0)).num, 2);
+  EXPECT_EQ(rig.server->peer(), restarted.local());
+  EXPECT_EQ(rig.server->counters().sessions.load(), 2u);
+}
+
+TEST(Server, ForeignFloodDoesNotHideTheControllersSilence) {
+  auto o = loopback_options();
+  o.cycle.cycle_timeout = 30ms;
+  Rig rig(o);
+  rig.init();
+  Peer stranger(rig.server->local_address());
+  // The stranger keeps sending well within the timeout; the controller says nothing.
+  for (int i = 0; i < 2000 && rig.server->state() != ServerState::silent; ++i) {
+    stranger.send(cyclic(i, 0));
+    std::this_thread::sleep_for(1ms);
+  }
+  EXPECT_EQ(rig.server->state(), ServerState::silent);
+}
+
+TEST(Server, TimingFiguresUseTheControllersPeriod) {
+  for (const std::int32_t period_ms : {1, 2}) {
+    SCOPED_TRACE(period_ms);
+    auto o = loopback_options();
+    Rig rig(o);
+    EXPECT_EQ(rig.server->period_ns(), 0);  // unknown before the initialization packet
+    auto init = make_init();
+    init.period_ms = period_ms;
+    rig.peer.send(init);
+    ASSERT_EQ(rig.peer.answer().count, 2u);
+    EXPECT_EQ(rig.server->period_ns(), period_ms * 1'000'000);
+    EXPECT_EQ(rig.server->cycle().timing().nominal_period_ns(), period_ms * 1'000'000);
+    rig.server->stop();
+    EXPECT_NE(rig.server->summary().find(fmt::format("Nominal inter-packet period       = 0.00{}000000 s", period_ms)),
+              std::string::npos) << rig.server->summary();
+  }
+}
+
+TEST(Server, PeriodOptionServesUntilTheInitializationPacketTells) {
+  auto o = loopback_options();
+  o.period = 1ms;
+  Rig rig(o);
+  EXPECT_EQ(rig.server->period_ns(), 1'000'000);
+  auto init = make_init();
+  init.period_ms = 2;
+  rig.peer.send(init);
+  ASSERT_EQ(rig.peer.answer().count, 2u);
+  EXPECT_EQ(rig.server->period_ns(), 2'000'000);
+  o.period = -1ms;
+  ScriptedController law;
+  EXPECT_FALSE(Server::start(law, o));
 }

@@ -91,3 +91,26 @@ TEST(TimingStats, ResetStartsOver) {
   EXPECT_EQ(t.inter_steps(), 0u);  // no step across the reset
   EXPECT_EQ(t.worst_cycle_time_ns(), 2);
 }
+
+// A controller exactly on its period, at 1 and at 2 ms: no jitter once the nominal period is the
+// controller's (before, a fixed 1 ms nominal showed +100 % at 2 ms).
+TEST(TimingStats, ExactPeriodHasNoJitterAtOneAndTwoMilliseconds) {
+  for (const std::int64_t period : {1'000'000, 2'000'000}) {
+    SCOPED_TRACE(period);
+    TimingStats t;  // the default configuration: the period is the session's
+    EXPECT_FALSE(t.nominal_known());
+    for (std::int64_t k = 0; k < 10; ++k) t.record(k * period, k * period + 100'000);
+    EXPECT_EQ(t.min_jitter_ns(), 0);  // unknown period: no figure rather than a wrong one
+    EXPECT_NE(t.summary().find("Nominal inter-packet period       = unknown"), std::string::npos) << t.summary();
+    EXPECT_EQ(t.summary().find("Percentage jitter"), std::string::npos) << t.summary();
+    t.set_nominal_period_ns(period);  // the initialization packet arrived
+    EXPECT_EQ(t.nominal_period_ns(), period);
+    EXPECT_EQ(t.min_jitter_ns(), 0);
+    EXPECT_EQ(t.max_jitter_ns(), 0);
+    EXPECT_DOUBLE_EQ(t.max_percent_jitter(), 0.0);
+    t.record(10 * period + period / 10, 10 * period + period / 10 + 100'000);  // one packet 10 % late
+    EXPECT_EQ(t.max_jitter_ns(), period / 10);
+    EXPECT_NEAR(t.max_percent_jitter(), 10.0, 1e-9);
+    EXPECT_NE(t.summary().find("[+0.000000000; +10.000000000] %"), std::string::npos) << t.summary();
+  }
+}
