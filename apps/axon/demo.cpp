@@ -77,7 +77,7 @@ void report(const char* path, const RoundTrips& r, int count) {
 }
 
 int run_demo() {
-  return run_command([](asio::io_context& io, auto) -> asio::awaitable<int> {
+  return run_command([](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
     auto ex = io.get_executor();
     const int n = 200;
     fmt::print("axon demo: the CAN foundation\n\n");
@@ -133,7 +133,7 @@ int run_demo() {
     scd->stop();
     gw->stop();
     const asio::any_io_executor any_ex = ex;
-    co_await demo_fps(any_ex);
+    co_await demo_fps(any_ex, set_on_signal);
     fmt::print("\ndone. Next: `axon can bridge --listen 127.0.0.1:29536` and connect your own tools.\n");
     co_return 0;
   });

@@ -7,6 +7,9 @@
 #include "fps/host/cold_control.hpp"
 #include "fps/host/plane_correct.hpp"
 #include "fps/host/plane_upgrade.hpp"
+#include "fps/host/trajectory_speed.hpp"
+#include "checks.hpp"
+#include "fps_stop.hpp"
 #include "fps/plan/layout_model.hpp"
 #include "layout_name.hpp"
 #include "net/endpoint.hpp"
@@ -15,6 +18,13 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/detached.hpp>
+#include <boost/asio/this_coro.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -35,6 +45,9 @@ struct PlaneArgs {
   double beta = 180;
   double duration_s = 10;
   int points = 20;
+  bool fit_duration = false;      // move: use the slowest robot's duration when --duration is too short
+  double max_rpm = host::kMaxMotorRpm;  // move: motor speed limit
+  double gear_ratio = host::kGearRatio;
   bool sync = false;
   std::string image;              // upgrade
   std::string version;            // upgrade: expected version
@@ -91,6 +104,217 @@ host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
   return o;
 }
 
+// Every known robot from where it is straight to (alpha, beta) over `points` points per arm.
+std::map<std::uint16_t, protocol::Trajectory> straight_moves(const host::StatusTable& table, const PlaneArgs& a,
+                                                             double duration_s,
+                                                             std::map<std::uint16_t, host::ArmAngles>& starts) {
+  std::map<std::uint16_t, protocol::Trajectory> t;
+  for (const auto& row : table.rows) {
+    if (!row.position) {
+      std::printf("positioner %u: no position (%s); left out\n", unsigned{row.id}, row.error.c_str());
+      continue;
+    }
+    starts[row.id] = *row.position;
+    std::vector<protocol::ArmPoint> al, be;
+    for (int i = 1; i <= a.points; ++i) {
+      const double f = static_cast<double>(i) / a.points;
+      al.push_back({row.position->alpha + (a.alpha - row.position->alpha) * f, duration_s * f});
+      be.push_back({row.position->beta + (a.beta - row.position->beta) * f, duration_s * f});
+    }
+    t.emplace(row.id, need(protocol::Trajectory::from_physical(al, be)));
+  }
+  return t;
+}
+
+// The duration to use: --duration when every robot can make it, the slowest robot's with
+// --fit-duration; otherwise a usage error that says what would do.
+double move_duration(const host::StatusTable& table, const PlaneArgs& a, const fps::plan::SpeedLimits& limits) {
+  std::map<std::uint16_t, host::ArmAngles> starts;
+  const auto moves = straight_moves(table, a, a.duration_s, starts);
+  const auto slowest = host::slowest_robot(moves, starts, limits);
+  if (!slowest || slowest->too_fast == 0) return a.duration_s;
+  const double needed = host::feasible_duration_s(slowest->needed_s);
+  const auto what = fmt::format("{} of {} robots cannot make {:g} s at {:g} deg/s (alpha) and {:g} deg/s (beta): the "
+                                "slowest robot (positioner {}) needs {:.1f} s",
+                                slowest->too_fast, moves.size(), a.duration_s, limits.alpha_deg_s, limits.beta_deg_s,
+                                slowest->id, needed);
+  if (!a.fit_duration) throw Exception(usage(fmt::format("{}; use --duration {:.1f} or --fit-duration", what, needed)));
+  std::fprintf(stderr, "%s: using --duration %.1f\n", what.c_str(), needed);
+  return needed;
+}
+
+// Progress of a move on stderr once the robots started: a line per second, or one line rewritten
+// in place when stderr is a terminal. Only for moves over 2 s.
+struct MoveProgress {
+  double total_s = 0;
+  std::size_t robots = 0;
+  bool started = false;
+  bool finished = false;
+  bool done = false;  // the progress coroutine has ended
+};
+
+asio::awaitable<void> show_progress(MoveProgress& p) {
+  const bool tty = ::isatty(STDERR_FILENO) != 0;
+  while (!p.started && !p.finished) co_await core::sleep_for(std::chrono::milliseconds(20));
+  const auto t0 = std::chrono::steady_clock::now();
+  auto next = t0;
+  bool printed = false;
+  while (!p.finished) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= next) {
+      const double el = std::chrono::duration<double>(now - t0).count();
+      std::fprintf(stderr, "%smoving %zu robots: %.0f of %.1f s (%.0f%%)%s", tty ? "\r" : "", p.robots, el, p.total_s,
+                   std::min(100.0, 100.0 * el / p.total_s), tty ? "   " : "\n");
+      std::fflush(stderr);
+      printed = true;
+      next += std::chrono::seconds(1);
+    }
+    co_await core::sleep_for(std::chrono::milliseconds(50));
+  }
+  if (tty && printed) std::fputc('\n', stderr);
+  p.done = true;
+}
+
+asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) {
+  const auto limits = fps::plan::SpeedLimits::from_motor(a.max_rpm, a.gear_ratio);
+  const auto table = co_await fpa.array().status_table(true);
+  const double duration_s = move_duration(table, a, limits);
+  std::map<std::uint16_t, host::ArmAngles> starts;
+  auto t = straight_moves(table, a, duration_s, starts);
+  if (t.empty()) throw Exception(Error(host::HostErrc::not_ready, "no robot reported its position: nothing to move"));
+  host::TrajectoryOptions to;
+  to.speed_limits = limits;
+  MoveProgress progress{duration_s, t.size()};
+  to.on_phase = [&progress](std::string_view phase) { progress.started = progress.started || phase == "started"; };
+  if (duration_s > 2.0) asio::co_spawn(co_await asio::this_coro::executor, show_progress(progress), asio::detached);
+  else progress.done = true;
+  auto r = co_await fpa.run_trajectories(std::move(t), to, a.sync);
+  progress.finished = true;
+  while (!progress.done) co_await core::sleep_for(std::chrono::milliseconds(10));
+  const auto rep = need(std::move(r));
+  std::map<std::size_t, std::pair<int, int>> per_bus;  // started, robots
+  for (const auto& rr : rep.robots) {
+    auto& c = per_bus[rr.bus];
+    ++c.second;
+    const bool went = rr.state == host::RobotState::started || rr.state == host::RobotState::completed ||
+                      rr.state == host::RobotState::position_mismatch || rr.state == host::RobotState::timeout ||
+                      rr.state == host::RobotState::stopped || rr.state == host::RobotState::collided;
+    c.first += went ? 1 : 0;
+  }
+  for (const auto& [b, c] : per_bus)
+    std::printf("bus %s: %d of %d robots started\n", fpa.bus_ref(b).to_string().c_str(), c.first, c.second);
+  std::printf("start by %s; upload %.3f s, start %.3f s, move %.3f s\n", a.sync ? "the sync line" : "broadcast",
+              std::chrono::duration<double>(rep.timings.upload).count(),
+              std::chrono::duration<double>(rep.timings.start).count(),
+              std::chrono::duration<double>(rep.timings.move).count());
+  const auto& lock = fpa.array().lock_state();
+  if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
+  for (const auto& l : fpa.link_stops()) std::printf("%s\n", l.c_str());
+  std::fputs(rep.summary().c_str(), stdout);
+  co_return motion_exit_code(rep.completed, fpa.array());
+}
+
+using SetOnSignal = std::function<void(std::function<void()>)>;
+
+// One `fps plane` action on the connected plane; returns the exit code.
+asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a, const std::string& action,
+                                  const fps::FocalPlane& plane, const SetOnSignal& set_on_signal,
+                                  const std::vector<std::uint8_t>& image, const host::PlaneUpgradeOptions& uo) {
+  int rc = 0;
+  if (action == "check") {
+    const auto check = co_await fpa.check_layout();
+    std::fputs(check.to_text().c_str(), stdout);
+    rc = check.ok() ? 0 : 1;
+  } else if (action == "status") {
+    auto d = co_await fpa.discover();
+    const auto found = need(std::move(d));
+    std::map<std::string, int> states;
+    for (const auto& row : found.table.rows) ++states[row.error.empty() ? row.state() : "no answer"];
+    std::printf("%zu robots known on %zu buses\n", found.table.rows.size(), fpa.bus_count());
+    for (const auto& [s, n] : states) std::printf("  %s: %d\n", s.c_str(), n);
+    for (const auto& p : found.problems) std::printf("problem: %s\n", p.c_str());
+    for (const auto& row : found.table.rows)
+      if (!row.error.empty()) std::printf("  positioner %u: %s\n", unsigned{row.id}, row.error.c_str());
+    rc = states.contains("no answer") || !found.problems.empty() ? 1 : 0;
+  } else if (action == "move") {
+    stop_robots_on_signal(set_on_signal, fpa.array());
+    rc = co_await plane_move(fpa, a);
+  }
+  if (action == "cold") {
+    // Once, or every period until a signal (or --for): the settings go out only when they change.
+    host::ColdControl cold(fpa);
+    bool stop = false;
+    set_on_signal([&stop] {
+      signal_is_normal_end().store(true);  // --watch runs until a signal: its normal end
+      stop = true;
+    });
+    const auto t0 = std::chrono::steady_clock::now();
+    bool first = true;
+    while (!stop) {
+      auto r = co_await cold.step(first);
+      first = false;
+      if (!r) {
+        std::printf("cold policy: %s\n", r.error().message().c_str());
+        rc = 1;
+      } else if (r.value().sent || !a.watch) {
+        std::fputs(r.value().to_text().c_str(), stdout);
+        rc = r.value().failed.empty() ? 0 : 1;
+      }
+      std::fflush(stdout);
+      if (!a.watch) break;
+      const auto next = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.period_s);
+      while (!stop && std::chrono::steady_clock::now() < next) {
+        co_await core::sleep_for(std::chrono::milliseconds(50));
+        if (a.for_s > 0 && std::chrono::steady_clock::now() - t0 >= std::chrono::duration<double>(a.for_s)) stop = true;
+      }
+    }
+    set_on_signal([] {});
+  }
+  if (action == "correct") {
+    // Correction iterations: each round reads the next --measured file (waiting for it to appear),
+    // corrects the robots outside tolerance and waits for them to arrive.
+    const auto targets = need(fps::plan::load_targets(a.targets));
+    const auto model = need(fps::plan::model_from_layout(plane));
+    std::vector<std::int32_t> known;
+    for (const auto& r : model.robots()) known.push_back(r.id());
+    host::CorrectionRunOptions co;
+    co.iterations = a.iterations;
+    co.correction.tolerance_mm = a.tolerance_um / 1000.0;
+    co.on_round = [](const host::CorrectionRound& r) {
+      std::fputs(r.to_text().c_str(), stdout);
+      std::fflush(stdout);
+    };
+    const auto files = a.measured;
+    const double wait_s = a.wait_s;
+    host::MeasurementSource source =
+        [files, wait_s, known](int round) -> asio::awaitable<Result<std::optional<host::MeasurementSet>>> {
+      if (round > static_cast<int>(files.size())) co_return std::optional<host::MeasurementSet>();
+      const std::string path = files[static_cast<std::size_t>(round - 1)];
+      if (round > 1) {  // the first measurement is there already; later ones follow the moves
+        auto there = co_await wait_for_file(path, wait_s);
+        if (!there) co_return there.error();
+      }
+      auto m = host::load_measurements(path, known);
+      if (!m) co_return m.error();
+      co_return std::optional<host::MeasurementSet>(std::move(m).value());
+    };
+    stop_robots_on_signal(set_on_signal, fpa.array());
+    auto run = co_await host::correct_positions(fpa.array(), model, targets, source, co);
+    const auto& lock = fpa.array().lock_state();
+    if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
+    std::fputs(run.summary().c_str(), stdout);
+    rc = motion_exit_code(run.ok(), fpa.array());
+  }
+  if (action == "upgrade") {
+    if (!uo.expected_version) std::printf("no --version given: versions are reported, not checked\n");
+    auto r = co_await host::upgrade_plane(fpa, image, uo);
+    const auto rep = need(std::move(r));
+    std::fputs(rep.summary().c_str(), stdout);
+    rc = rep.ok() ? 0 : 1;
+  }
+  co_return rc;
+}
+
 int run_plane(const PlaneArgs& a, const std::string& action) {
   const auto plane = need(resolve_layout(a.layout));
   return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
@@ -118,129 +342,17 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
     auto connected = co_await host::FocalPlaneArray::connect(ex, plane, array_options(a));
     auto fpa = need(std::move(connected));
     int rc = 0;
-    if (action == "check") {
-      const auto check = co_await fpa->check_layout();
-      std::fputs(check.to_text().c_str(), stdout);
-      rc = check.ok() ? 0 : 1;
-    } else if (action == "status") {
-      auto d = co_await fpa->discover();
-      const auto found = need(std::move(d));
-      std::map<std::string, int> states;
-      for (const auto& row : found.table.rows) ++states[row.error.empty() ? row.state() : "no answer"];
-      std::printf("%zu robots known on %zu buses\n", found.table.rows.size(), fpa->bus_count());
-      for (const auto& [s, n] : states) std::printf("  %s: %d\n", s.c_str(), n);
-      for (const auto& p : found.problems) std::printf("problem: %s\n", p.c_str());
-      for (const auto& row : found.table.rows)
-        if (!row.error.empty()) std::printf("  positioner %u: %s\n", unsigned{row.id}, row.error.c_str());
-    } else if (action == "move") {
-      // Every known robot from where it is straight to (alpha, beta), all with the same timing.
-      const auto table = co_await fpa->array().status_table(true);
-      std::map<std::uint16_t, protocol::Trajectory> t;
-      for (const auto& row : table.rows) {
-        if (!row.position) {
-          std::printf("positioner %u: no position (%s); left out\n", unsigned{row.id}, row.error.c_str());
-          continue;
-        }
-        std::vector<protocol::ArmPoint> al, be;
-        for (int i = 1; i <= a.points; ++i) {
-          const double f = static_cast<double>(i) / a.points;
-          al.push_back({row.position->alpha + (a.alpha - row.position->alpha) * f, a.duration_s * f});
-          be.push_back({row.position->beta + (a.beta - row.position->beta) * f, a.duration_s * f});
-        }
-        t.emplace(row.id, need(protocol::Trajectory::from_physical(al, be)));
-      }
-      auto r = co_await fpa->run_trajectories(std::move(t), {}, a.sync);
-      const auto rep = need(std::move(r));
-      std::map<std::size_t, std::pair<int, int>> per_bus;  // started, robots
-      for (const auto& rr : rep.robots) {
-        auto& c = per_bus[rr.bus];
-        ++c.second;
-        const bool went = rr.state == host::RobotState::started || rr.state == host::RobotState::completed ||
-                          rr.state == host::RobotState::position_mismatch || rr.state == host::RobotState::timeout ||
-                          rr.state == host::RobotState::stopped || rr.state == host::RobotState::collided;
-        c.first += went ? 1 : 0;
-      }
-      for (const auto& [b, c] : per_bus)
-        std::printf("bus %s: %d of %d robots started\n", fpa->bus_ref(b).to_string().c_str(), c.first, c.second);
-      std::printf("start by %s; upload %.3f s, start %.3f s, move %.3f s\n", a.sync ? "the sync line" : "broadcast",
-                  std::chrono::duration<double>(rep.timings.upload).count(),
-                  std::chrono::duration<double>(rep.timings.start).count(),
-                  std::chrono::duration<double>(rep.timings.move).count());
-      const auto& lock = fpa->array().lock_state();
-      if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
-      std::fputs(rep.summary().c_str(), stdout);
-      rc = rep.completed ? 0 : 1;
-    }
-    if (action == "cold") {
-      // Once, or every period until a signal (or --for): the settings go out only when they change.
-      host::ColdControl cold(*fpa);
-      bool stop = false;
-      set_on_signal([&stop] { stop = true; });
-      const auto t0 = std::chrono::steady_clock::now();
-      bool first = true;
-      while (!stop) {
-        auto r = co_await cold.step(first);
-        first = false;
-        if (!r) {
-          std::printf("cold policy: %s\n", r.error().message().c_str());
-          rc = 1;
-        } else if (r.value().sent || !a.watch) {
-          std::fputs(r.value().to_text().c_str(), stdout);
-          rc = r.value().failed.empty() ? 0 : 1;
-        }
-        std::fflush(stdout);
-        if (!a.watch) break;
-        const auto next = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.period_s);
-        while (!stop && std::chrono::steady_clock::now() < next) {
-          co_await core::sleep_for(std::chrono::milliseconds(50));
-          if (a.for_s > 0 && std::chrono::steady_clock::now() - t0 >= std::chrono::duration<double>(a.for_s)) stop = true;
-        }
-      }
-      set_on_signal([] {});
-    }
-    if (action == "correct") {
-      // Correction iterations: each round reads the next --measured file (waiting for it to appear),
-      // corrects the robots outside tolerance and waits for them to arrive.
-      const auto targets = need(fps::plan::load_targets(a.targets));
-      const auto model = need(fps::plan::model_from_layout(plane));
-      std::vector<std::int32_t> known;
-      for (const auto& r : model.robots()) known.push_back(r.id());
-      host::CorrectionRunOptions co;
-      co.iterations = a.iterations;
-      co.correction.tolerance_mm = a.tolerance_um / 1000.0;
-      co.on_round = [](const host::CorrectionRound& r) {
-        std::fputs(r.to_text().c_str(), stdout);
-        std::fflush(stdout);
-      };
-      const auto files = a.measured;
-      const double wait_s = a.wait_s;
-      host::MeasurementSource source =
-          [files, wait_s, known](int round) -> asio::awaitable<Result<std::optional<host::MeasurementSet>>> {
-        if (round > static_cast<int>(files.size())) co_return std::optional<host::MeasurementSet>();
-        const std::string path = files[static_cast<std::size_t>(round - 1)];
-        if (round > 1) {  // the first measurement is there already; later ones follow the moves
-          auto there = co_await wait_for_file(path, wait_s);
-          if (!there) co_return there.error();
-        }
-        auto m = host::load_measurements(path, known);
-        if (!m) co_return m.error();
-        co_return std::optional<host::MeasurementSet>(std::move(m).value());
-      };
-      auto run = co_await host::correct_positions(fpa->array(), model, targets, source, co);
-      const auto& lock = fpa->array().lock_state();
-      if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
-      std::fputs(run.summary().c_str(), stdout);
-      rc = run.ok() ? 0 : 1;
-    }
-    if (action == "upgrade") {
-      if (!uo.expected_version) std::printf("no --version given: versions are reported, not checked\n");
-      auto r = co_await host::upgrade_plane(*fpa, image, uo);
-      const auto rep = need(std::move(r));
-      std::fputs(rep.summary().c_str(), stdout);
-      rc = rep.ok() ? 0 : 1;
+    std::exception_ptr failure;
+    try {
+      rc = co_await plane_action(*fpa, a, action, plane, set_on_signal, image, uo);
+    } catch (...) {
+      failure = std::current_exception();  // close first: the robots and connections are left tidy
     }
     std::fflush(stdout);
     co_await fpa->close();
+    set_on_signal([] {});  // the array is closed: a later signal has nothing to stop
+    report_signal_stop(fpa->array());
+    if (failure) std::rethrow_exception(failure);
     co_return rc;
   });
 }
@@ -258,14 +370,19 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
     exit_code() = run_plane(a, "check");
   });
   auto* ck = p->get_subcommand("check");
-  ck->add_option("--window", a.window_s, "seconds to collect GET_ID answers (default 0.5)");
+  ck->add_option("--window", a.window_s, "seconds to collect GET_ID answers (default 0.5)")->check(positive());
   p->add_subcommand("status", "discovery: firmware and status of every robot")->callback([] {
     exit_code() = run_plane(a, "status");
   });
   auto* mv = p->add_subcommand("move", "every robot straight to one (alpha, beta) by a trajectory, all at once");
   mv->add_option("--alpha", a.alpha, "degrees (default 0)");
   mv->add_option("--beta", a.beta, "degrees (default 180: folded)");
-  mv->add_option("--duration", a.duration_s, "seconds of the trajectory (default 10)");
+  mv->add_option("--duration", a.duration_s, "seconds of the trajectory (default 10)")->check(positive());
+  mv->add_flag("--fit-duration", a.fit_duration,
+               "when a robot cannot make --duration within its speed limit, use the duration the slowest robot needs");
+  mv->add_option("--max-rpm", a.max_rpm, "motor speed limit, rpm at the motor (default 5000, the actuators' requirement)")
+      ->check(positive());
+  mv->add_option("--gear-ratio", a.gear_ratio, "motor turns per arm turn (default 1000)")->check(positive());
   mv->add_option("--points", a.points, "points per arm (default 20)")->check(CLI::Range(1, 1000));
   mv->add_flag("--sync", a.sync, "start with the PLC's sync line instead of the START_TRAJECTORY broadcast");
   mv->callback([] { exit_code() = run_plane(a, "move"); });
@@ -283,7 +400,7 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
                                "(needs --plc)");
   cd->add_flag("--watch", a.watch, "keep going: read every --period, send only when the decision changes");
   cd->add_option("--period", a.period_s, "seconds between readings with --watch (default 60)")->check(CLI::Range(0.05, 86400.0));
-  cd->add_option("--for", a.for_s, "with --watch: stop after this many seconds (default: at a signal)");
+  cd->add_option("--for", a.for_s, "with --watch: stop after this many seconds (default: at a signal)")->check(non_negative());
   cd->callback([] {
     if (a.plc.empty()) throw Exception(usage("fps plane cold needs --plc"));
     exit_code() = run_plane(a, "cold");
