@@ -9,6 +9,7 @@
 #include "fps/host/plane_upgrade.hpp"
 #include "fps/host/trajectory_speed.hpp"
 #include "checks.hpp"
+#include "fps_json.hpp"
 #include "fps_stop.hpp"
 #include "fps/plan/layout_model.hpp"
 #include "layout_name.hpp"
@@ -16,6 +17,7 @@
 #include "run.hpp"
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include <boost/asio/co_spawn.hpp>
@@ -36,10 +38,12 @@ namespace {
 
 namespace host = fps::host;
 namespace protocol = fps::protocol;
+using json = nlohmann::json;
 
 struct PlaneArgs {
   std::string layout;
   std::string plc;
+  bool json = false;              // check, status, move: one JSON document on stdout, nothing else
   double window_s = 0.5;
   double alpha = 0;
   double beta = 180;
@@ -104,6 +108,67 @@ host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
   return o;
 }
 
+double phase_s(core::Duration d) { return std::chrono::duration<double>(d).count(); }
+
+void print_plane_json(const json& j) {
+  std::fputs(j.dump(2).c_str(), stdout);
+  std::fputc('\n', stdout);
+}
+
+// Per bus: robots that started (whatever happened next) and robots in the run.
+std::map<std::size_t, std::pair<int, int>> started_per_bus(const host::TrajectoryReport& rep) {
+  std::map<std::size_t, std::pair<int, int>> per_bus;
+  for (const auto& rr : rep.robots) {
+    auto& c = per_bus[rr.bus];
+    ++c.second;
+    const bool went = rr.state == host::RobotState::started || rr.state == host::RobotState::completed ||
+                      rr.state == host::RobotState::position_mismatch || rr.state == host::RobotState::timeout ||
+                      rr.state == host::RobotState::stopped || rr.state == host::RobotState::collided;
+    c.first += went ? 1 : 0;
+  }
+  return per_bus;
+}
+
+json maybe_angles_json(const std::optional<host::ArmAngles>& a) {
+  return a ? json{{"alpha", a->alpha}, {"beta", a->beta}} : json(nullptr);
+}
+
+json move_json(host::FocalPlaneArray& fpa, const host::TrajectoryReport& rep, double duration_s, bool sync) {
+  auto& array = fpa.array();
+  json j{{"started", rep.started}, {"completed", rep.completed}, {"outcome", rep.outcome}, {"duration_s", duration_s},
+         {"start_by", sync ? "sync line" : "broadcast"},
+         {"timings_s", {{"upload", phase_s(rep.timings.upload)}, {"start", phase_s(rep.timings.start)}, {"move", phase_s(rep.timings.move)}}},
+         {"locked", array.lock_state().locked ? json(array.lock_state().reason) : json(nullptr)},
+         {"link_stops", fpa.link_stops()}, {"buses", json::array()}, {"robots", json::array()}};
+  for (const auto& [b, c] : started_per_bus(rep))
+    j["buses"].push_back(json{{"bus", fpa.bus_ref(b).to_string()}, {"started", c.first}, {"robots", c.second}});
+  for (const auto& r : rep.robots)
+    j["robots"].push_back(json{{"id", r.id}, {"state", host::to_string(r.state)}, {"detail", r.detail},
+                               {"target", maybe_angles_json(r.target)}, {"reached", maybe_angles_json(r.reached)}});
+  return j;
+}
+
+// Robots per state ("no answer" for a robot that did not answer), problems, silent robots.
+int plane_status(const host::FocalPlaneArray& fpa, const host::DiscoveryReport& found, bool as_json) {
+  std::map<std::string, int> states;
+  for (const auto& row : found.table.rows) ++states[row.error.empty() ? row.state() : "no answer"];
+  const int rc = states.contains("no answer") || !found.problems.empty() ? 1 : 0;
+  if (as_json) {
+    json j{{"robots", found.table.rows.size()}, {"buses", fpa.bus_count()}, {"states", states},
+           {"problems", found.problems}, {"silent", json::array()}};
+    for (const auto& row : found.table.rows)
+      if (!row.error.empty()) j["silent"].push_back(json{{"id", row.id}, {"error", row.error}});
+    print_plane_json(j);
+    return rc;
+  }
+  std::printf("%zu robots known on %zu buses\n", found.table.rows.size(), fpa.bus_count());
+  for (const auto& [s, n] : states) std::printf("  %s: %d\n", s.c_str(), n);
+  for (const auto& p : found.problems) std::printf("problem: %s\n", p.c_str());
+  for (const auto& row : found.table.rows)
+    if (!row.error.empty()) std::printf("  positioner %u: %s\n", unsigned{row.id}, row.error.c_str());
+  return rc;
+}
+
 // Every known robot from where it is straight to (alpha, beta) over `points` points per arm.
 std::map<std::uint16_t, protocol::Trajectory> straight_moves(const host::StatusTable& table, const PlaneArgs& a,
                                                              double duration_s,
@@ -111,7 +176,7 @@ std::map<std::uint16_t, protocol::Trajectory> straight_moves(const host::StatusT
   std::map<std::uint16_t, protocol::Trajectory> t;
   for (const auto& row : table.rows) {
     if (!row.position) {
-      std::printf("positioner %u: no position (%s); left out\n", unsigned{row.id}, row.error.c_str());
+      std::fprintf(stderr, "positioner %u: no position (%s); left out\n", unsigned{row.id}, row.error.c_str());
       continue;
     }
     starts[row.id] = *row.position;
@@ -192,22 +257,15 @@ asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) 
   progress.finished = true;
   while (!progress.done) co_await core::sleep_for(std::chrono::milliseconds(10));
   const auto rep = need(std::move(r));
-  std::map<std::size_t, std::pair<int, int>> per_bus;  // started, robots
-  for (const auto& rr : rep.robots) {
-    auto& c = per_bus[rr.bus];
-    ++c.second;
-    const bool went = rr.state == host::RobotState::started || rr.state == host::RobotState::completed ||
-                      rr.state == host::RobotState::position_mismatch || rr.state == host::RobotState::timeout ||
-                      rr.state == host::RobotState::stopped || rr.state == host::RobotState::collided;
-    c.first += went ? 1 : 0;
+  const auto& lock = fpa.array().lock_state();
+  if (a.json) {
+    print_plane_json(move_json(fpa, rep, duration_s, a.sync));
+    co_return motion_exit_code(rep.completed, fpa.array());
   }
-  for (const auto& [b, c] : per_bus)
+  for (const auto& [b, c] : started_per_bus(rep))
     std::printf("bus %s: %d of %d robots started\n", fpa.bus_ref(b).to_string().c_str(), c.first, c.second);
   std::printf("start by %s; upload %.3f s, start %.3f s, move %.3f s\n", a.sync ? "the sync line" : "broadcast",
-              std::chrono::duration<double>(rep.timings.upload).count(),
-              std::chrono::duration<double>(rep.timings.start).count(),
-              std::chrono::duration<double>(rep.timings.move).count());
-  const auto& lock = fpa.array().lock_state();
+              phase_s(rep.timings.upload), phase_s(rep.timings.start), phase_s(rep.timings.move));
   if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
   for (const auto& l : fpa.link_stops()) std::printf("%s\n", l.c_str());
   std::fputs(rep.summary().c_str(), stdout);
@@ -223,19 +281,13 @@ asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a
   int rc = 0;
   if (action == "check") {
     const auto check = co_await fpa.check_layout();
-    std::fputs(check.to_text().c_str(), stdout);
+    if (a.json) print_plane_json(layout_check_json(check));
+    else std::fputs(check.to_text().c_str(), stdout);
     rc = check.ok() ? 0 : 1;
   } else if (action == "status") {
     auto d = co_await fpa.discover();
     const auto found = need(std::move(d));
-    std::map<std::string, int> states;
-    for (const auto& row : found.table.rows) ++states[row.error.empty() ? row.state() : "no answer"];
-    std::printf("%zu robots known on %zu buses\n", found.table.rows.size(), fpa.bus_count());
-    for (const auto& [s, n] : states) std::printf("  %s: %d\n", s.c_str(), n);
-    for (const auto& p : found.problems) std::printf("problem: %s\n", p.c_str());
-    for (const auto& row : found.table.rows)
-      if (!row.error.empty()) std::printf("  positioner %u: %s\n", unsigned{row.id}, row.error.c_str());
-    rc = states.contains("no answer") || !found.problems.empty() ? 1 : 0;
+    rc = plane_status(fpa, found, a.json);
   } else if (action == "move") {
     stop_robots_on_signal(set_on_signal, fpa.array());
     rc = co_await plane_move(fpa, a);
@@ -366,6 +418,8 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   p->require_subcommand(1);
   p->add_option("--layout", a.layout, "layout: default, benchtop or FILE (gateway addresses from it)")->required();
   p->add_option("--plc", a.plc, "the PLC at HOST[:PORT] (needed for --sync)");
+  p->add_flag("--json", a.json, "check, status, move: one JSON document on stdout and nothing else");
+  p->fallthrough();  // --json may also follow the action
   p->add_subcommand("check", "GET_ID on every bus at once, compared with the layout")->callback([] {
     exit_code() = run_plane(a, "check");
   });

@@ -263,7 +263,8 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
       if (e == HostErrc::collision || reported) {
         co_return fail(r, RobotState::collided, e.message());
       }
-      if (e == HostErrc::locked) co_return fail(r, RobotState::stopped, e.message());
+      // The lock's reason is the run's outcome, said once (not on each of 500 robot lines).
+      if (e == HostErrc::locked) co_return fail(r, RobotState::stopped, "stopped with every robot (see the outcome)");
       co_return fail(r, RobotState::timeout, e.message());
     }
     auto pos = co_await p->read_position();
