@@ -155,6 +155,7 @@ std::vector<can::BusSpec> selected_buses(const FpsOptions& o) {
     if (!spec) throw Exception(usage(spec.error().message()));
     specs.push_back(std::move(spec).value());
   }
+  if (auto distinct = can::check_distinct(specs); !distinct) throw Exception(usage(distinct.error().detail));
   return specs;
 }
 

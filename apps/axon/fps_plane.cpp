@@ -274,6 +274,43 @@ asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) 
 
 using SetOnSignal = std::function<void(std::function<void()>)>;
 
+// Correction iterations: each round reads the next --measured file (waiting for it to appear),
+// corrects the robots outside tolerance and waits for them to arrive.
+asio::awaitable<int> plane_correct(host::FocalPlaneArray& fpa, const PlaneArgs& a, const fps::FocalPlane& plane,
+                                   const SetOnSignal& set_on_signal) {
+  const auto targets = need(fps::plan::load_targets(a.targets));
+  const auto model = need(fps::plan::model_from_layout(plane));
+  std::vector<std::int32_t> known;
+  for (const auto& r : model.robots()) known.push_back(r.id());
+  host::CorrectionRunOptions co;
+  co.iterations = a.iterations;
+  co.correction.tolerance_mm = a.tolerance_um / 1000.0;
+  co.on_round = [](const host::CorrectionRound& r) {
+    std::fputs(r.to_text().c_str(), stdout);
+    std::fflush(stdout);
+  };
+  const auto files = a.measured;
+  const double wait_s = a.wait_s;
+  host::MeasurementSource source =
+      [files, wait_s, known](int round) -> asio::awaitable<Result<std::optional<host::MeasurementSet>>> {
+    if (round > static_cast<int>(files.size())) co_return std::optional<host::MeasurementSet>();
+    const std::string path = files[static_cast<std::size_t>(round - 1)];
+    if (round > 1) {  // the first measurement is there already; later ones follow the moves
+      auto there = co_await wait_for_file(path, wait_s);
+      if (!there) co_return there.error();
+    }
+    auto m = host::load_measurements(path, known);
+    if (!m) co_return m.error();
+    co_return std::optional<host::MeasurementSet>(std::move(m).value());
+  };
+  stop_robots_on_signal(set_on_signal, fpa.array());
+  auto run = co_await host::correct_positions(fpa.array(), model, targets, source, co);
+  const auto& lock = fpa.array().lock_state();
+  if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
+  std::fputs(run.summary().c_str(), stdout);
+  co_return motion_exit_code(run.ok(), fpa.array());
+}
+
 // One `fps plane` action on the connected plane; returns the exit code.
 asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a, const std::string& action,
                                   const fps::FocalPlane& plane, const SetOnSignal& set_on_signal,
@@ -322,41 +359,7 @@ asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a
     }
     set_on_signal([] {});
   }
-  if (action == "correct") {
-    // Correction iterations: each round reads the next --measured file (waiting for it to appear),
-    // corrects the robots outside tolerance and waits for them to arrive.
-    const auto targets = need(fps::plan::load_targets(a.targets));
-    const auto model = need(fps::plan::model_from_layout(plane));
-    std::vector<std::int32_t> known;
-    for (const auto& r : model.robots()) known.push_back(r.id());
-    host::CorrectionRunOptions co;
-    co.iterations = a.iterations;
-    co.correction.tolerance_mm = a.tolerance_um / 1000.0;
-    co.on_round = [](const host::CorrectionRound& r) {
-      std::fputs(r.to_text().c_str(), stdout);
-      std::fflush(stdout);
-    };
-    const auto files = a.measured;
-    const double wait_s = a.wait_s;
-    host::MeasurementSource source =
-        [files, wait_s, known](int round) -> asio::awaitable<Result<std::optional<host::MeasurementSet>>> {
-      if (round > static_cast<int>(files.size())) co_return std::optional<host::MeasurementSet>();
-      const std::string path = files[static_cast<std::size_t>(round - 1)];
-      if (round > 1) {  // the first measurement is there already; later ones follow the moves
-        auto there = co_await wait_for_file(path, wait_s);
-        if (!there) co_return there.error();
-      }
-      auto m = host::load_measurements(path, known);
-      if (!m) co_return m.error();
-      co_return std::optional<host::MeasurementSet>(std::move(m).value());
-    };
-    stop_robots_on_signal(set_on_signal, fpa.array());
-    auto run = co_await host::correct_positions(fpa.array(), model, targets, source, co);
-    const auto& lock = fpa.array().lock_state();
-    if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
-    std::fputs(run.summary().c_str(), stdout);
-    rc = motion_exit_code(run.ok(), fpa.array());
-  }
+  if (action == "correct") rc = co_await plane_correct(fpa, a, plane, set_on_signal);
   if (action == "upgrade") {
     if (!uo.expected_version) std::printf("no --version given: versions are reported, not checked\n");
     auto r = co_await host::upgrade_plane(fpa, image, uo);

@@ -70,12 +70,17 @@ asio::awaitable<Result<std::unique_ptr<Bus>>> open_bus(asio::any_io_executor ex,
   co_return Error(CanErrc::bad_spec, spec.text);
 }
 
-asio::awaitable<Result<std::vector<std::unique_ptr<Bus>>>> open_buses(asio::any_io_executor ex,
-                                                                      std::vector<BusSpec> specs, OpenOptions options) {
+Result<void> check_distinct(const std::vector<BusSpec>& specs) {
   for (std::size_t i = 0; i < specs.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (same_bus(specs[i], specs[j]))
-        co_return Error(CanErrc::bad_spec, fmt::format("'{}' is the same bus as '{}' (listed twice)", specs[i].text, specs[j].text));
+        return Error(CanErrc::bad_spec, fmt::format("'{}' is the same bus as '{}' (listed twice)", specs[i].text, specs[j].text));
+  return ok();
+}
+
+asio::awaitable<Result<std::vector<std::unique_ptr<Bus>>>> open_buses(asio::any_io_executor ex,
+                                                                      std::vector<BusSpec> specs, OpenOptions options) {
+  AXON_CO_TRY(check_distinct(specs));
   // One connection per gateway, with every channel asked of it.
   std::vector<std::pair<net::Endpoint, std::vector<int>>> gateways;
   for (const auto& s : specs) {

@@ -6,7 +6,8 @@
 #   2. another client takes gateway 2 over in the middle of a move: the host says so, stops every
 #      robot (those behind gateway 2 through one reconnection) and exits 4 (safety stop);
 #   3. a duration the robots cannot make is refused before anything moves, with the duration that
-#      would do, in a few lines; --fit-duration uses it.
+#      would do, in a few lines; --fit-duration uses it;
+#   4. --json: status and move print one JSON document on stdout and nothing else.
 source "$(dirname "$0")/lib.sh"
 
 "$AXON" sim fps --layout "$SMALL_PLANE" --folded --time-scale 1 --write-layout "$TMP/p.yaml" >"$TMP/sim.out" 2>"$TMP/sim.err" &
@@ -92,4 +93,17 @@ assert_stopped "impossible duration"
   >"$TMP/fit.out" 2>"$TMP/fit.err" || fail "--fit-duration: exit code $?"
 grep -q 'using --duration ' "$TMP/fit.err" || fail "--fit-duration: the duration used is not said"
 grep -q '^completed: 6 robots at their targets' "$TMP/fit.out" || fail "--fit-duration: the move did not complete"
+
+# 4. JSON.
+"$AXON" fps plane --layout "$TMP/p.yaml" --json status >"$TMP/st.json" 2>"$TMP/st.err" || fail "status --json: exit code $?"
+"$AXON" fps plane --layout "$TMP/p.yaml" move --alpha 50 --beta 170 --duration 0.5 --fit-duration --json \
+  >"$TMP/mv.json" 2>"$TMP/mv.err" || fail "move --json: exit code $?"
+/usr/bin/python3 - "$TMP/st.json" "$TMP/mv.json" <<'PY' || fail "--json output is not one JSON document as expected"
+import json, sys
+st = json.load(open(sys.argv[1]))
+assert st["robots"] == 6 and st["states"] == {"ready": 6} and st["silent"] == [], st
+mv = json.load(open(sys.argv[2]))
+assert mv["completed"] and len(mv["robots"]) == 6, mv
+assert all(r["state"] == "completed" and abs(r["reached"]["alpha"] - 50) < 0.2 for r in mv["robots"]), mv["robots"]
+PY
 echo PASS

@@ -279,6 +279,13 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
     }
     r.state = RobotState::completed;
   });
+  // Robots the host stopped watching before they were seen done may still be moving: stop them.
+  co_await for_each_concurrently(n, [&](std::size_t i) -> asio::awaitable<void> {
+    auto& r = rep.robots[i];
+    if (r.state != RobotState::timeout) co_return;
+    auto aborted = co_await find(r.id)->abort();
+    r.detail += aborted ? "; TRAJECTORY_ABORT sent to it" : fmt::format("; TRAJECTORY_ABORT not sent: {}", aborted.error().message());
+  });
   phase_end(rep.timings.move, "finished");
   rep.completed = rep.all(RobotState::completed);
   if (rep.completed) {
