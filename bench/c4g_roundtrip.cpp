@@ -2,19 +2,12 @@
 // timing) against a minimal echo server on the same kind of socket, measured in the same run.
 // Prints `BENCH c4g_roundtrip ... ratio=` (server p50 / echo p50).
 #include "c4g/host/server.hpp"
-
-#include <sys/socket.h>
-#include <netinet/in.h>
-#include <arpa/inet.h>
-#include <unistd.h>
-#include <poll.h>
+#include "net/udp_echo.hpp"
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <thread>
 #include <vector>
 
 using namespace axon;
@@ -61,30 +54,10 @@ struct Hold : host::Controller {
 }  // namespace
 
 int main() {
-  // Baseline: a plain blocking echo loop.
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in sa{};
-  sa.sin_family = AF_INET;
-  sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t len = sizeof sa;
-  ::bind(fd, reinterpret_cast<sockaddr*>(&sa), sizeof sa);
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&sa), &len);
-  std::atomic<bool> stop{false};
-  std::thread echo([&] {
-    char buf[2048];
-    while (!stop) {
-      pollfd pf{fd, POLLIN, 0};
-      if (::poll(&pf, 1, 50) <= 0) continue;
-      sockaddr_in from{};
-      socklen_t fl = sizeof from;
-      const auto n = ::recvfrom(fd, buf, sizeof buf, 0, reinterpret_cast<sockaddr*>(&from), &fl);
-      if (n > 0) ::sendto(fd, buf, static_cast<std::size_t>(n), 0, reinterpret_cast<sockaddr*>(&from), fl);
-    }
-  });
-  const auto base = drive(net::SocketAddress{0x7f000001, ntohs(sa.sin_port)});
-  stop = true;
-  echo.join();
-  ::close(fd);
+  // Baseline: a plain blocking echo loop on the same kind of socket.
+  auto echo = net::UdpEchoServer::start().value();
+  const auto base = drive(echo->address());
+  echo->stop();
 
   Hold hold;
   host::ServerOptions o;

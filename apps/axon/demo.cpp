@@ -7,6 +7,7 @@
 #include "can/virtual_bus.hpp"
 #include "commands.hpp"
 #include "demo_fps.hpp"
+#include "demo_parts.hpp"
 #include "run.hpp"
 
 #include <boost/asio/detached.hpp>
@@ -76,7 +77,15 @@ void report(const char* path, const RoundTrips& r, int count) {
              r.percentile(0.5), r.percentile(0.99));
 }
 
+int run_can_and_fps();
+
 int run_demo() {
+  const int rc = run_can_and_fps();
+  if (rc != 0) return rc;
+  return demo_c4g();
+}
+
+int run_can_and_fps() {
   return run_command([](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
     auto ex = io.get_executor();
     const int n = 200;
@@ -134,7 +143,6 @@ int run_demo() {
     gw->stop();
     const asio::any_io_executor any_ex = ex;
     co_await demo_fps(any_ex, set_on_signal);
-    fmt::print("\ndone. Next: `axon can bridge --listen 127.0.0.1:29536` and connect your own tools.\n");
     co_return 0;
   });
 }

@@ -5,6 +5,7 @@
 // simulator's collision count verified, each phase timed against the wire time of its busiest bus.
 // The simulated plane runs on a thread of its own (sim_thread.hpp), the host on the caller's.
 #include "demo_fps.hpp"
+#include "core/progress.hpp"
 
 #include "fps/host/cold_control.hpp"
 #include "fps/host/focal_plane_array.hpp"
@@ -249,6 +250,9 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
     std::vector<std::uint16_t> sample;
     for (const auto& [s, ids] : sextants)
       if (!ids.empty()) sample.push_back(ids.front());
+    core::ProgressOptions po;
+    po.quiet_for = {};
+    core::Progress line(stdout, po);  // rewritten in place on a terminal, a line a second into a file
     while (!finished) {
       std::string where;
       for (auto id : sample) {
@@ -256,12 +260,11 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
         if (p) where += fmt::format(" {}:{:.0f}/{:.0f}", id, p.value().alpha, p.value().beta);
       }
       const double el = seconds(Clock::now() - start), total = move_s / kTimeScale;
-      std::printf("\r   moving %4.1f of %.1f s (%3.0f%%), alpha/beta of one robot per sextant:%s   ", el, total,
-                  std::min(100.0, 100.0 * el / total), where.c_str());
-      std::fflush(stdout);
+      line.update(fmt::format("   moving {:4.1f} of {:.1f} s ({:3.0f}%), alpha/beta of one robot per sextant:{}", el, total,
+                              std::min(100.0, 100.0 * el / total), where));
       co_await core::sleep_for(250ms);
     }
-    std::printf("\n");
+    line.finish();
     progress_done = true;
   };
   asio::co_spawn(ex, progress(), asio::detached);

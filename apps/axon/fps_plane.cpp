@@ -14,6 +14,7 @@
 #include "fps/plan/layout_model.hpp"
 #include "layout_name.hpp"
 #include "net/endpoint.hpp"
+#include "core/progress.hpp"
 #include "run.hpp"
 
 #include <fmt/format.h>
@@ -23,8 +24,6 @@
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
 #include <boost/asio/this_coro.hpp>
-
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -208,8 +207,8 @@ double move_duration(const host::StatusTable& table, const PlaneArgs& a, const f
   return needed;
 }
 
-// Progress of a move on stderr once the robots started: a line per second, or one line rewritten
-// in place when stderr is a terminal. Only for moves over 2 s.
+// Progress of a move on stderr once the robots started (core::Progress: nothing for the first 2 s,
+// then a line per second into a file or pipe, one line rewritten in place on a terminal).
 struct MoveProgress {
   double total_s = 0;
   std::size_t robots = 0;
@@ -219,24 +218,16 @@ struct MoveProgress {
 };
 
 asio::awaitable<void> show_progress(MoveProgress& p) {
-  const bool tty = ::isatty(STDERR_FILENO) != 0;
   while (!p.started && !p.finished) co_await core::sleep_for(std::chrono::milliseconds(20));
   const auto t0 = std::chrono::steady_clock::now();
-  auto next = t0;
-  bool printed = false;
+  core::Progress line(stderr);
   while (!p.finished) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now >= next) {
-      const double el = std::chrono::duration<double>(now - t0).count();
-      std::fprintf(stderr, "%smoving %zu robots: %.0f of %.1f s (%.0f%%)%s", tty ? "\r" : "", p.robots, el, p.total_s,
-                   std::min(100.0, 100.0 * el / p.total_s), tty ? "   " : "\n");
-      std::fflush(stderr);
-      printed = true;
-      next += std::chrono::seconds(1);
-    }
-    co_await core::sleep_for(std::chrono::milliseconds(50));
+    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    line.update(fmt::format("moving {} robots: {:.0f} of {:.1f} s ({:.0f}%)", p.robots, el, p.total_s,
+                            std::min(100.0, 100.0 * el / p.total_s)));
+    co_await core::sleep_for(std::chrono::milliseconds(100));
   }
-  if (tty && printed) std::fputc('\n', stderr);
+  line.finish();
   p.done = true;
 }
 
@@ -251,8 +242,7 @@ asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) 
   to.speed_limits = limits;
   MoveProgress progress{duration_s, t.size()};
   to.on_phase = [&progress](std::string_view phase) { progress.started = progress.started || phase == "started"; };
-  if (duration_s > 2.0) asio::co_spawn(co_await asio::this_coro::executor, show_progress(progress), asio::detached);
-  else progress.done = true;
+  asio::co_spawn(co_await asio::this_coro::executor, show_progress(progress), asio::detached);
   auto r = co_await fpa.run_trajectories(std::move(t), to, a.sync);
   progress.finished = true;
   while (!progress.done) co_await core::sleep_for(std::chrono::milliseconds(10));

@@ -15,19 +15,9 @@ int& exit_code() {
   static int code = 0;
   return code;
 }
-// Errors that mean "the input was wrong" (option values, files): nothing was done.
-bool is_usage_error(std::error_code ec) {
-  if (ec.category() != axon::core_category()) return false;
-  using axon::CoreErrc;
-  switch (static_cast<CoreErrc>(ec.value())) {
-    case CoreErrc::invalid_argument:
-    case CoreErrc::config_syntax:
-    case CoreErrc::config_missing_key:
-    case CoreErrc::config_bad_value:
-    case CoreErrc::config_unknown_key: return true;
-    default: return false;
-  }
-}
+// Errors that mean "the input was wrong" (option values, files): nothing was done. Each layer's
+// error category maps its bad-input codes to std::errc::invalid_argument.
+bool is_usage_error(std::error_code ec) { return ec == std::errc::invalid_argument; }
 }  // namespace axon::app
 
 int main(int argc, char** argv) {

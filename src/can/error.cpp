@@ -24,6 +24,17 @@ class CanCategory final : public std::error_category {
     }
     return "unknown CAN error";
   }
+  // Text the user gave that is not a frame or a bus compares equal to std::errc::invalid_argument
+  // (see core/error.cpp). A peer's malformed line is counted where it arrives, not thrown.
+  std::error_condition default_error_condition(int c) const noexcept override {
+    switch (static_cast<CanErrc>(c)) {
+      case CanErrc::invalid_id:
+      case CanErrc::invalid_length:
+      case CanErrc::parse_error:
+      case CanErrc::bad_spec: return std::errc::invalid_argument;
+      default: return {c, *this};
+    }
+  }
 };
 }  // namespace
 

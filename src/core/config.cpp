@@ -10,11 +10,39 @@
 
 namespace axon::core {
 
+namespace {
+// yaml-cpp keeps both entries of a key given twice in one map and answers lookups with the first:
+// a second value the user meant would be ignored without a word. Refused with both lines instead.
+Result<void> reject_duplicate_keys(const YAML::Node& node, const std::string& file) {
+  if (node.IsSequence()) {
+    for (const auto& item : node) {
+      AXON_TRY(reject_duplicate_keys(item, file));
+    }
+  } else if (node.IsMap()) {
+    for (auto a = node.begin(); a != node.end(); ++a) {
+      if (a->first.IsScalar()) {
+        auto b = a;
+        for (++b; b != node.end(); ++b) {
+          if (!b->first.IsScalar() || b->first.Scalar() != a->first.Scalar()) continue;
+          const auto first = a->first.Mark(), again = b->first.Mark();
+          return Error(CoreErrc::config_syntax,
+                       fmt::format("{}:{}:{}: key '{}' given twice (first at line {}); remove one", file,
+                                   again.line + 1, again.column + 1, a->first.Scalar(), first.line + 1));
+        }
+      }
+      AXON_TRY(reject_duplicate_keys(a->second, file));
+    }
+  }
+  return ok();
+}
+}  // namespace
+
 Result<ConfigNode> ConfigNode::load_string(std::string_view text, std::string name) {
   auto file = std::make_shared<const std::string>(std::move(name));
   try {
     YAML::Node root = YAML::Load(std::string(text));
     if (!root.IsDefined() || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+    AXON_TRY(reject_duplicate_keys(root, *file));
     return ConfigNode(root, file, "");
   } catch (const YAML::Exception& e) {
     return Error(CoreErrc::config_syntax,

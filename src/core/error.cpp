@@ -31,6 +31,18 @@ class CoreCategory final : public std::error_category {
     }
     return "unknown core error";
   }
+  // Bad input from the user (values, configuration files) compares equal to
+  // std::errc::invalid_argument, so a surface (the CLI's exit code 2) tells it from a failed device.
+  std::error_condition default_error_condition(int c) const noexcept override {
+    switch (static_cast<CoreErrc>(c)) {
+      case CoreErrc::invalid_argument:
+      case CoreErrc::config_syntax:
+      case CoreErrc::config_missing_key:
+      case CoreErrc::config_bad_value:
+      case CoreErrc::config_unknown_key: return std::errc::invalid_argument;
+      default: return {c, *this};
+    }
+  }
 };
 }  // namespace
 

@@ -42,3 +42,11 @@ TEST(BusSpec, RejectsBadSpecsWithReason) {
     EXPECT_NE(r.error().message().find(t), std::string::npos) << r.error().message();
   }
 }
+
+// A bus or frame the user typed wrong is a usage error (CLI exit code 2); a device's trouble is not.
+TEST(BusSpec, BadSpecAndBadFrameTextCompareEqualToInvalidArgument) {
+  EXPECT_TRUE(parse_bus_spec("no-such-transport:x").error().code == std::errc::invalid_argument);
+  EXPECT_TRUE(make_error_code(CanErrc::parse_error) == std::errc::invalid_argument);
+  EXPECT_FALSE(make_error_code(CanErrc::timeout) == std::errc::invalid_argument);
+  EXPECT_FALSE(make_error_code(CanErrc::connect_failed) == std::errc::invalid_argument);
+}

@@ -78,3 +78,24 @@ TEST(Config, LoadsFileAndReportsMissingFile) {
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error(), CoreErrc::io);
 }
+
+// yaml-cpp keeps a key given twice and answers with the first value: the second, which the user
+// probably meant, would be dropped without a word. Both places are named instead.
+TEST(Config, KeyGivenTwiceIsRefusedWithBothLines) {
+  auto r = ConfigNode::load_string("name: a\nbitrate: 500000\nbitrate: 1000000\n", "bus.yaml");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, CoreErrc::config_syntax);
+  EXPECT_EQ(r.error().detail, "bus.yaml:3:1: key 'bitrate' given twice (first at line 2); remove one");
+}
+
+TEST(Config, KeyGivenTwiceInsideAListIsRefused) {
+  auto r = ConfigNode::load_string("robots:\n  - {id: 1, bus: can0}\n  - {id: 2, bus: can0, id: 3}\n", "plane.yaml");
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().detail.find("plane.yaml:3:"), std::string::npos) << r.error().detail;
+  EXPECT_NE(r.error().detail.find("key 'id' given twice"), std::string::npos) << r.error().detail;
+}
+
+TEST(Config, SameKeyInDifferentMapsIsFine) {
+  auto r = ConfigNode::load_string("a: {x: 1}\nb: {x: 2}\nlist: [{x: 1}, {x: 2}]\n", "ok.yaml");
+  EXPECT_TRUE(r) << r.error().detail;
+}

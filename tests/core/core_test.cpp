@@ -82,3 +82,15 @@ TEST(Realtime, RefusesCpuThatDoesNotExist) {
   ASSERT_EQ(report.steps.size(), 1u);
   EXPECT_FALSE(report.steps[0].granted);
 }
+
+// The CLI's exit code 2 ("usage error: nothing was done") rests on this: bad values and bad
+// configuration files compare equal to std::errc::invalid_argument, device and I/O trouble does not.
+TEST(Error, BadInputComparesEqualToInvalidArgument) {
+  using axon::CoreErrc;
+  for (auto e : {CoreErrc::invalid_argument, CoreErrc::config_syntax, CoreErrc::config_missing_key,
+                 CoreErrc::config_bad_value, CoreErrc::config_unknown_key})
+    EXPECT_TRUE(make_error_code(e) == std::errc::invalid_argument) << make_error_code(e).message();
+  for (auto e : {CoreErrc::io, CoreErrc::timeout, CoreErrc::closed, CoreErrc::permission})
+    EXPECT_FALSE(make_error_code(e) == std::errc::invalid_argument) << make_error_code(e).message();
+  EXPECT_TRUE(make_error_code(CoreErrc::timeout) == CoreErrc::timeout);  // same-category compares unchanged
+}
