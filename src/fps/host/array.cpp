@@ -461,9 +461,6 @@ asio::awaitable<Result<Array::MoveResults>> Array::move_many(std::map<std::uint1
     } else {
       results[i] = co_await p->goto_absolute(list[i].second);
     }
-    // A move the host gives up on (no end seen in time, lost replies) may still be running: stop
-    // that robot rather than leave it moving unwatched (harmless when it never started).
-    if (!results[i]) (void)co_await p->abort();
   });
   MoveResults out;
   for (std::size_t i = 0; i < list.size(); ++i) out.emplace(list[i].first, std::move(results[i]));

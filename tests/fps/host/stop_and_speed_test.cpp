@@ -163,3 +163,32 @@ TEST(StopRequest, ARobotTheRunStopsWatchingIsStoppedNotLeftMoving) {
   EXPECT_FALSE(rig.model(2).moving());
   EXPECT_LT(rig.model(2).physical_deg(sim::Arm::alpha), 45.0);
 }
+
+TEST(StopRequest, AGotoTheHostGivesUpOnIsAbortedNotLeftMoving) {
+  ArrayOptions ao = fast_array();
+  ao.client.timeout = 100ms;
+  auto so = fast_sim(1);  // real time: a 90 deg go-to at 12 deg/s takes 7.5 s
+  // Status replies are lost after discovery's read: the host cannot see the move end.
+  can::FaultRule lost;
+  lost.action = can::FaultRule::Action::drop;
+  lost.match = can::Filter{(std::uint32_t{1} << 18) | (std::uint32_t{protocol::number(protocol::CommandId::get_status)} << 10),
+                           0x1FFFFC00u, can::Filter::Format::extended};
+  lost.skip = 1;
+  lost.count = std::numeric_limits<std::uint64_t>::max();
+  so.reply_faults.rules.push_back(lost);
+  SimRig rig(1, so, ao);
+  rig.add(1, 0);
+  rig.start();
+  Result<Array::MoveResults> moved = Error(HostErrc::cancelled);
+  rig.run([&]() -> asio::awaitable<void> {
+    co_await rig.discover();
+    moved = co_await rig.array->goto_absolute({{1, ArmAngles{90, 180}}});
+  });
+  ASSERT_TRUE(moved.has_value()) << moved.error().message();
+  const auto& r1 = moved.value().at(1);
+  ASSERT_FALSE(r1.has_value());
+  EXPECT_EQ(r1.error(), HostErrc::timeout);
+  EXPECT_NE(r1.error().detail.find("TRAJECTORY_ABORT sent"), std::string::npos) << r1.error().message();
+  EXPECT_FALSE(rig.model(1).moving());
+  EXPECT_LT(rig.model(1).physical_deg(sim::Arm::alpha), 45.0);
+}
