@@ -182,7 +182,9 @@ TEST(StopRequest, AGotoTheHostGivesUpOnIsAbortedNotLeftMoving) {
   Result<Array::MoveResults> moved = Error(HostErrc::cancelled);
   rig.run([&]() -> asio::awaitable<void> {
     co_await rig.discover();
-    moved = co_await rig.array->goto_absolute({{1, ArmAngles{90, 180}}});
+    std::map<std::uint16_t, ArmAngles> target;  // named: gcc 12 and braced temporaries in co_await
+    target[1] = ArmAngles{90, 180};
+    moved = co_await rig.array->goto_absolute(std::move(target));
   });
   ASSERT_TRUE(moved.has_value()) << moved.error().message();
   const auto& r1 = moved.value().at(1);
