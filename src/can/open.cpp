@@ -94,6 +94,7 @@ asio::awaitable<Result<std::vector<std::unique_ptr<Bus>>>> open_buses(asio::any_
   auto fail = [&](const BusSpec& spec, const Error& e) {
     for (auto& b : out) b->close();
     for (auto& g : connected) g->close();
+    if (e.detail.find(spec.text) != std::string::npos) return e;  // already named
     return Error(e.code, fmt::format("{}: {}", spec.text, e.detail));
   };
   const CanNetOptions cn = cannet_options(options);
