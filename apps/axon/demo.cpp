@@ -86,7 +86,7 @@ int run_demo() {
 }
 
 int run_can_fps_blmc() {
-  return run_command([](asio::io_context& io, auto) -> asio::awaitable<int> {
+  return run_command([](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
     auto ex = io.get_executor();
     const int n = 200;
     fmt::print("axon demo: the CAN foundation\n\n");
@@ -142,8 +142,10 @@ int run_can_fps_blmc() {
     scd->stop();
     gw->stop();
     const asio::any_io_executor any_ex = ex;
-    co_await demo_fps(any_ex);
-    const int blmc = co_await demo_blmc(any_ex);
+    co_await demo_fps(any_ex, set_on_signal);
+    set_on_signal([] {});  // the fps part's array is gone; a signal from here on is the blmc part's
+    if (received_stop_signal().load() != 0) co_return exit_code_value::failed;  // run_command makes it 128+N
+    const int blmc = co_await demo_blmc(any_ex, set_on_signal);
     co_return blmc;
   });
 }

@@ -24,7 +24,8 @@ constexpr double kAmplitudeRev = 0.5, kFrequencyHz = 1.0, kRunS = 3.0;
 double blmc_us(core::Duration d) { return std::chrono::duration<double, std::micro>(d).count(); }
 
 // The PD loop for kRunS; the loop's fault if the safety supervisor stopped it.
-asio::awaitable<std::optional<bh::LoopFault>> run_pd(bh::Board& board, bh::PdController& pd, bh::LoopStats& stats) {
+asio::awaitable<std::optional<bh::LoopFault>> run_pd(bh::Board& board, bh::PdController& pd, bh::LoopStats& stats,
+                                                     const bool& stop) {
   auto c = co_await board.start_cyclic();
   need(std::move(c));
   std::optional<bh::LoopFault> fault;
@@ -37,7 +38,7 @@ asio::awaitable<std::optional<bh::LoopFault>> run_pd(bh::Board& board, bh::PdCon
     need(loop.start());
     const auto t0 = std::chrono::steady_clock::now();
     bh::CycleRecord rec;
-    while (loop.running() && std::chrono::steady_clock::now() - t0 < std::chrono::duration<double>(kRunS)) {
+    while (loop.running() && !stop && std::chrono::steady_clock::now() - t0 < std::chrono::duration<double>(kRunS)) {
       co_await core::sleep_for(20ms);
       while (loop.pop_record(rec)) {
       }
@@ -53,7 +54,7 @@ asio::awaitable<std::optional<bh::LoopFault>> run_pd(bh::Board& board, bh::PdCon
 
 }  // namespace
 
-asio::awaitable<int> demo_blmc(asio::any_io_executor ex) {
+asio::awaitable<int> demo_blmc(asio::any_io_executor ex, std::function<void(std::function<void()>)> set_on_signal) {
   fmt::print("\naxon demo: blmc, a dual brushless motor driver board at 1 kHz\n\n");
   can::VirtualBusRegistry registry(ex);
   need(registry.add("can0"));
@@ -73,12 +74,15 @@ asio::awaitable<int> demo_blmc(asio::any_io_executor ex) {
   bh::LoopStats st;
   std::optional<bh::LoopFault> fault;
   std::exception_ptr failure;
+  bool stop = false;
+  set_on_signal([&stop] { stop = true; });
   try {
-    fault = co_await run_pd(board, pd, st);
+    fault = co_await run_pd(board, pd, st, stop);
   } catch (...) {
     failure = std::current_exception();
   }
   auto off = co_await board.disable();  // whatever happened above
+  set_on_signal([] {});
   co_await core::sleep_for(50ms);
   const auto status = board_sim->status();
   runner.stop();
@@ -99,6 +103,7 @@ asio::awaitable<int> demo_blmc(asio::any_io_executor ex) {
   fmt::print("   after the run: system {}, motor 1 {}, motor 2 {}\n", status.system_enabled ? "ENABLED" : "disabled",
              status.motor1_enabled ? "ENABLED" : "disabled", status.motor2_enabled ? "ENABLED" : "disabled");
   const bool safe = !status.system_enabled && !status.motor1_enabled && !status.motor2_enabled;
+  if (stop) fmt::print("   stopped early by {}: motors disabled\n", signal_name(received_stop_signal().load()));
   co_return (!fault && safe) ? exit_code_value::ok : exit_code_value::failed;
 }
 

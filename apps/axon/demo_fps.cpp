@@ -14,6 +14,7 @@
 #include "fps/plan/problems.hpp"
 #include "fps/sim/focal_plane_sim.hpp"
 #include "layout_name.hpp"
+#include "fps_stop.hpp"
 #include "run.hpp"
 #include "sim_thread.hpp"
 
@@ -96,7 +97,7 @@ struct Phase {
 
 }  // namespace
 
-asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
+asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std::function<void()>)> set_on_signal) {
   fmt::print("\naxon demo: a focal plane of fiber positioners (fps)\n\n");
   const auto plane = need(resolve_layout("default"));
   fps::sim::FocalPlaneSimOptions so;
@@ -129,6 +130,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   auto connected = co_await host::FocalPlaneArray::connect(ex, plane, ao);
   auto fpa = need(std::move(connected));
   auto& array = fpa->array();
+  stop_robots_on_signal(set_on_signal, array);
   std::vector<Phase> phases;
 
   // 2. Layout check and discovery.
@@ -185,6 +187,11 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   auto r1 = co_await fpa->run_trajectories(std::move(fold), {}, true);
   const auto folded = need(std::move(r1));
   fmt::print("4. fold (20 points per arm, 16 s simulated, started by the PLC's sync line): {}\n", folded.outcome);
+  if (received_stop_signal().load() != 0) {  // stopped by a signal: every robot was stopped; end here
+    co_await fpa->close();
+    report_signal_stop(array);
+    co_return;
+  }
   if (!folded.completed) throw Exception(Error(CoreErrc::invalid_argument, failure_text(folded)));
 
   // 5. A random reconfiguration of every robot, planned collision-free from the folded lattice
@@ -266,6 +273,12 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex) {
   const auto run = need(std::move(r2));
   finished = true;
   while (!progress_done) co_await core::sleep_for(20ms);  // let the progress line end
+  if (received_stop_signal().load() != 0) {
+    fmt::print("   planned move: {}\n", run.outcome);
+    co_await fpa->close();
+    report_signal_stop(array);
+    co_return;
+  }
   fmt::print("   planned move of {} robots ({:.1f} s simulated), started by the sync line: {}\n", run.robots.size(),
              move_s, run.outcome);
   if (marks.contains("checked") && marks.contains("uploaded")) {

@@ -6,6 +6,8 @@
 #include "can/open.hpp"
 #include "commands.hpp"
 #include "fps_array.hpp"
+#include "fps_stop.hpp"
+#include "checks.hpp"
 #include "core/config.hpp"
 #include "fps/host/array.hpp"
 #include "fps/protocol/commands.hpp"
@@ -68,9 +70,12 @@ Result<void> apply_config_file(FpsOptions& o) {
     AXON_TRY(node, root.child("channels"));
     AXON_TRY(items, node.items());
     std::vector<int> v;
+    std::map<int, int> line_of;
     for (const auto& item : items) {
       AXON_TRY(c, item.as<int>());
       if (c < 1 || c > 4) return item.error(CoreErrc::config_bad_value, "a gateway channel is 1..4");
+      if (auto [it, fresh] = line_of.emplace(c, item.line()); !fresh)
+        return item.error(CoreErrc::config_bad_value, fmt::format("channel {} listed twice (first at line {})", c, it->second));
       v.push_back(c);
     }
     if (o.channels.empty()) o.channels = v;
@@ -80,8 +85,11 @@ Result<void> apply_config_file(FpsOptions& o) {
     AXON_TRY(node, root.child(key));
     AXON_TRY(items, node.items());
     std::vector<std::string> v;
+    std::map<std::string, int> line_of;
     for (const auto& item : items) {
       AXON_TRY(text, item.as<std::string>());
+      if (auto [it, fresh] = line_of.emplace(text, item.line()); !fresh)
+        return item.error(CoreErrc::config_bad_value, fmt::format("'{}' listed twice (first at line {})", text, it->second));
       v.push_back(text);
     }
     auto& target = std::string_view(key) == "channel" ? o.scd_channels : o.buses;
@@ -131,43 +139,50 @@ json row_json(const host::StatusRow& r) {
   return j;
 }
 
-// Opens the selected buses, discovers, runs `job`, closes everything.
-int with_array(const FpsOptions& given, const Job& job) {
+// The bus specs the options select: --gateway with --channels, --socketcand with --channel, --bus.
+std::vector<can::BusSpec> selected_buses(const FpsOptions& o) {
+  std::vector<std::string> texts;
+  if (!o.gateway.empty()) {
+    const net::Endpoint ep = need(net::parse_endpoint(o.gateway, can::kCanNetPort));
+    for (int c : o.channels) texts.push_back(fmt::format("cannet://{}/{}", ep.to_string(), c));
+  }
+  if (!o.socketcand.empty())
+    for (const auto& c : o.scd_channels) texts.push_back(fmt::format("socketcand://{}/{}", o.socketcand, c));
+  texts.insert(texts.end(), o.buses.begin(), o.buses.end());
+  std::vector<can::BusSpec> specs;
+  for (const auto& t : texts) {
+    auto spec = can::parse_bus_spec(t);
+    if (!spec) throw Exception(usage(spec.error().message()));
+    specs.push_back(std::move(spec).value());
+  }
+  if (auto distinct = can::check_distinct(specs); !distinct) throw Exception(usage(distinct.error().detail));
+  return specs;
+}
+
+// Buses where the discovery broadcast failed: the command cannot vouch for those robots.
+std::size_t failed_buses(const host::DiscoveryReport& report) {
+  return report.failed_buses.size();
+}
+
+// Opens the selected buses (channels of one gateway on one connection), discovers, runs `job`,
+// closes everything. With `moves`, a stop signal stops every robot (fps_stop.hpp). A bus whose
+// discovery failed makes the exit code at least 1.
+int with_array(const FpsOptions& given, const Job& job, bool moves = false) {
   const FpsOptions o = resolved(given);
   const int sources = (o.gateway.empty() ? 0 : 1) + (o.socketcand.empty() ? 0 : 1) + (o.buses.empty() ? 0 : 1);
   if (sources == 0) throw Exception(usage("select the buses: --gateway HOST:PORT, --socketcand HOST:PORT or --bus SPEC"));
+  const auto specs = selected_buses(o);
   return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
     const asio::any_io_executor ex = io.get_executor();
-    std::vector<std::unique_ptr<can::Bus>> buses;
-    std::shared_ptr<can::CanNetGateway> gateway;
     const auto timeout = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.timeout_s));
-    if (!o.gateway.empty()) {
-      const net::Endpoint ep = need(net::parse_endpoint(o.gateway, can::kCanNetPort));
-      std::vector<int> channels = o.channels;
-      const can::CanNetOptions cn;
-      auto r = co_await can::CanNetGateway::connect(ex, ep, channels, cn);
-      gateway = need(std::move(r));
-      for (int c : o.channels) buses.push_back(need(gateway->bus(c)));
-    }
-    std::vector<std::string> specs = o.buses;
-    if (!o.socketcand.empty())
-      for (const auto& c : o.scd_channels) specs.push_back(fmt::format("socketcand://{}/{}", o.socketcand, c));
-    for (const auto& text : specs) {
-      const auto spec = need(can::parse_bus_spec(text));
-      auto r = co_await can::open_bus(ex, spec);
-      buses.push_back(need(std::move(r)));
-    }
+    auto opened = co_await can::open_buses(ex, specs);
+    auto buses = need(std::move(opened));
     std::vector<can::Bus*> raw;
     for (auto& b : buses) raw.push_back(b.get());
     host::ArrayOptions ao;
     ao.client.timeout = timeout;
     auto array = std::make_unique<host::Array>(raw, ao);
-    set_on_signal([&] {
-      spdlog::warn("fps: interrupted: stopping every robot");
-      asio::co_spawn(ex, array->emergency_stop("interrupted (Ctrl-C)"), [&](std::exception_ptr) {
-        for (auto& b : buses) b->close();
-      });
-    });
+    if (moves) stop_robots_on_signal(set_on_signal, *array);
 
     int rc = 0;
     std::exception_ptr failure;
@@ -177,13 +192,18 @@ int with_array(const FpsOptions& given, const Job& job) {
       for (const auto& p : report.problems) spdlog::warn("discover: {}", p);
       spdlog::debug("discover: {} robots on {} buses", report.table.rows.size(), buses.size());
       rc = co_await job(*array, report);
+      if (failed_buses(report) > 0 && rc == 0) {
+        spdlog::error("discovery failed on {} of {} buses (above)", failed_buses(report), buses.size());
+        rc = exit_code_value::failed;
+      }
     } catch (...) {
       failure = std::current_exception();
     }
     co_await array->close();
+    set_on_signal([] {});
+    report_signal_stop(*array);
     array.reset();
     for (auto& b : buses) b->close();
-    if (gateway) gateway->close();
     if (failure) std::rethrow_exception(failure);
     co_return rc;
   });
@@ -199,6 +219,14 @@ host::Positioner* robot(host::Array& array, std::uint16_t id) {
 }
 
 // ---- discover / status / position ---------------------------------------------------------------
+
+// Robots that did not answer their status reads (a status report that lacks them failed).
+std::size_t silent_robots(const host::StatusTable& t) {
+  std::size_t n = 0;
+  for (const auto& r : t.rows) n += r.error.empty() ? 0 : 1;
+  if (n > 0) spdlog::error("{} of {} robots did not answer", n, t.rows.size());
+  return n;
+}
 
 asio::awaitable<int> job_discover(const FpsOptions& o, host::Array& array, const host::DiscoveryReport& report) {
   if (o.json) {
@@ -218,7 +246,7 @@ asio::awaitable<int> job_discover(const FpsOptions& o, host::Array& array, const
     for (const auto& p : report.problems) fmt::print("problem: {}\n", p);
     std::fflush(stdout);
   }
-  co_return array.ids().empty() ? 1 : 0;
+  co_return array.ids().empty() || silent_robots(report.table) > 0 ? 1 : 0;
 }
 
 // The status table with each robot's line coloured by its state (ANSI): ready green, moving or
@@ -259,7 +287,7 @@ asio::awaitable<int> job_status(const FpsOptions& o, host::Array&, const host::D
       if (r.status && !r.ready()) fmt::print("  {}: {}\n", r.id, r.status->to_string());
     std::fflush(stdout);
   }
-  co_return 0;
+  co_return silent_robots(t) == 0 && !t.rows.empty() ? 0 : 1;
 }
 
 asio::awaitable<int> job_position(const FpsOptions& o, const std::vector<std::string>& id_text, host::Array& array,
@@ -290,10 +318,15 @@ asio::awaitable<int> job_goto(const FpsOptions& o, const GotoArgs& g, host::Arra
   auto* p = robot(array, g.id);
   const host::ArmAngles value{g.alpha, g.beta};
   spdlog::info("goto: robot {} {} alpha {} beta {}", g.id, g.relative ? "by" : "to", g.alpha, g.beta);
-  Result<host::MoveResult> r = Error(CoreErrc::invalid_argument);
-  if (g.relative) r = co_await p->goto_relative(value);
-  else r = co_await p->goto_absolute(value);
-  const auto m = need(std::move(r));
+  (void)p;
+  std::map<std::uint16_t, host::ArmAngles> one{{g.id, value}};
+  Result<host::Array::MoveResults> r = Error(CoreErrc::invalid_argument);
+  if (g.relative) r = co_await array.goto_relative(std::move(one));
+  else r = co_await array.goto_absolute(std::move(one));
+  auto results = need(std::move(r));
+  auto& moved = results.at(g.id);
+  if (!moved) throw Exception(moved.error());
+  const auto m = std::move(moved).value();
   if (o.json) print_json(json{{"id", g.id}, {"target", angles_json(m.target)}, {"reached", angles_json(m.reached)}});
   else fmt::print("robot {} at alpha {:.3f} beta {:.3f} (target {:.3f} {:.3f})\n", g.id, m.reached.alpha, m.reached.beta,
                   m.target.alpha, m.target.beta);
@@ -311,10 +344,14 @@ std::map<std::uint16_t, protocol::Trajectory> load_trajectories(const std::strin
   }
   if (!root.IsMap() || root.size() == 0) throw Exception(usage(fmt::format("{}: expected a map of robot id -> {{alpha, beta}}", file)));
   std::map<std::uint16_t, protocol::Trajectory> out;
+  std::map<std::uint16_t, int> line_of;  // where each robot's entry starts (1-based)
   for (const auto& kv : root) {
     const auto key = kv.first.as<std::string>();
     const auto ids = need(parse_id_list(key));
     if (ids.size() != 1) throw Exception(usage(fmt::format("{}: key '{}' must be one robot id", file, key)));
+    const int line = kv.first.Mark().line + 1;
+    if (auto [it, fresh] = line_of.emplace(ids.front(), line); !fresh)
+      throw Exception(usage(fmt::format("{}:{}: robot {} listed twice (first at line {})", file, line, ids.front(), it->second)));
     std::vector<protocol::ArmPoint> arms[2];
     const char* names[2] = {"alpha", "beta"};
     for (int a = 0; a < 2; ++a) {
@@ -358,7 +395,7 @@ asio::awaitable<int> job_move(const FpsOptions& o, const std::map<std::uint16_t,
     fmt::print("{}\n", report.summary());
     std::fflush(stdout);
   }
-  co_return report.ok(load_only) ? 0 : 1;
+  co_return load_only ? (report.ok(true) ? 0 : 1) : motion_exit_code(report.ok(), array);
 }
 
 asio::awaitable<int> job_stop(const FpsOptions& o, bool clear, host::Array& array, const host::DiscoveryReport&) {
@@ -536,7 +573,7 @@ void add_fps_commands(CLI::App& app, GlobalOptions&) {
   fps->add_option("--bus", o.buses, "any bus spec (repeatable): cannet://HOST/N, socketcand://HOST/CH, socketcan:IF");
   fps->add_flag("--json", o.json, "machine-readable output");
   fps->add_flag("--no-color", o.no_color, "no colours in the status table (colours only on a terminal anyway)");
-  fps->add_option("--timeout", o.timeout_s, "seconds to wait for each reply (default 1)");
+  fps->add_option("--timeout", o.timeout_s, "seconds to wait for each reply (default 1)")->check(non_negative());
 
   fps->add_subcommand("discover", "robots per bus and their firmware")->callback([] {
     exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_discover(o, a, r); });
@@ -559,7 +596,7 @@ void add_fps_commands(CLI::App& app, GlobalOptions&) {
   g->add_option("beta", go.beta, "beta angle, degrees")->required();
   g->add_flag("--relative", go.relative, "move by ALPHA and BETA instead of to them");
   g->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_goto(o, go, a, r); });
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_goto(o, go, a, r); }, true);
   });
 
   static std::string trajectory_file;
@@ -569,7 +606,7 @@ void add_fps_commands(CLI::App& app, GlobalOptions&) {
   m->add_flag("--load-only", load_only, "upload and validate, do not start");
   m->callback([] {
     const auto trajectories = load_trajectories(trajectory_file);
-    exit_code() = with_array(o, [&](host::Array& a, const host::DiscoveryReport& r) { return job_move(o, trajectories, load_only, a, r); });
+    exit_code() = with_array(o, [&](host::Array& a, const host::DiscoveryReport& r) { return job_move(o, trajectories, load_only, a, r); }, true);
   });
 
   static bool clear_flags = false;
@@ -590,14 +627,14 @@ void add_fps_commands(CLI::App& app, GlobalOptions&) {
   c->add_flag("--cogging", cal.cogging, "calibrate cogging (long: up to 40 min)");
   c->add_flag("--save", cal.save, "save the calibration to flash");
   c->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_calibrate(o, cal, a, r); });
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_calibrate(o, cal, a, r); }, true);
   });
 
   static std::uint16_t datum_id = 0;
   auto* d = fps->add_subcommand("datum", "datum search: both arms into their hard stops");
   d->add_option("id", datum_id, "robot id")->required()->check(CLI::Range(1, 2047));
   d->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_datum(o, datum_id, a, r); });
+    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_datum(o, datum_id, a, r); }, true);
   });
 
   static std::string firmware_file;
@@ -623,8 +660,8 @@ void add_fps_commands(CLI::App& app, GlobalOptions&) {
   });
 }
 
-int with_fps_array(const FpsArrayJob& job) {
-  return with_array(*g_options, [&job](host::Array& a, const host::DiscoveryReport&) { return job(a); });
+int with_fps_array(const FpsArrayJob& job, bool moves) {
+  return with_array(*g_options, [&job](host::Array& a, const host::DiscoveryReport&) { return job(a); }, moves);
 }
 
 }  // namespace axon::app

@@ -11,7 +11,8 @@
 namespace axon::app {
 
 using FpsArrayJob = std::function<boost::asio::awaitable<int>(fps::host::Array&)>;
-// Opens the buses, discovers, runs `job`, closes; returns the job's exit code.
-int with_fps_array(const FpsArrayJob& job);
+// Opens the buses, discovers, runs `job`, closes; returns the job's exit code. With `moves`, SIGINT,
+// SIGTERM and SIGHUP stop every robot (fps_stop.hpp).
+int with_fps_array(const FpsArrayJob& job, bool moves = false);
 
 }  // namespace axon::app

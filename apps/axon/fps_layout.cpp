@@ -3,6 +3,7 @@
 #include "can/bus_spec.hpp"
 #include "can/cannet_client.hpp"
 #include "commands.hpp"
+#include "fps_json.hpp"
 #include "fps/host/command_client.hpp"
 #include "fps/layout/layout_check.hpp"
 #include "fps/layout/layout_file.hpp"
@@ -108,28 +109,6 @@ int show(const LayoutArgs& a) {
   return 0;
 }
 
-json check_json(const fps::LayoutCheck& c) {
-  auto buses = [](const std::vector<fps::BusRef>& v) {
-    json a = json::array();
-    for (const auto& b : v) a.push_back(b.to_string());
-    return a;
-  };
-  json j{{"ok", c.ok()},           {"matched", c.matched},   {"missing", c.missing},
-         {"offline_answered", c.offline_answered}, {"offline_silent", c.offline_silent},
-         {"not_checked", c.not_checked}};
-  j["wrong_bus"] = json::array();
-  for (const auto& w : c.wrong_bus)
-    j["wrong_bus"].push_back(json{{"id", w.id}, {"expected", w.expected.to_string()}, {"found", buses(w.found)}});
-  for (const char* key : {"unexpected", "duplicated"}) {
-    j[key] = json::array();
-    for (const auto& u : std::string_view(key) == "unexpected" ? c.unexpected : c.duplicated)
-      j[key].push_back(json{{"id", u.id}, {"found", buses(u.found)}});
-  }
-  j["failed_buses"] = json::object();
-  for (const auto& [b, why] : c.failed_buses) j["failed_buses"][b.to_string()] = why;
-  return j;
-}
-
 // Which gateways to open for a check, and as which layout gateway each counts.
 struct GatewayTarget {
   std::uint16_t layout_id = 0;
@@ -216,7 +195,7 @@ int check(const LayoutArgs& a, CLI::App& fps_cmd) {
     clients.clear();
     for (auto& b : buses) b->close();
     for (auto& g : open) g->close();
-    if (a.json) std::puts(check_json(result).dump(2).c_str());
+    if (a.json) std::puts(layout_check_json(result).dump(2).c_str());
     else std::fputs(result.to_text().c_str(), stdout);
     std::fflush(stdout);
     co_return result.ok() && sweep.failed.empty() ? 0 : 1;

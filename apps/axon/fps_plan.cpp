@@ -10,7 +10,9 @@
 #include "fps/plan/problems.hpp"
 #include "fps/plan/svg.hpp"
 #include "fps/plan/targets.hpp"
+#include "checks.hpp"
 #include "fps_array.hpp"
+#include "fps_stop.hpp"
 #include "run.hpp"
 
 #include <fmt/format.h>
@@ -222,7 +224,7 @@ asio::awaitable<int> job_goto_all(const PlanArgs& a, host::Array& array) {
   std::fputs(report.summary().c_str(), stdout);
   std::fputc('\n', stdout);
   std::fflush(stdout);
-  co_return report.ok() ? 0 : 1;
+  co_return motion_exit_code(report.ok(), array);
 }
 
 }  // namespace
@@ -233,7 +235,7 @@ void add_fps_plan_commands(CLI::App& app, GlobalOptions&) {
   auto common = [](CLI::App* c) {
     c->add_option("--layout", a.layout, "focal-plane layout: default, benchtop or a YAML file")->required();
     c->add_option("--seed", a.seed, "seed for random poses and the planner's nudges (default 1)");
-    c->add_option("--buffer", a.buffer, "collision buffer of every robot, mm (default 2.0)");
+    c->add_option("--buffer", a.buffer, "collision buffer of every robot, mm (default 2.0)")->check(non_negative());
   };
   auto* pl = fps_cmd->add_subcommand("plan", "plan collision-free trajectories for the whole focal plane");
   common(pl);
@@ -241,7 +243,7 @@ void add_fps_plan_commands(CLI::App& app, GlobalOptions&) {
   pl->add_option("--to", a.to, "targets: a target file (YAML/CSV) or 'random'")->required();
   pl->add_option("-o,--output", a.output, "plan.json to write ('-' for stdout)");
   pl->add_option("--svg", a.svg, "also draw the end poses and the fibre paths");
-  pl->add_option("--speed", a.speed, "arm speed, deg/s (default 12: 2000 rpm at the motor, 1000:1)");
+  pl->add_option("--speed", a.speed, "arm speed, deg/s (default 12: 2000 rpm at the motor, 1000:1)")->check(positive());
   pl->add_flag("--reject", a.reject, "fail on bad targets instead of parking those robots");
   pl->add_flag("--allow-partial", a.allow_partial, "exit 0 even when some robots cannot reach their targets");
   pl->callback([] { exit_code() = run_plan(a); });
@@ -258,11 +260,11 @@ void add_fps_plan_commands(CLI::App& app, GlobalOptions&) {
   auto* ga = fps_cmd->add_subcommand("goto-all", "plan from the robots' current positions to targets, then run it");
   common(ga);
   ga->add_option("--targets", a.targets, "target file (YAML/CSV)")->required();
-  ga->add_option("--speed", a.speed, "arm speed, deg/s (default 12)");
+  ga->add_option("--speed", a.speed, "arm speed, deg/s (default 12)")->check(positive());
   ga->add_option("--save-plan", a.output, "also write the plan.json");
   ga->add_flag("--reject", a.reject, "fail on bad targets instead of parking those robots");
   ga->add_flag("--allow-partial", a.allow_partial, "move the others when some robots cannot reach their targets");
-  ga->callback([] { exit_code() = with_fps_array([](host::Array& array) { return job_goto_all(a, array); }); });
+  ga->callback([] { exit_code() = with_fps_array([](host::Array& array) { return job_goto_all(a, array); }, true); });
 }
 
 }  // namespace axon::app

@@ -7,14 +7,25 @@
 #include "fps/host/cold_control.hpp"
 #include "fps/host/plane_correct.hpp"
 #include "fps/host/plane_upgrade.hpp"
+#include "fps/host/trajectory_speed.hpp"
+#include "checks.hpp"
+#include "fps_json.hpp"
+#include "fps_stop.hpp"
 #include "fps/plan/layout_model.hpp"
 #include "layout_name.hpp"
 #include "net/endpoint.hpp"
+#include "core/progress.hpp"
 #include "run.hpp"
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/detached.hpp>
+#include <boost/asio/this_coro.hpp>
+
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -26,15 +37,20 @@ namespace {
 
 namespace host = fps::host;
 namespace protocol = fps::protocol;
+using json = nlohmann::json;
 
 struct PlaneArgs {
   std::string layout;
   std::string plc;
+  bool json = false;              // check, status, move: one JSON document on stdout, nothing else
   double window_s = 0.5;
   double alpha = 0;
   double beta = 180;
   double duration_s = 10;
   int points = 20;
+  bool fit_duration = false;      // move: use the slowest robot's duration when --duration is too short
+  double max_rpm = host::kMaxMotorRpm;  // move: motor speed limit
+  double gear_ratio = host::kGearRatio;
   bool sync = false;
   std::string image;              // upgrade
   std::string version;            // upgrade: expected version
@@ -91,6 +107,259 @@ host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
   return o;
 }
 
+double phase_s(core::Duration d) { return std::chrono::duration<double>(d).count(); }
+
+void print_plane_json(const json& j) {
+  std::fputs(j.dump(2).c_str(), stdout);
+  std::fputc('\n', stdout);
+}
+
+// Per bus: robots that started (whatever happened next) and robots in the run.
+std::map<std::size_t, std::pair<int, int>> started_per_bus(const host::TrajectoryReport& rep) {
+  std::map<std::size_t, std::pair<int, int>> per_bus;
+  for (const auto& rr : rep.robots) {
+    auto& c = per_bus[rr.bus];
+    ++c.second;
+    const bool went = rr.state == host::RobotState::started || rr.state == host::RobotState::completed ||
+                      rr.state == host::RobotState::position_mismatch || rr.state == host::RobotState::timeout ||
+                      rr.state == host::RobotState::stopped || rr.state == host::RobotState::collided;
+    c.first += went ? 1 : 0;
+  }
+  return per_bus;
+}
+
+json maybe_angles_json(const std::optional<host::ArmAngles>& a) {
+  return a ? json{{"alpha", a->alpha}, {"beta", a->beta}} : json(nullptr);
+}
+
+json move_json(host::FocalPlaneArray& fpa, const host::TrajectoryReport& rep, double duration_s, bool sync) {
+  auto& array = fpa.array();
+  json j{{"started", rep.started}, {"completed", rep.completed}, {"outcome", rep.outcome}, {"duration_s", duration_s},
+         {"start_by", sync ? "sync line" : "broadcast"},
+         {"timings_s", {{"upload", phase_s(rep.timings.upload)}, {"start", phase_s(rep.timings.start)}, {"move", phase_s(rep.timings.move)}}},
+         {"locked", array.lock_state().locked ? json(array.lock_state().reason) : json(nullptr)},
+         {"link_stops", fpa.link_stops()}, {"buses", json::array()}, {"robots", json::array()}};
+  for (const auto& [b, c] : started_per_bus(rep))
+    j["buses"].push_back(json{{"bus", fpa.bus_ref(b).to_string()}, {"started", c.first}, {"robots", c.second}});
+  for (const auto& r : rep.robots)
+    j["robots"].push_back(json{{"id", r.id}, {"state", host::to_string(r.state)}, {"detail", r.detail},
+                               {"target", maybe_angles_json(r.target)}, {"reached", maybe_angles_json(r.reached)}});
+  return j;
+}
+
+// Robots per state ("no answer" for a robot that did not answer), problems, silent robots.
+int plane_status(const host::FocalPlaneArray& fpa, const host::DiscoveryReport& found, bool as_json) {
+  std::map<std::string, int> states;
+  for (const auto& row : found.table.rows) ++states[row.error.empty() ? row.state() : "no answer"];
+  const int rc = states.contains("no answer") || !found.problems.empty() ? 1 : 0;
+  if (as_json) {
+    json j{{"robots", found.table.rows.size()}, {"buses", fpa.bus_count()}, {"states", states},
+           {"problems", found.problems}, {"silent", json::array()}};
+    for (const auto& row : found.table.rows)
+      if (!row.error.empty()) j["silent"].push_back(json{{"id", row.id}, {"error", row.error}});
+    print_plane_json(j);
+    return rc;
+  }
+  std::printf("%zu robots known on %zu buses\n", found.table.rows.size(), fpa.bus_count());
+  for (const auto& [s, n] : states) std::printf("  %s: %d\n", s.c_str(), n);
+  for (const auto& p : found.problems) std::printf("problem: %s\n", p.c_str());
+  for (const auto& row : found.table.rows)
+    if (!row.error.empty()) std::printf("  positioner %u: %s\n", unsigned{row.id}, row.error.c_str());
+  return rc;
+}
+
+// Every known robot from where it is straight to (alpha, beta) over `points` points per arm.
+std::map<std::uint16_t, protocol::Trajectory> straight_moves(const host::StatusTable& table, const PlaneArgs& a,
+                                                             double duration_s,
+                                                             std::map<std::uint16_t, host::ArmAngles>& starts) {
+  std::map<std::uint16_t, protocol::Trajectory> t;
+  for (const auto& row : table.rows) {
+    if (!row.position) {
+      std::fprintf(stderr, "positioner %u: no position (%s); left out\n", unsigned{row.id}, row.error.c_str());
+      continue;
+    }
+    starts[row.id] = *row.position;
+    std::vector<protocol::ArmPoint> al, be;
+    for (int i = 1; i <= a.points; ++i) {
+      const double f = static_cast<double>(i) / a.points;
+      al.push_back({row.position->alpha + (a.alpha - row.position->alpha) * f, duration_s * f});
+      be.push_back({row.position->beta + (a.beta - row.position->beta) * f, duration_s * f});
+    }
+    t.emplace(row.id, need(protocol::Trajectory::from_physical(al, be)));
+  }
+  return t;
+}
+
+// The duration to use: --duration when every robot can make it, the slowest robot's with
+// --fit-duration; otherwise a usage error that says what would do.
+double move_duration(const host::StatusTable& table, const PlaneArgs& a, const fps::plan::SpeedLimits& limits) {
+  std::map<std::uint16_t, host::ArmAngles> starts;
+  const auto moves = straight_moves(table, a, a.duration_s, starts);
+  const auto slowest = host::slowest_robot(moves, starts, limits);
+  if (!slowest || slowest->too_fast == 0) return a.duration_s;
+  const double needed = host::feasible_duration_s(slowest->needed_s);
+  const auto what = fmt::format("{} of {} robots cannot make {:g} s at {:g} deg/s (alpha) and {:g} deg/s (beta): the "
+                                "slowest robot (positioner {}) needs {:.1f} s",
+                                slowest->too_fast, moves.size(), a.duration_s, limits.alpha_deg_s, limits.beta_deg_s,
+                                slowest->id, needed);
+  if (!a.fit_duration) throw Exception(usage(fmt::format("{}; use --duration {:.1f} or --fit-duration", what, needed)));
+  std::fprintf(stderr, "%s: using --duration %.1f\n", what.c_str(), needed);
+  return needed;
+}
+
+// Progress of a move on stderr once the robots started (core::Progress: nothing for the first 2 s,
+// then a line per second into a file or pipe, one line rewritten in place on a terminal).
+struct MoveProgress {
+  double total_s = 0;
+  std::size_t robots = 0;
+  bool started = false;
+  bool finished = false;
+  bool done = false;  // the progress coroutine has ended
+};
+
+asio::awaitable<void> show_progress(MoveProgress& p) {
+  while (!p.started && !p.finished) co_await core::sleep_for(std::chrono::milliseconds(20));
+  const auto t0 = std::chrono::steady_clock::now();
+  core::Progress line(stderr);
+  while (!p.finished) {
+    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    line.update(fmt::format("moving {} robots: {:.0f} of {:.1f} s ({:.0f}%)", p.robots, el, p.total_s,
+                            std::min(100.0, 100.0 * el / p.total_s)));
+    co_await core::sleep_for(std::chrono::milliseconds(100));
+  }
+  line.finish();
+  p.done = true;
+}
+
+asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) {
+  const auto limits = fps::plan::SpeedLimits::from_motor(a.max_rpm, a.gear_ratio);
+  const auto table = co_await fpa.array().status_table(true);
+  const double duration_s = move_duration(table, a, limits);
+  std::map<std::uint16_t, host::ArmAngles> starts;
+  auto t = straight_moves(table, a, duration_s, starts);
+  if (t.empty()) throw Exception(Error(host::HostErrc::not_ready, "no robot reported its position: nothing to move"));
+  host::TrajectoryOptions to;
+  to.speed_limits = limits;
+  MoveProgress progress{duration_s, t.size()};
+  to.on_phase = [&progress](std::string_view phase) { progress.started = progress.started || phase == "started"; };
+  asio::co_spawn(co_await asio::this_coro::executor, show_progress(progress), asio::detached);
+  auto r = co_await fpa.run_trajectories(std::move(t), to, a.sync);
+  progress.finished = true;
+  while (!progress.done) co_await core::sleep_for(std::chrono::milliseconds(10));
+  const auto rep = need(std::move(r));
+  const auto& lock = fpa.array().lock_state();
+  if (a.json) {
+    print_plane_json(move_json(fpa, rep, duration_s, a.sync));
+    co_return motion_exit_code(rep.completed, fpa.array());
+  }
+  for (const auto& [b, c] : started_per_bus(rep))
+    std::printf("bus %s: %d of %d robots started\n", fpa.bus_ref(b).to_string().c_str(), c.first, c.second);
+  std::printf("start by %s; upload %.3f s, start %.3f s, move %.3f s\n", a.sync ? "the sync line" : "broadcast",
+              phase_s(rep.timings.upload), phase_s(rep.timings.start), phase_s(rep.timings.move));
+  if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
+  for (const auto& l : fpa.link_stops()) std::printf("%s\n", l.c_str());
+  std::fputs(rep.summary().c_str(), stdout);
+  co_return motion_exit_code(rep.completed, fpa.array());
+}
+
+using SetOnSignal = std::function<void(std::function<void()>)>;
+
+// Correction iterations: each round reads the next --measured file (waiting for it to appear),
+// corrects the robots outside tolerance and waits for them to arrive.
+asio::awaitable<int> plane_correct(host::FocalPlaneArray& fpa, const PlaneArgs& a, const fps::FocalPlane& plane,
+                                   const SetOnSignal& set_on_signal) {
+  const auto targets = need(fps::plan::load_targets(a.targets));
+  const auto model = need(fps::plan::model_from_layout(plane));
+  std::vector<std::int32_t> known;
+  for (const auto& r : model.robots()) known.push_back(r.id());
+  host::CorrectionRunOptions co;
+  co.iterations = a.iterations;
+  co.correction.tolerance_mm = a.tolerance_um / 1000.0;
+  co.on_round = [](const host::CorrectionRound& r) {
+    std::fputs(r.to_text().c_str(), stdout);
+    std::fflush(stdout);
+  };
+  const auto files = a.measured;
+  const double wait_s = a.wait_s;
+  host::MeasurementSource source =
+      [files, wait_s, known](int round) -> asio::awaitable<Result<std::optional<host::MeasurementSet>>> {
+    if (round > static_cast<int>(files.size())) co_return std::optional<host::MeasurementSet>();
+    const std::string path = files[static_cast<std::size_t>(round - 1)];
+    if (round > 1) {  // the first measurement is there already; later ones follow the moves
+      auto there = co_await wait_for_file(path, wait_s);
+      if (!there) co_return there.error();
+    }
+    auto m = host::load_measurements(path, known);
+    if (!m) co_return m.error();
+    co_return std::optional<host::MeasurementSet>(std::move(m).value());
+  };
+  stop_robots_on_signal(set_on_signal, fpa.array());
+  auto run = co_await host::correct_positions(fpa.array(), model, targets, source, co);
+  const auto& lock = fpa.array().lock_state();
+  if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
+  std::fputs(run.summary().c_str(), stdout);
+  co_return motion_exit_code(run.ok(), fpa.array());
+}
+
+// One `fps plane` action on the connected plane; returns the exit code.
+asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a, const std::string& action,
+                                  const fps::FocalPlane& plane, const SetOnSignal& set_on_signal,
+                                  const std::vector<std::uint8_t>& image, const host::PlaneUpgradeOptions& uo) {
+  int rc = 0;
+  if (action == "check") {
+    const auto check = co_await fpa.check_layout();
+    if (a.json) print_plane_json(layout_check_json(check));
+    else std::fputs(check.to_text().c_str(), stdout);
+    rc = check.ok() ? 0 : 1;
+  } else if (action == "status") {
+    auto d = co_await fpa.discover();
+    const auto found = need(std::move(d));
+    rc = plane_status(fpa, found, a.json);
+  } else if (action == "move") {
+    stop_robots_on_signal(set_on_signal, fpa.array());
+    rc = co_await plane_move(fpa, a);
+  }
+  if (action == "cold") {
+    // Once, or every period until a signal (or --for): the settings go out only when they change.
+    host::ColdControl cold(fpa);
+    bool stop = false;
+    set_on_signal([&stop] {
+      signal_is_normal_end().store(true);  // --watch runs until a signal: its normal end
+      stop = true;
+    });
+    const auto t0 = std::chrono::steady_clock::now();
+    bool first = true;
+    while (!stop) {
+      auto r = co_await cold.step(first);
+      first = false;
+      if (!r) {
+        std::printf("cold policy: %s\n", r.error().message().c_str());
+        rc = 1;
+      } else if (r.value().sent || !a.watch) {
+        std::fputs(r.value().to_text().c_str(), stdout);
+        rc = r.value().failed.empty() ? 0 : 1;
+      }
+      std::fflush(stdout);
+      if (!a.watch) break;
+      const auto next = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.period_s);
+      while (!stop && std::chrono::steady_clock::now() < next) {
+        co_await core::sleep_for(std::chrono::milliseconds(50));
+        if (a.for_s > 0 && std::chrono::steady_clock::now() - t0 >= std::chrono::duration<double>(a.for_s)) stop = true;
+      }
+    }
+    set_on_signal([] {});
+  }
+  if (action == "correct") rc = co_await plane_correct(fpa, a, plane, set_on_signal);
+  if (action == "upgrade") {
+    if (!uo.expected_version) std::printf("no --version given: versions are reported, not checked\n");
+    auto r = co_await host::upgrade_plane(fpa, image, uo);
+    const auto rep = need(std::move(r));
+    std::fputs(rep.summary().c_str(), stdout);
+    rc = rep.ok() ? 0 : 1;
+  }
+  co_return rc;
+}
+
 int run_plane(const PlaneArgs& a, const std::string& action) {
   const auto plane = need(resolve_layout(a.layout));
   return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
@@ -118,129 +387,17 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
     auto connected = co_await host::FocalPlaneArray::connect(ex, plane, array_options(a));
     auto fpa = need(std::move(connected));
     int rc = 0;
-    if (action == "check") {
-      const auto check = co_await fpa->check_layout();
-      std::fputs(check.to_text().c_str(), stdout);
-      rc = check.ok() ? 0 : 1;
-    } else if (action == "status") {
-      auto d = co_await fpa->discover();
-      const auto found = need(std::move(d));
-      std::map<std::string, int> states;
-      for (const auto& row : found.table.rows) ++states[row.error.empty() ? row.state() : "no answer"];
-      std::printf("%zu robots known on %zu buses\n", found.table.rows.size(), fpa->bus_count());
-      for (const auto& [s, n] : states) std::printf("  %s: %d\n", s.c_str(), n);
-      for (const auto& p : found.problems) std::printf("problem: %s\n", p.c_str());
-      for (const auto& row : found.table.rows)
-        if (!row.error.empty()) std::printf("  positioner %u: %s\n", unsigned{row.id}, row.error.c_str());
-    } else if (action == "move") {
-      // Every known robot from where it is straight to (alpha, beta), all with the same timing.
-      const auto table = co_await fpa->array().status_table(true);
-      std::map<std::uint16_t, protocol::Trajectory> t;
-      for (const auto& row : table.rows) {
-        if (!row.position) {
-          std::printf("positioner %u: no position (%s); left out\n", unsigned{row.id}, row.error.c_str());
-          continue;
-        }
-        std::vector<protocol::ArmPoint> al, be;
-        for (int i = 1; i <= a.points; ++i) {
-          const double f = static_cast<double>(i) / a.points;
-          al.push_back({row.position->alpha + (a.alpha - row.position->alpha) * f, a.duration_s * f});
-          be.push_back({row.position->beta + (a.beta - row.position->beta) * f, a.duration_s * f});
-        }
-        t.emplace(row.id, need(protocol::Trajectory::from_physical(al, be)));
-      }
-      auto r = co_await fpa->run_trajectories(std::move(t), {}, a.sync);
-      const auto rep = need(std::move(r));
-      std::map<std::size_t, std::pair<int, int>> per_bus;  // started, robots
-      for (const auto& rr : rep.robots) {
-        auto& c = per_bus[rr.bus];
-        ++c.second;
-        const bool went = rr.state == host::RobotState::started || rr.state == host::RobotState::completed ||
-                          rr.state == host::RobotState::position_mismatch || rr.state == host::RobotState::timeout ||
-                          rr.state == host::RobotState::stopped || rr.state == host::RobotState::collided;
-        c.first += went ? 1 : 0;
-      }
-      for (const auto& [b, c] : per_bus)
-        std::printf("bus %s: %d of %d robots started\n", fpa->bus_ref(b).to_string().c_str(), c.first, c.second);
-      std::printf("start by %s; upload %.3f s, start %.3f s, move %.3f s\n", a.sync ? "the sync line" : "broadcast",
-                  std::chrono::duration<double>(rep.timings.upload).count(),
-                  std::chrono::duration<double>(rep.timings.start).count(),
-                  std::chrono::duration<double>(rep.timings.move).count());
-      const auto& lock = fpa->array().lock_state();
-      if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
-      std::fputs(rep.summary().c_str(), stdout);
-      rc = rep.completed ? 0 : 1;
-    }
-    if (action == "cold") {
-      // Once, or every period until a signal (or --for): the settings go out only when they change.
-      host::ColdControl cold(*fpa);
-      bool stop = false;
-      set_on_signal([&stop] { stop = true; });
-      const auto t0 = std::chrono::steady_clock::now();
-      bool first = true;
-      while (!stop) {
-        auto r = co_await cold.step(first);
-        first = false;
-        if (!r) {
-          std::printf("cold policy: %s\n", r.error().message().c_str());
-          rc = 1;
-        } else if (r.value().sent || !a.watch) {
-          std::fputs(r.value().to_text().c_str(), stdout);
-          rc = r.value().failed.empty() ? 0 : 1;
-        }
-        std::fflush(stdout);
-        if (!a.watch) break;
-        const auto next = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.period_s);
-        while (!stop && std::chrono::steady_clock::now() < next) {
-          co_await core::sleep_for(std::chrono::milliseconds(50));
-          if (a.for_s > 0 && std::chrono::steady_clock::now() - t0 >= std::chrono::duration<double>(a.for_s)) stop = true;
-        }
-      }
-      set_on_signal([] {});
-    }
-    if (action == "correct") {
-      // Correction iterations: each round reads the next --measured file (waiting for it to appear),
-      // corrects the robots outside tolerance and waits for them to arrive.
-      const auto targets = need(fps::plan::load_targets(a.targets));
-      const auto model = need(fps::plan::model_from_layout(plane));
-      std::vector<std::int32_t> known;
-      for (const auto& r : model.robots()) known.push_back(r.id());
-      host::CorrectionRunOptions co;
-      co.iterations = a.iterations;
-      co.correction.tolerance_mm = a.tolerance_um / 1000.0;
-      co.on_round = [](const host::CorrectionRound& r) {
-        std::fputs(r.to_text().c_str(), stdout);
-        std::fflush(stdout);
-      };
-      const auto files = a.measured;
-      const double wait_s = a.wait_s;
-      host::MeasurementSource source =
-          [files, wait_s, known](int round) -> asio::awaitable<Result<std::optional<host::MeasurementSet>>> {
-        if (round > static_cast<int>(files.size())) co_return std::optional<host::MeasurementSet>();
-        const std::string path = files[static_cast<std::size_t>(round - 1)];
-        if (round > 1) {  // the first measurement is there already; later ones follow the moves
-          auto there = co_await wait_for_file(path, wait_s);
-          if (!there) co_return there.error();
-        }
-        auto m = host::load_measurements(path, known);
-        if (!m) co_return m.error();
-        co_return std::optional<host::MeasurementSet>(std::move(m).value());
-      };
-      auto run = co_await host::correct_positions(fpa->array(), model, targets, source, co);
-      const auto& lock = fpa->array().lock_state();
-      if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
-      std::fputs(run.summary().c_str(), stdout);
-      rc = run.ok() ? 0 : 1;
-    }
-    if (action == "upgrade") {
-      if (!uo.expected_version) std::printf("no --version given: versions are reported, not checked\n");
-      auto r = co_await host::upgrade_plane(*fpa, image, uo);
-      const auto rep = need(std::move(r));
-      std::fputs(rep.summary().c_str(), stdout);
-      rc = rep.ok() ? 0 : 1;
+    std::exception_ptr failure;
+    try {
+      rc = co_await plane_action(*fpa, a, action, plane, set_on_signal, image, uo);
+    } catch (...) {
+      failure = std::current_exception();  // close first: the robots and connections are left tidy
     }
     std::fflush(stdout);
     co_await fpa->close();
+    set_on_signal([] {});  // the array is closed: a later signal has nothing to stop
+    report_signal_stop(fpa->array());
+    if (failure) std::rethrow_exception(failure);
     co_return rc;
   });
 }
@@ -254,18 +411,25 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   p->require_subcommand(1);
   p->add_option("--layout", a.layout, "layout: default, benchtop or FILE (gateway addresses from it)")->required();
   p->add_option("--plc", a.plc, "the PLC at HOST[:PORT] (needed for --sync)");
+  p->add_flag("--json", a.json, "check, status, move: one JSON document on stdout and nothing else");
+  p->fallthrough();  // --json may also follow the action
   p->add_subcommand("check", "GET_ID on every bus at once, compared with the layout")->callback([] {
     exit_code() = run_plane(a, "check");
   });
   auto* ck = p->get_subcommand("check");
-  ck->add_option("--window", a.window_s, "seconds to collect GET_ID answers (default 0.5)");
+  ck->add_option("--window", a.window_s, "seconds to collect GET_ID answers (default 0.5)")->check(positive());
   p->add_subcommand("status", "discovery: firmware and status of every robot")->callback([] {
     exit_code() = run_plane(a, "status");
   });
   auto* mv = p->add_subcommand("move", "every robot straight to one (alpha, beta) by a trajectory, all at once");
   mv->add_option("--alpha", a.alpha, "degrees (default 0)");
   mv->add_option("--beta", a.beta, "degrees (default 180: folded)");
-  mv->add_option("--duration", a.duration_s, "seconds of the trajectory (default 10)");
+  mv->add_option("--duration", a.duration_s, "seconds of the trajectory (default 10)")->check(positive());
+  mv->add_flag("--fit-duration", a.fit_duration,
+               "when a robot cannot make --duration within its speed limit, use the duration the slowest robot needs");
+  mv->add_option("--max-rpm", a.max_rpm, "motor speed limit, rpm at the motor (default 5000, the actuators' requirement)")
+      ->check(positive());
+  mv->add_option("--gear-ratio", a.gear_ratio, "motor turns per arm turn (default 1000)")->check(positive());
   mv->add_option("--points", a.points, "points per arm (default 20)")->check(CLI::Range(1, 1000));
   mv->add_flag("--sync", a.sync, "start with the PLC's sync line instead of the START_TRAJECTORY broadcast");
   mv->callback([] { exit_code() = run_plane(a, "move"); });
@@ -283,7 +447,7 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
                                "(needs --plc)");
   cd->add_flag("--watch", a.watch, "keep going: read every --period, send only when the decision changes");
   cd->add_option("--period", a.period_s, "seconds between readings with --watch (default 60)")->check(CLI::Range(0.05, 86400.0));
-  cd->add_option("--for", a.for_s, "with --watch: stop after this many seconds (default: at a signal)");
+  cd->add_option("--for", a.for_s, "with --watch: stop after this many seconds (default: at a signal)")->check(non_negative());
   cd->callback([] {
     if (a.plc.empty()) throw Exception(usage("fps plane cold needs --plc"));
     exit_code() = run_plane(a, "cold");

@@ -15,6 +15,7 @@
 #include <chrono>
 
 #include <csignal>
+#include <cstdio>
 #include <exception>
 #include <functional>
 #include <string>
@@ -62,8 +63,18 @@ inline int run_command(const std::function<asio::awaitable<int>(asio::io_context
                    io.stop();
                  });
   io.run();
-  if (failure) std::rethrow_exception(failure);
   const int signo = received_stop_signal().load();
+  if (failure && signo != 0 && !signal_is_normal_end().load()) {
+    // The signal's stop made the body fail (a move refused because the devices were stopped): the
+    // error is told, the exit code stays the signal's.
+    try {
+      std::rethrow_exception(failure);
+    } catch (const Exception& e) {
+      std::fprintf(stderr, "axon: error: %s\n", e.what());
+      return signal_exit_code(signo);
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
   if (signo != 0 && !signal_is_normal_end().load()) return signal_exit_code(signo);
   return rc;
 }

@@ -242,8 +242,13 @@ asio::awaitable<void> CanNetGateway::Impl::run_reader(std::shared_ptr<Impl> self
     boost::system::error_code ec;
     const std::size_t n = co_await s.socket.async_read_some(asio::buffer(buf), asio::redirect_error(asio::use_awaitable, ec));
     if (ec) {
+      // An orderly close from the gateway's side: it serves one client at a time and closes the
+      // older connection when another client connects (its protocol has no line to say so).
       s.connection_down(Error(CanErrc::io, ec == asio::error::eof
-                                               ? fmt::format("{}: the gateway closed the connection", s.where)
+                                               ? fmt::format("{}: the gateway closed the connection: another client "
+                                                             "has probably taken the gateway over (it serves one client "
+                                                             "at a time), or it restarted",
+                                                             s.where)
                                                : fmt::format("{}: read failed: {}", s.where, ec.message())));
       co_return;
     }
@@ -559,6 +564,7 @@ asio::awaitable<Result<void>> CanNetGateway::restart(int channel) {
 
 void CanNetGateway::close() { impl_->connection_down(Error(CanErrc::closed, fmt::format("{}: closed by the host", impl_->where))); }
 bool CanNetGateway::is_connected() const noexcept { return impl_->connected; }
+const Error& CanNetGateway::disconnect_reason() const noexcept { return impl_->down_error; }
 const std::vector<int>& CanNetGateway::channels() const noexcept { return impl_->channels; }
 const net::Endpoint& CanNetGateway::endpoint() const noexcept { return impl_->endpoint; }
 const CanNetGatewayStats& CanNetGateway::stats() const noexcept { return impl_->stats; }

@@ -96,6 +96,9 @@ class CanNetGateway : public std::enable_shared_from_this<CanNetGateway> {
   // Closes the connection; every bus closes too. Safe to call twice.
   void close();
   [[nodiscard]] bool is_connected() const noexcept;
+  // Why the connection is down (meaningful once is_connected() is false): closed by the host, the
+  // gateway's close (another client took the gateway over, or it restarted), a read or write error.
+  [[nodiscard]] const Error& disconnect_reason() const noexcept;
   [[nodiscard]] const std::vector<int>& channels() const noexcept;
   [[nodiscard]] const net::Endpoint& endpoint() const noexcept;
   [[nodiscard]] const CanNetGatewayStats& stats() const noexcept;

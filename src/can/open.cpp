@@ -6,7 +6,32 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace axon::can {
+
+namespace {
+
+CanNetOptions cannet_options(const OpenOptions& options) {
+  CanNetOptions o;
+  o.connect_timeout = options.connect_timeout;
+  o.bitrate_kbit = options.bus.bitrate / 1000;
+  o.bus_options = options.bus;
+  return o;
+}
+
+bool same_endpoint(const net::Endpoint& a, const net::Endpoint& b) { return a.host == b.host && a.port == b.port; }
+
+bool same_bus(const BusSpec& a, const BusSpec& b) {
+  if (a.kind != b.kind) return false;
+  switch (a.kind) {
+    case BusSpec::Kind::cannet: return same_endpoint(a.endpoint, b.endpoint) && a.cannet_channel == b.cannet_channel;
+    case BusSpec::Kind::socketcand: return same_endpoint(a.endpoint, b.endpoint) && a.channel == b.channel;
+    default: return a.channel == b.channel;
+  }
+}
+
+}  // namespace
 
 asio::awaitable<Result<std::unique_ptr<Bus>>> open_bus(asio::any_io_executor ex, const BusSpec& spec,
                                                        OpenOptions options) {
@@ -29,10 +54,7 @@ asio::awaitable<Result<std::unique_ptr<Bus>>> open_bus(asio::any_io_executor ex,
       co_return std::unique_ptr<Bus>(std::move(r).value());
     }
     case Kind::cannet: {
-      CanNetOptions o;
-      o.connect_timeout = options.connect_timeout;
-      o.bitrate_kbit = options.bus.bitrate / 1000;
-      o.bus_options = options.bus;
+      const CanNetOptions o = cannet_options(options);
       const net::Endpoint endpoint = spec.endpoint;
       std::vector<int> channels{spec.cannet_channel};
       auto gw = co_await CanNetGateway::connect(ex, endpoint, std::move(channels), o);
@@ -46,6 +68,59 @@ asio::awaitable<Result<std::unique_ptr<Bus>>> open_bus(asio::any_io_executor ex,
     }
   }
   co_return Error(CanErrc::bad_spec, spec.text);
+}
+
+Result<void> check_distinct(const std::vector<BusSpec>& specs) {
+  for (std::size_t i = 0; i < specs.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (same_bus(specs[i], specs[j]))
+        return Error(CanErrc::bad_spec, fmt::format("'{}' is the same bus as '{}' (listed twice)", specs[i].text, specs[j].text));
+  return ok();
+}
+
+asio::awaitable<Result<std::vector<std::unique_ptr<Bus>>>> open_buses(asio::any_io_executor ex,
+                                                                      std::vector<BusSpec> specs, OpenOptions options) {
+  AXON_CO_TRY(check_distinct(specs));
+  // One connection per gateway, with every channel asked of it.
+  std::vector<std::pair<net::Endpoint, std::vector<int>>> gateways;
+  for (const auto& s : specs) {
+    if (s.kind != BusSpec::Kind::cannet) continue;
+    auto it = std::find_if(gateways.begin(), gateways.end(), [&](const auto& g) { return same_endpoint(g.first, s.endpoint); });
+    if (it == gateways.end()) it = gateways.insert(gateways.end(), {s.endpoint, {}});
+    it->second.push_back(s.cannet_channel);
+  }
+  std::vector<std::shared_ptr<CanNetGateway>> connected;
+  std::vector<std::unique_ptr<Bus>> out;
+  auto fail = [&](const BusSpec& spec, const Error& e) {
+    for (auto& b : out) b->close();
+    for (auto& g : connected) g->close();
+    if (e.detail.find(spec.text) != std::string::npos) return e;  // already named
+    return Error(e.code, fmt::format("{}: {}", spec.text, e.detail));
+  };
+  const CanNetOptions cn = cannet_options(options);
+  for (const auto& g : gateways) {
+    const net::Endpoint ep = g.first;
+    std::vector<int> chans = g.second;
+    auto gw = co_await CanNetGateway::connect(ex, ep, std::move(chans), cn);
+    if (!gw) {
+      const auto& spec = *std::find_if(specs.begin(), specs.end(), [&](const BusSpec& s) { return s.kind == BusSpec::Kind::cannet && same_endpoint(s.endpoint, ep); });
+      co_return fail(spec, gw.error());
+    }
+    connected.push_back(std::move(gw).value());
+  }
+  for (const auto& s : specs) {
+    Result<std::unique_ptr<Bus>> bus = Error(CanErrc::bad_spec, s.text);
+    if (s.kind == BusSpec::Kind::cannet) {
+      auto it = std::find_if(connected.begin(), connected.end(), [&](const auto& g) { return same_endpoint(g->endpoint(), s.endpoint); });
+      bus = (*it)->bus(s.cannet_channel);
+    } else {
+      const BusSpec spec = s;
+      bus = co_await open_bus(ex, spec, options);
+    }
+    if (!bus) co_return fail(s, bus.error());
+    out.push_back(std::move(bus).value());
+  }
+  co_return out;
 }
 
 }  // namespace axon::can

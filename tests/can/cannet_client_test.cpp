@@ -2,6 +2,7 @@
 // it drives CAN buses through a CAN@net gateway.
 #include "can/cannet_client.hpp"
 #include "can/cannet_server.hpp"
+#include "can/open.hpp"
 #include "can/virtual_bus.hpp"
 
 #include "can/cannet_harness.hpp"
@@ -271,7 +272,46 @@ TEST(CanNetClient, ANewClientReplacesTheOldOneWhoseBusesClose) {
     CO_ASSERT_TRUE(f);
     EXPECT_EQ(f.value().to_string(), "222#02");
     EXPECT_EQ(b.emulator->stats().replaced, 1u);
+    // The old client is told why, as far as it can know: the gateway closed the connection, which
+    // a CAN@net gateway does when another client takes it over.
+    EXPECT_NE(old_gw.value()->disconnect_reason().detail.find("another client"), std::string::npos)
+        << old_gw.value()->disconnect_reason().detail;
     new_gw.value()->close();
+  });
+}
+
+TEST(CanNetClient, BusesOnOneGatewayOpenedTogetherShareOneConnection) {
+  ClientBench b;
+  run(b.io, [&]() -> asio::awaitable<void> {
+    const auto ep = b.emulator->local_endpoint().to_string();
+    std::vector<BusSpec> specs{parse_bus_spec(fmt::format("cannet://{}/1", ep)).value(),
+                               parse_bus_spec(fmt::format("cannet://{}/2", ep)).value()};
+    auto opened = co_await open_buses(b.io.get_executor(), specs);
+    CO_ASSERT_TRUE(opened);
+    auto& buses = opened.value();
+    CO_ASSERT_TRUE(buses.size() == 2u);
+    EXPECT_EQ(b.emulator->stats().connections, 1u);
+    EXPECT_EQ(b.emulator->stats().replaced, 0u);
+    // Both buses work, each on its own channel.
+    CO_ASSERT_TRUE((co_await buses[0]->send(F("101#01"))).has_value());
+    CO_ASSERT_TRUE((co_await buses[1]->send(F("102#02"))).has_value());
+    auto on0 = co_await b.can0->receive(5s);
+    auto on1 = co_await b.can1->receive(5s);
+    CO_ASSERT_TRUE(on0 && on1);
+    EXPECT_EQ(on0.value().to_string(), "101#01");
+    EXPECT_EQ(on1.value().to_string(), "102#02");
+    CO_ASSERT_TRUE((co_await b.can0->send(F("201#AA"))).has_value());
+    auto back = co_await buses[0]->receive(5s);
+    CO_ASSERT_TRUE(back);
+    EXPECT_EQ(back.value().to_string(), "201#AA");
+    for (auto& bus : buses) bus->close();
+
+    // The same bus twice is refused before anything connects.
+    std::vector<BusSpec> twice{specs[0], specs[0]};
+    auto refused = co_await open_buses(b.io.get_executor(), twice);
+    CO_ASSERT_TRUE(!refused);
+    EXPECT_EQ(refused.error(), CanErrc::bad_spec);
+    EXPECT_EQ(b.emulator->stats().connections, 1u);
   });
 }
 

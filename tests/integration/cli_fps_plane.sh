@@ -81,7 +81,7 @@ set +e
   >"$TMP/coll.out" 2>"$TMP/coll.err"
 rc=$?
 set -e
-[ $rc = 1 ] || fail "a collided move must fail (rc $rc)"
+[ $rc = 4 ] || fail "a collided move must end in a safety stop (rc $rc, expected 4)"
 grep -q '^locked: ' "$TMP/coll.out" || fail "the array did not lock"
 grep -q 'positioner 8: collided' "$TMP/coll.out" || fail "robot 8 not reported collided"
 for id in 1 4 7 10 12; do

@@ -134,6 +134,7 @@ asio::awaitable<Result<DiscoveryReport>> Array::discover(std::map<std::size_t, s
   std::map<std::uint16_t, std::size_t> seen;
   for (const auto& f : found) {
     if (!f.result) {
+      report.failed_buses.push_back(f.bus);
       report.problems.push_back(fmt::format("bus {}: GET_ID broadcast failed: {}", bus_name(f.bus),
                                             f.result.error().message()));
       continue;
@@ -269,7 +270,7 @@ void Array::collision_seen(std::uint16_t positioner, const protocol::PositionerS
 
 void Array::stop_in_background() {
   ++background_;
-  asio::co_spawn(executor_, stop_everyone(), [this](std::exception_ptr) {
+  asio::co_spawn(executor_, stop_everyone(lock_.reason), [this](std::exception_ptr, StopReport) {
     --background_;
     for (auto* w : background_waiters_) w->notify();
   });
@@ -281,24 +282,81 @@ void Array::lock_for(std::string reason) {
   spdlog::error("fps array locked: {}; stopping every robot", lock_.reason);
 }
 
-asio::awaitable<void> Array::stop_everyone() {
+asio::awaitable<StopReport> Array::stop_everyone(std::string reason) {
   ++counters_.emergency_stops;
+  StopReport report;
+  report.reason = std::move(reason);
+  report.buses.resize(buses_.size());
+  for (std::size_t i = 0; i < buses_.size(); ++i) {
+    auto& b = report.buses[i];
+    b.bus = i;
+    b.name = bus_name(i);
+    for (const auto& [id, r] : robots_) {
+      if (r.bus != i) continue;
+      ++b.robots;
+      b.moving += moving_.contains(id) ? 1 : 0;
+    }
+  }
   co_await for_each_concurrently(buses_.size(), [&](std::size_t i) -> asio::awaitable<void> {
     Result<void> r = ok();
     for (unsigned attempt = 0; attempt < std::max(1u, options_.emergency_send_attempts); ++attempt) {
       r = co_await buses_[i].client->broadcast_now(CommandId::trajectory_abort);
-      if (r) co_return;
+      if (r) {
+        report.buses[i].sent = true;
+        co_return;
+      }
       co_await core::sleep_for(10ms);
     }
+    report.buses[i].error = r.error().message();
     const auto msg = fmt::format("bus {}: TRAJECTORY_ABORT not sent: {}", bus_name(i), r.error().message());
     spdlog::error("fps array: {}", msg);
     lock_.stop_errors.push_back(msg);
   });
+  last_stop_ = report;
+  co_return report;
 }
 
-asio::awaitable<void> Array::emergency_stop(std::string reason) {
+asio::awaitable<StopReport> Array::emergency_stop(std::string reason) {
+  if (!lock_.locked) lock_for(reason);
+  auto report = co_await stop_everyone(std::move(reason));
+  co_return report;
+}
+
+void Array::request_stop(std::string reason) {
   if (!lock_.locked) lock_for(std::move(reason));
-  co_await stop_everyone();
+  stop_in_background();
+}
+
+// --- stop reports --------------------------------------------------------------------------------
+
+std::size_t StopReport::robots_reached() const noexcept {
+  std::size_t n = 0;
+  for (const auto& b : buses) n += b.sent ? b.robots : 0;
+  return n;
+}
+
+std::size_t StopReport::moving_reached() const noexcept {
+  std::size_t n = 0;
+  for (const auto& b : buses) n += b.sent ? b.moving : 0;
+  return n;
+}
+
+std::size_t StopReport::buses_sent() const noexcept {
+  return static_cast<std::size_t>(std::count_if(buses.begin(), buses.end(), [](const BusStop& b) { return b.sent; }));
+}
+
+std::string StopReport::to_text() const {
+  std::vector<std::string> parts;
+  for (const auto& b : buses) {
+    if (b.sent) parts.push_back(fmt::format("{} {} robots", b.name, b.robots));
+  }
+  std::string out = fmt::format("{}: stopped {} robots ({} of them moving under this host) with TRAJECTORY_ABORT on {} of {} buses{}{}\n",
+                                reason, robots_reached(), moving_reached(), buses_sent(), buses.size(),
+                                parts.empty() ? "" : ": ", fmt::join(parts, ", "));
+  for (const auto& b : buses) {
+    if (!b.sent) out += fmt::format("  bus {}: NOT stopped ({} robots, {} moving): {}\n", b.name, b.robots, b.moving, b.error);
+  }
+  return out;
 }
 
 asio::awaitable<Result<UnlockReport>> Array::unlock() {
@@ -392,6 +450,9 @@ asio::awaitable<Result<Array::MoveResults>> Array::move_many(std::map<std::uint1
     if (auto g = may_move(id); !g) co_return g.error();
   }
   std::vector<Result<MoveResult>> results(list.size(), Result<MoveResult>(Error(HostErrc::cancelled)));
+  std::vector<std::uint16_t> ids;
+  for (const auto& [id, t] : list) ids.push_back(id);
+  const MovingMark mark(moving_, std::move(ids));
   co_await for_each_concurrently(list.size(), [&](std::size_t i) -> asio::awaitable<void> {
     Positioner* p = find(list[i].first);
     // (no co_await inside ?: : gcc 12 miscompiles it)

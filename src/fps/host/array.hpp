@@ -13,7 +13,11 @@
 // the stop are expected (neighbours hit by the stop, robots noticing late): they are recorded, not
 // treated as new. unlock() sends STOP_TRAJECTORY on every bus, which clears the flags, and only then
 // unlocks. A robot that does not acknowledge a trajectory start makes the array stop every robot
-// (TRAJECTORY_ABORT broadcast on every bus), without locking.
+// (TRAJECTORY_ABORT broadcast on every bus), without locking. An operator's or a program's stop
+// (emergency_stop(), or request_stop() from a signal handler or a watchdog) locks and stops the same
+// way, with its own reason: whatever the host was doing stops with the robots. Every stop leaves a
+// StopReport (last_stop()): the reason and, per bus, whether the abort went out and to how many
+// robots, of which how many this array had set moving.
 //
 // Threading: all buses must live on the same executor (one io_context thread); the array's
 // coroutines run there. Lifetime: `co_await close()` before destroying the array; the buses must
@@ -35,6 +39,8 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <vector>
@@ -51,6 +57,7 @@ struct ArrayOptions {
 struct DiscoveryReport {
   StatusTable table;                  // every robot found, with firmware and status
   std::vector<std::string> problems;  // buses that failed, ids that answered on two buses, ...
+  std::vector<std::size_t> failed_buses;  // buses whose GET_ID broadcast failed (their robots are unknown)
 };
 
 struct Collision {
@@ -66,6 +73,29 @@ struct LockState {
   std::string reason;                   // what locked the array
   std::vector<Collision> collisions;    // the first caused the lock; the rest came after the stop
   std::vector<std::string> stop_errors; // buses where the stop broadcast could not be sent
+};
+
+// One bus of an emergency stop: did the TRAJECTORY_ABORT broadcast go out, and to whom.
+struct BusStop {
+  std::size_t bus = 0;
+  std::string name;
+  std::size_t robots = 0;  // robots the array knows on the bus (the broadcast reaches them all)
+  std::size_t moving = 0;  // of them, robots this array had set moving (a run or a move under way)
+  bool sent = false;
+  std::string error;       // why it was not sent
+};
+
+// What a stop of every robot did (collision, lost connection, operator, signal).
+struct StopReport {
+  std::string reason;
+  std::vector<BusStop> buses;
+
+  [[nodiscard]] std::size_t robots_reached() const noexcept;  // on the buses where the abort went out
+  [[nodiscard]] std::size_t moving_reached() const noexcept;
+  [[nodiscard]] std::size_t buses_sent() const noexcept;
+  // "stopped 12 robots (12 moving) with TRAJECTORY_ABORT on 4 of 4 buses: cannet://h:p/1 3 robots, ...",
+  // plus a line per bus where the abort could not be sent.
+  [[nodiscard]] std::string to_text() const;
 };
 
 struct UnlockReport {
@@ -122,8 +152,17 @@ class Array final : public MotionGate {
   [[nodiscard]] bool locked() const noexcept { return lock_.locked; }
   [[nodiscard]] const LockState& lock_state() const noexcept { return lock_; }
   // Locks the array and stops every robot (TRAJECTORY_ABORT broadcast on every bus at once), as
-  // a collision does. For operators and supervisors.
-  asio::awaitable<void> emergency_stop(std::string reason);
+  // a collision does; `reason` says why in the lock and in every robot's result. For operators and
+  // supervisors. When the array was already locked, the first reason stays and the abort goes out
+  // again.
+  asio::awaitable<StopReport> emergency_stop(std::string reason);
+  // The same without waiting: for signal handlers, watchdogs and other callbacks that cannot
+  // co_await. Runs on the array's executor; close() waits for it; last_stop() has its report.
+  void request_stop(std::string reason);
+  // The report of the latest stop of every robot (none yet: empty).
+  [[nodiscard]] const std::optional<StopReport>& last_stop() const noexcept { return last_stop_; }
+  // Robots this array has set moving and not yet seen finish (trajectory runs, goto moves).
+  [[nodiscard]] const std::set<std::uint16_t>& moving() const noexcept { return moving_; }
   // STOP_TRAJECTORY on every bus (clears collision flags), then unlocks. Stays locked when a
   // stop could not be sent on some bus.
   asio::awaitable<Result<UnlockReport>> unlock();
@@ -182,7 +221,23 @@ class Array final : public MotionGate {
   void on_unsolicited(std::size_t bus, const Unsolicited& u);
   void lock_for(std::string reason);
   void stop_in_background();
-  asio::awaitable<void> stop_everyone();
+  asio::awaitable<StopReport> stop_everyone(std::string reason);
+  // Marks robots moving while it lives (from the start of a run or a move to its end).
+  class MovingMark {
+   public:
+    MovingMark(std::set<std::uint16_t>& moving, std::vector<std::uint16_t> ids) : moving_(&moving), ids_(std::move(ids)) {
+      moving_->insert(ids_.begin(), ids_.end());
+    }
+    ~MovingMark() {
+      for (auto id : ids_) moving_->erase(id);
+    }
+    MovingMark(const MovingMark&) = delete;
+    MovingMark& operator=(const MovingMark&) = delete;
+
+   private:
+    std::set<std::uint16_t>* moving_;
+    std::vector<std::uint16_t> ids_;
+  };
   asio::awaitable<std::vector<BusBroadcast>> broadcast_on(std::vector<std::size_t> buses, protocol::CommandId c,
                                                           BroadcastOptions options = {});
   asio::awaitable<Result<void>> broadcast_checked(protocol::CommandId c);
@@ -197,6 +252,8 @@ class Array final : public MotionGate {
   std::map<std::uint16_t, Robot> robots_;
   LockState lock_;
   ArrayCounters counters_;
+  std::set<std::uint16_t> moving_;
+  std::optional<StopReport> last_stop_;
   std::size_t background_ = 0;  // emergency stops running in the background
   std::vector<core::Wakeup*> background_waiters_;
 };

@@ -2,6 +2,7 @@
 #include "fps/host/array.hpp"
 
 #include "fps/host/concurrent.hpp"
+#include "fps/host/trajectory_speed.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -109,6 +110,16 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
     if (!pos) co_return fail(r, RobotState::not_ready, pos.error().message());
     r.start = pos.value();
     r.target = end_of(*traj[i], pos.value());
+    if (o.speed_limits) {
+      const auto c = check_speed(*traj[i], pos.value(), *o.speed_limits);
+      if (!c.feasible()) {
+        fail(r, RobotState::not_ready,
+             fmt::format("too fast for its speed limit (alpha {:.1f}, beta {:.1f} deg/s): its {:.1f} s trajectory needs "
+                         "at least {:.1f} s",
+                         o.speed_limits->alpha_deg_s, o.speed_limits->beta_deg_s, c.duration_s,
+                         feasible_duration_s(c.shortest_duration_s())));
+      }
+    }
   });
 
   phase_end(rep.timings.check, "checked");
@@ -138,8 +149,9 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
   const bool lock_now = lock_.locked;
   if (!failed.empty() || lock_now) {
     rep.outcome = lock_now ? fmt::format("not started: the array is locked ({})", lock_.reason)
-                           : fmt::format("not started: positioners {} failed validation or upload (see each robot)",
-                                         fmt::join(failed, ", "));
+                           : fmt::format("not started: {} of {} positioners failed the checks or the upload (each "
+                                         "listed once below)",
+                                         failed.size(), n);
     // Drop the trajectories that did load (and partial uploads), so that nothing (a stray sync
     // pulse) can start them; say exactly what each robot holds when the abort did not reach it.
     auto results = co_await broadcast_on(involved, CommandId::trajectory_abort);
@@ -158,10 +170,11 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
       }
       if (r.state == RobotState::loaded) {
         if (acknowledged) {
-          fail(r, RobotState::withdrawn, "loaded, then withdrawn (abort acknowledged): " + rep.outcome);
+          fail(r, RobotState::withdrawn, "loaded, then withdrawn (abort acknowledged): the run was not started");
         } else {
           fail(r, RobotState::still_loaded,
-               fmt::format("still holds its whole trajectory ({} points): {}; {}", traj_points(r), abort_failure, rep.outcome));
+               fmt::format("still holds its whole trajectory ({} points): {}; the run was not started", traj_points(r),
+                           abort_failure));
         }
       } else if (r.state == RobotState::upload_failed && r.upload.stage != UploadResult::Stage::not_sent) {
         r.detail += acknowledged ? "; the partial upload was discarded (abort acknowledged)"
@@ -187,6 +200,9 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
       co_return co_await o.sync_line();
     };
   }
+  std::vector<std::uint16_t> run_ids;
+  for (const auto& r : rep.robots) run_ids.push_back(r.id);
+  const MovingMark moving(moving_, std::move(run_ids));  // from the start to the end of the run
   auto acks = co_await broadcast_on(involved, CommandId::start_trajectory, start);
   std::vector<std::uint16_t> not_acked;
   for (auto& r : rep.robots) {
@@ -207,10 +223,11 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
   }
   if (!not_acked.empty()) {
     ++counters_.start_failures;
-    rep.outcome = fmt::format("start failed: positioners {} did not acknowledge; every robot was stopped",
-                              fmt::join(not_acked, ", "));
+    rep.outcome = fmt::format("start failed: {} of {} positioners did not acknowledge (listed below); every robot was "
+                              "stopped",
+                              not_acked.size(), n);
     spdlog::error("fps array: {}", rep.outcome);
-    co_await stop_everyone();
+    co_await stop_everyone(rep.outcome);
     for (auto& r : rep.robots) {
       if (r.state == RobotState::started) fail(r, RobotState::stopped, "stopped because another robot did not start");
     }
@@ -246,7 +263,8 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
       if (e == HostErrc::collision || reported) {
         co_return fail(r, RobotState::collided, e.message());
       }
-      if (e == HostErrc::locked) co_return fail(r, RobotState::stopped, e.message());
+      // The lock's reason is the run's outcome, said once (not on each of 500 robot lines).
+      if (e == HostErrc::locked) co_return fail(r, RobotState::stopped, "stopped with every robot (see the outcome)");
       co_return fail(r, RobotState::timeout, e.message());
     }
     auto pos = co_await p->read_position();
@@ -260,6 +278,13 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
                                  r.reached->alpha, r.reached->beta, r.target->alpha, r.target->beta, tol));
     }
     r.state = RobotState::completed;
+  });
+  // Robots the host stopped watching before they were seen done may still be moving: stop them.
+  co_await for_each_concurrently(n, [&](std::size_t i) -> asio::awaitable<void> {
+    auto& r = rep.robots[i];
+    if (r.state != RobotState::timeout) co_return;
+    auto aborted = co_await find(r.id)->abort();
+    r.detail += aborted ? "; TRAJECTORY_ABORT sent to it" : fmt::format("; TRAJECTORY_ABORT not sent: {}", aborted.error().message());
   });
   phase_end(rep.timings.move, "finished");
   rep.completed = rep.all(RobotState::completed);

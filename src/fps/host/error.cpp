@@ -12,8 +12,8 @@ class HostCategory final : public std::error_category {
       case HostErrc::cancelled: return "request cancelled because the command client stopped";
       case HostErrc::closed: return "the CAN bus closed; reconnect to the gateway";
       case HostErrc::locked:
-        return "the array is locked after a collision; inspect the robots, then unlock (sends STOP_TRAJECTORY, "
-               "which clears the collision flags)";
+        return "the array is locked and every robot was stopped (the reason comes first); inspect the robots, then "
+               "unlock (sends STOP_TRAJECTORY, which clears any collision flags)";
       case HostErrc::collision: return "a positioner reported a collision; every robot was stopped";
       case HostErrc::unknown_positioner: return "no such positioner on the array's buses; run discovery first";
       case HostErrc::bad_reply: return "a positioner's reply does not fit its command (firmware mismatch or corruption)";

@@ -15,7 +15,7 @@ enum class HostErrc {
   timeout = 1,           // no reply within the command's timeout (after any retries)
   cancelled,             // the client was stopped while the request waited
   closed,                // the bus closed under the client
-  locked,                // the array is locked after a collision: motion refused until unlock()
+  locked,                // the array is locked (collision, lost link, operator or signal): motion refused until unlock()
   collision,             // a robot reported a collision during the operation
   unknown_positioner,    // an id the array has not discovered
   bad_reply,             // a reply whose data does not fit its command (counted, never used)

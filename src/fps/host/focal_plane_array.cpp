@@ -9,6 +9,7 @@
 #include <boost/asio/detached.hpp>
 #include <boost/asio/this_coro.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <set>
@@ -104,19 +105,94 @@ std::optional<std::size_t> FocalPlaneArray::bus_index(const BusRef& ref) const {
 
 asio::awaitable<void> FocalPlaneArray::watch(FocalPlaneArray* self, std::shared_ptr<bool> alive) {
   std::set<std::uint16_t> seen;
-  const auto ex = co_await asio::this_coro::executor;
   while (*alive) {
     co_await core::sleep_for(self->options_.connection_poll);
     if (!*alive || self->closed_) co_return;
     for (const auto& link : self->gateways_) {
       if (link.gateway->is_connected() || seen.contains(link.id)) continue;
       seen.insert(link.id);
-      self->lost_.push_back(link.id);
-      const auto reason = fmt::format("gateway {} at {} disconnected", link.id, link.endpoint.to_string());
-      spdlog::error("fps focal plane: {}: stopping every robot", reason);
-      asio::co_spawn(ex, self->array_->emergency_stop(reason), asio::detached);
+      self->link_lost(link);
     }
   }
+}
+
+void FocalPlaneArray::link_lost(const GatewayLink& link) {
+  lost_.push_back(link.id);
+  const auto reason = fmt::format("gateway {} at {} disconnected ({})", link.id, link.endpoint.to_string(),
+                                  link.gateway->disconnect_reason().detail);
+  spdlog::error("fps focal plane: {}: stopping every robot", reason);
+  array_->request_stop(reason);
+  std::vector<std::uint16_t> behind;
+  std::size_t moving = 0;
+  for (auto b : link.buses) {
+    for (auto id : array_->ids_on(b)) {
+      behind.push_back(id);
+      moving += array_->moving().contains(id) ? 1 : 0;
+    }
+  }
+  if (moving == 0) {
+    link_stops_.push_back(fmt::format("gateway {}: lost; none of its {} robots was moving under this host", link.id,
+                                      behind.size()));
+    return;
+  }
+  if (!options_.reconnect_to_stop) {
+    link_stops_.push_back(fmt::format("gateway {}: lost with {} robots moving behind it: NOT stopped (no reconnection "
+                                      "allowed)", link.id, moving));
+    return;
+  }
+  ++reconnecting_;
+  asio::co_spawn(array_->client(0).bus().get_executor(), stop_behind(link, std::move(behind), moving),
+                 [this](std::exception_ptr) { --reconnecting_; });
+}
+
+// One reconnection to a lost gateway, a TRAJECTORY_ABORT broadcast on each of its channels
+// (acknowledgements collected briefly), and the connection closed again.
+asio::awaitable<void> FocalPlaneArray::stop_behind(GatewayLink link, std::vector<std::uint16_t> robots, std::size_t moving) {
+  const auto ex = co_await asio::this_coro::executor;
+  std::vector<int> channels;
+  for (auto b : link.buses) channels.push_back(refs_[b].channel);
+  can::CanNetOptions o = options_.gateway;
+  o.connect_timeout = options_.reconnect_timeout;
+  o.reply_timeout = options_.reconnect_timeout;
+  const net::Endpoint ep = link.endpoint;
+  spdlog::warn("fps focal plane: gateway {}: {} robots were moving behind it; reconnecting once to stop them", link.id, moving);
+  auto gw = co_await can::CanNetGateway::connect(ex, ep, channels, o);
+  if (!gw) {
+    link_stops_.push_back(fmt::format("gateway {}: {} robots were moving behind it: NOT stopped, the reconnection "
+                                      "failed: {}", link.id, moving, gw.error().message()));
+    spdlog::error("fps focal plane: {}", link_stops_.back());
+    co_return;
+  }
+  std::size_t acked = 0;
+  std::vector<std::string> failures;
+  for (auto b : link.buses) {
+    const int ch = refs_[b].channel;
+    const auto ids = array_->ids_on(b);
+    const std::set<std::uint16_t> expected(ids.begin(), ids.end());
+    auto bus = gw.value()->bus(ch);
+    if (!bus) {
+      failures.push_back(bus.error().message());
+      continue;
+    }
+    CommandClient client(*bus.value());
+    BroadcastOptions bo;
+    bo.expected_ids = expected;
+    bo.window = options_.reconnect_window;
+    auto r = co_await client.broadcast(protocol::CommandId::trajectory_abort, {}, bo);
+    if (r) {
+      for (const auto& reply : r.value().replies) acked += expected.contains(reply.positioner) ? 1 : 0;
+    } else {
+      failures.push_back(r.error().message());
+    }
+    co_await client.stop();
+    bus.value()->close();
+  }
+  gw.value()->close();
+  link_stops_.push_back(fmt::format("gateway {}: reconnected once and sent TRAJECTORY_ABORT on channel(s) {}: {} of {} "
+                                    "robots acknowledged ({} had been moving){}{}",
+                                    link.id, fmt::join(channels, ", "), acked, robots.size(), moving,
+                                    failures.empty() ? "" : "; failed: ", fmt::join(failures, "; ")));
+  spdlog::warn("fps focal plane: {}", link_stops_.back());
 }
 
 asio::awaitable<LayoutCheck> FocalPlaneArray::check_layout() {
@@ -152,6 +228,7 @@ asio::awaitable<void> FocalPlaneArray::close() {
   if (closed_) co_return;
   closed_ = true;
   *alive_ = false;
+  while (reconnecting_ > 0) co_await core::sleep_for(10ms);
   co_await array_->close();
   for (auto& b : buses_) b->close();
   for (auto& l : gateways_)

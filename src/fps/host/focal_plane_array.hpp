@@ -12,8 +12,17 @@
 //
 // Faults: the array already stops every bus on a collision anywhere. Here, besides, a gateway
 // whose connection drops stops everything too (TRAJECTORY_ABORT broadcast on every bus still
-// reachable, array locked, the reason naming the gateway): a watch checks the connections every
-// `connection_poll`.
+// reachable, array locked, the reason naming the gateway and why its connection ended): a watch
+// checks the connections every `connection_poll`.
+//
+// The robots behind the lost gateway cannot hear that stop. When some of them were moving under
+// this host, it reconnects to that gateway once (reconnect_to_stop) and broadcasts TRAJECTORY_ABORT
+// on its channels, then closes again. Why: their neighbours behind the other gateways have just been
+// stopped, and paths planned to be collision-free together are no longer so when half the plane
+// stops and the other half follows its trajectories to the end. The price is that a client that
+// took the gateway over (a CAN@net NT serves one client at a time) loses its connection for that
+// moment; stopping moving robots comes first. Only once: a gateway that cannot be reached again is
+// reported (link_stops()), not retried.
 #pragma once
 
 #include "can/cannet_client.hpp"
@@ -42,6 +51,10 @@ struct FocalPlaneArrayOptions {
   core::Duration connection_poll = 20ms;    // how often the gateway connections are checked
   // Replaces the layout's gateway addresses (e.g. emulators on other ports), by gateway id.
   std::map<std::uint16_t, net::Endpoint> addresses;
+  // A lost gateway behind which robots were moving: reconnect once to stop them (see above).
+  bool reconnect_to_stop = true;
+  core::Duration reconnect_timeout = 1s;    // connect and set-up of that one reconnection
+  core::Duration reconnect_window = 300ms;  // collecting the robots' acknowledgements of the abort
 };
 
 struct GatewayLink {
@@ -82,6 +95,9 @@ class FocalPlaneArray {
 
   // Gateways whose connection dropped (by id), in the order noticed.
   [[nodiscard]] const std::vector<std::uint16_t>& lost_gateways() const noexcept { return lost_; }
+  // What was done for the robots behind each lost gateway (one line each): the stop sent through
+  // a reconnection, or why they could not be stopped.
+  [[nodiscard]] const std::vector<std::string>& link_stops() const noexcept { return link_stops_; }
 
   // Stops the watch, closes the array and every gateway connection.
   asio::awaitable<void> close();
@@ -89,6 +105,8 @@ class FocalPlaneArray {
  private:
   FocalPlaneArray(const FocalPlane& plane, FocalPlaneArrayOptions options);
   static asio::awaitable<void> watch(FocalPlaneArray* self, std::shared_ptr<bool> alive);
+  void link_lost(const GatewayLink& link);
+  asio::awaitable<void> stop_behind(GatewayLink link, std::vector<std::uint16_t> robots, std::size_t moving);
 
   FocalPlane plane_;
   FocalPlaneArrayOptions options_;
@@ -98,6 +116,8 @@ class FocalPlaneArray {
   std::unique_ptr<Array> array_;
   std::unique_ptr<plc::AsyncPlc> plc_;
   std::vector<std::uint16_t> lost_;
+  std::vector<std::string> link_stops_;
+  std::size_t reconnecting_ = 0;  // stop_behind() coroutines running
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
   bool closed_ = false;
 };

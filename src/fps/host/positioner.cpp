@@ -328,7 +328,7 @@ asio::awaitable<Result<MoveResult>> Positioner::move(ArmAngles value, bool relat
     }
     return seen_moving || core::steady_now() - started >= eta_d;
   };
-  auto st = co_await wait_for(done, eta_d + options_.move_margin, relative ? "relative move" : "absolute move");
+  auto st = co_await watch_motion(done, eta_d + options_.move_margin, relative ? "relative move" : "absolute move");
   if (!st) co_return st.error();
   auto reached = co_await read_position();
   if (!reached) co_return reached.error();
@@ -377,7 +377,20 @@ asio::awaitable<Result<PositionerStatus>> Positioner::run_step(CommandId c, core
                                                                std::string what) {
   if (auto g = check_gate(); !g) co_return g.error();
   if (auto r = co_await simple(c); !r) co_return r.error();
-  co_return co_await wait_for(std::move(done), timeout, std::move(what));
+  co_return co_await watch_motion(std::move(done), timeout, std::move(what));
+}
+
+asio::awaitable<Result<PositionerStatus>> Positioner::watch_motion(std::function<bool(const PositionerStatus&)> done,
+                                                                   core::Duration timeout, std::string what) {
+  auto st = co_await wait_for(std::move(done), timeout, std::move(what));
+  // Given up on (no end in time, no status replies, the bus lost): the robot may still be moving,
+  // so it is stopped rather than left unwatched. A collision or a lock has stopped it already.
+  if (!st && st.error() != HostErrc::collision && st.error() != HostErrc::locked) {
+    if (auto aborted = co_await abort(); !aborted)
+      co_return Error(st.error().code, fmt::format("{}; TRAJECTORY_ABORT not sent: {}", st.error().detail, aborted.error().message()));
+    co_return Error(st.error().code, fmt::format("{}; TRAJECTORY_ABORT sent to it", st.error().detail));
+  }
+  co_return st;
 }
 
 asio::awaitable<Result<PositionerStatus>> Positioner::go_to_datums(Arm arm) {

@@ -10,7 +10,9 @@
 // PositionerOptions::poll_interval until the flags the interface document names show the step
 // finished (DISPLACEMENT_COMPLETED plus the step's own flags), a collision flag appears, the gate
 // closes, or the step's timeout passes. Moves then read the position back and check it against the
-// target within PositionerOptions::position_tolerance (0.1 deg, as hosts in service do).
+// target within PositionerOptions::position_tolerance (0.1 deg, as hosts in service do). A move,
+// datum search or calibration the host gives up on (timeout, no status replies, bus lost) gets a
+// TRAJECTORY_ABORT, so that no robot keeps moving unwatched; the error says whether it went out.
 #pragma once
 
 #include "core/error.hpp"
@@ -192,6 +194,9 @@ class Positioner {
   Result<void> check_gate() const;
   asio::awaitable<Result<void>> simple(protocol::CommandId c);
   asio::awaitable<Result<MoveResult>> move(ArmAngles value, bool relative);
+  // wait_for a step the robot runs; stops the robot when the host gives up on it.
+  asio::awaitable<Result<protocol::PositionerStatus>> watch_motion(std::function<bool(const protocol::PositionerStatus&)> done,
+                                                                   core::Duration timeout, std::string what);
   asio::awaitable<Result<protocol::PositionerStatus>> run_step(protocol::CommandId c, core::Duration timeout,
                                                                std::function<bool(const protocol::PositionerStatus&)> done,
                                                                std::string what);

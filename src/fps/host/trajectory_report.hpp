@@ -3,6 +3,7 @@
 #pragma once
 
 #include "fps/host/positioner.hpp"
+#include "fps/plan/planner.hpp"
 
 #include <boost/asio/awaitable.hpp>
 
@@ -60,6 +61,10 @@ struct TrajectoryOptions {
   // Starts with the sync line instead of a START_TRAJECTORY broadcast: called once every bus
   // listens for the acknowledgements (uid 0). Must drive the line high long enough (about 0.5 s).
   std::function<asio::awaitable<Result<void>>()> sync_line;
+  // When given, a robot whose trajectory drives an arm faster than this (from where it stands) is
+  // not ready, with the duration it would need (trajectory_speed.hpp): nothing is uploaded, instead
+  // of every too-fast point being refused by the robot.
+  std::optional<plan::SpeedLimits> speed_limits;
   // Called as each phase ends ("checked": robots checked, "uploaded": every upload done,
   // "started": start acknowledged, "finished": every robot done), e.g. for timings and progress.
   std::function<void(std::string_view phase)> on_phase;
