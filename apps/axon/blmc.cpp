@@ -125,13 +125,17 @@ bool emit(const json& j) { return emit(j.dump()); }
 json pair_json(const bh::MotorPair& p) { return json::array({p.motor1, p.motor2}); }
 
 json status_json(const bp::Status& s) {
-  return json{{"type", "status"},         {"system_enabled", s.system_enabled}, {"motor1_enabled", s.motor1_enabled},
+  return json{{"system_enabled", s.system_enabled}, {"motor1_enabled", s.motor1_enabled},
               {"motor1_ready", s.motor1_ready}, {"motor2_enabled", s.motor2_enabled}, {"motor2_ready", s.motor2_ready},
               {"error", std::string(bp::name(s.error))}, {"byte", s.to_byte()}};
 }
 
 bool print_status(const bp::Status& s) {
-  if (opts().json) return emit(status_json(s));
+  if (opts().json) {
+    auto j = status_json(s);
+    j["type"] = "status";
+    return emit(j);
+  }
   return emit(fmt::format("{}  (byte 0x{:02X})", s.to_string(), s.to_byte()));
 }
 
