@@ -8,6 +8,8 @@
 # among them, which used to leave the board enabled) are usage errors said in words, before
 # anything is sent.
 source "$(dirname "$0")/lib.sh"
+# The control cases run with a stale limit of 0.5 s: a loaded machine must not end them in a safety
+# stop before the exit path under test.
 # Alignment takes 6 s on this board: long enough to interrupt an enable in the middle of it.
 printf 'alignment_s: 6\n' >"$TMP/board.yaml"
 "$AXON" sim blmc --socketcand 127.0.0.1:0 --config "$TMP/board.yaml" >"$TMP/sim.out" 2>"$TMP/sim.err" &
@@ -72,7 +74,7 @@ end_case 1
 grep -q 'not ready' "$TMP/failed_enable.err" || fail "no reason given: $(cat "$TMP/failed_enable.err")"
 
 # ---- a signal during the alignment ends the enable at once (the alignment would take 6 s).
-start_case enable_interrupted current 1 0.3 --duration 5
+start_case enable_interrupted --stale-ms 500 current 1 0.3 --duration 5
 wait_bus '000#0000000100000003$'  # ENABLE_MTR2=1 went out: the alignment runs
 kill -INT "$CASE_PID"
 end_case 130
@@ -86,7 +88,7 @@ blmc enable >/dev/null 2>"$TMP/enable.err" || fail "enable failed: $(cat "$TMP/e
 CASE=broken_pipe
 MARK=$(wc -l <"$TMP/bus.out")
 set +e
-timeout 30 "$AXON" blmc --bus "$BUS" --no-realtime current 1 0.3 --duration 60 2>"$TMP/pipe.err" | head -1 >/dev/null
+timeout 30 "$AXON" blmc --bus "$BUS" --no-realtime --stale-ms 500 current 1 0.3 --duration 60 2>"$TMP/pipe.err" | head -1 >/dev/null
 rc=${PIPESTATUS[0]}
 set -e
 [ "$rc" = 1 ] || fail "broken pipe: exited $rc, expected 1: $(cat "$TMP/pipe.err")"
@@ -95,7 +97,7 @@ board_is_off
 
 # ---- SIGINT, SIGTERM, SIGHUP during control: 128+N after the disable.
 for sig in INT TERM HUP; do
-  start_case "sig$sig" current 1 0.3 --duration 60
+  start_case "sig$sig" --stale-ms 500 current 1 0.3 --duration 60
   wait_rows "$TMP/sig$sig.out"
   kill -s "$sig" "$CASE_PID"
   case $sig in INT) want=130 ;; TERM) want=143 ;; HUP) want=129 ;; esac
@@ -106,7 +108,7 @@ done
 # ---- a second SIGINT stops the event loop at once (rows every 2 s: it comes before the first
 # signal is acted on). At zero current the board's receive timeout never arms: only the host's
 # disable, over a new connection, turns it off.
-start_case double_sigint --refresh 0.5 current 1 0 --duration 60
+start_case double_sigint --stale-ms 500 --refresh 0.5 current 1 0 --duration 60
 wait_rows "$TMP/double_sigint.out"
 kill -INT "$CASE_PID"
 sleep 0.3

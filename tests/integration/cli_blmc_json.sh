@@ -29,7 +29,7 @@ assert len(lines) == 1 and lines[0]["type"] == "status", lines
 s = lines[0]
 assert s["system_enabled"] is False and s["error"] == "NONE" and s["byte"] == 0, s'
 
-blmc pd --amplitude 0.2 --frequency 1 --duration 2 >"$TMP/pd.out" 2>"$TMP/pd.err" || fail "pd failed: $(cat "$TMP/pd.err")"
+blmc --stale-ms 500 pd --amplitude 0.2 --frequency 1 --duration 2 >"$TMP/pd.out" 2>"$TMP/pd.err" || fail "pd failed: $(cat "$TMP/pd.err")"
 check_json "$TMP/pd.out" '
 samples = [l for l in lines if l["type"] == "sample"]
 assert len(samples) >= 5, len(samples)
@@ -63,7 +63,7 @@ blmc monitor --duration 0.5 >"$TMP/monitor.out" 2>"$TMP/monitor.err" || fail "mo
 check_json "$TMP/monitor.out" 'assert lines and all(l["type"] == "sample" for l in lines), lines'
 
 # Without --json: the table, then the tracking lines.
-"$AXON" blmc --socketcand "127.0.0.1:$PORT/can0" --no-realtime pd --duration 1 >"$TMP/pd.txt" 2>/dev/null \
+"$AXON" blmc --socketcand "127.0.0.1:$PORT/can0" --no-realtime --stale-ms 500 pd --duration 1 >"$TMP/pd.txt" 2>/dev/null \
   || fail "pd (text) failed"
 head -1 "$TMP/pd.txt" | grep -q '^ *t\[s\] |' || fail "no table header: $(head -1 "$TMP/pd.txt")"
 grep -q '^motor 1: tracking error rms' "$TMP/pd.txt" || fail "no tracking line: $(tail -2 "$TMP/pd.txt")"
