@@ -440,15 +440,18 @@ asio::awaitable<int> cmd_monitor(Session& s) {
 // `enable` hands the board on enabled (that is what it is for); a failed or interrupted enable is
 // disabled again.
 asio::awaitable<int> cmd_enable(Session& s) {
+  g_motors_may_be_on = true;  // until handed on or disabled
   auto r = co_await s.board->enable();
   if (!r) {
     if (r.error() != bh::HostErrc::interrupted) spdlog::error("blmc: enable: {}", r.error().message());
     auto d = co_await s.board->disable();
     if (d) spdlog::info("blmc: board disabled, currents zero");
     else spdlog::error("blmc: could not disable the board: {}", d.error().message());
+    g_motors_may_be_on = false;
     co_return exit_code_value::failed;
   }
   s.board->leave_enabled();
+  g_motors_may_be_on = false;
   co_return print_status(s.board->latest().status.value) ? exit_code_value::ok : exit_code_value::failed;
 }
 

@@ -117,6 +117,12 @@ end_case 130
 grep -q 'disabling the board over a new connection' "$TMP/double_sigint.err" \
   || fail "double SIGINT: $(cat "$TMP/double_sigint.err")"
 
+# ---- monitor runs until Ctrl-C: that is its normal end (exit 0); it never enabled anything.
+start_case monitor monitor
+wait_for_line "$TMP/monitor.out" '^ +[0-9.]+ \|' >/dev/null
+kill -INT "$CASE_PID"
+end_case 0
+
 # ---- bad values are usage errors in words (exit 2), and nothing reaches the board.
 expect_usage() {
   local want=$1
