@@ -10,6 +10,7 @@
 #include "can/cannet_server.hpp"
 #include "can/socketcand_server.hpp"
 #include "can/virtual_bus.hpp"
+#include "checks.hpp"
 #include "commands.hpp"
 #include "core/config.hpp"
 #include "fps/sim/focal_plane_sim.hpp"
@@ -225,7 +226,7 @@ int run_sim_fps(const SimFpsOptions& o) {
 
 struct SimBlmcOptions {
   unsigned boards = 1;
-  std::string socketcand;
+  std::string socketcand = "127.0.0.1:29536";  // loopback, socketcand's usual port
   std::string config;
   std::string fault_plan;
   double duration_s = 0;
@@ -258,7 +259,6 @@ std::vector<blmc::sim::BoardFaultPlan> load_blmc_fault_plans(const std::string& 
 }
 
 int run_sim_blmc(const SimBlmcOptions& o) {
-  if (o.socketcand.empty()) throw Exception(Error(CoreErrc::invalid_argument, "give --socketcand HOST:PORT"));
   blmc::sim::BoardConfig config;
   if (!o.config.empty()) config = need(blmc::sim::BoardConfig::from_config(need(core::ConfigNode::load_file(o.config))));
   const auto plans = load_blmc_fault_plans(o.fault_plan, o.boards);
@@ -288,8 +288,9 @@ int run_sim_blmc(const SimBlmcOptions& o) {
     for (std::size_t i = 0; i < runner.size(); ++i) {
       const auto& b = runner.board(i);
       const auto& s = b.stats();
-      spdlog::info("sim: {}: status {}; {} frames in ({} malformed, {} ignored), {} out; bus load {:.1f} %", channels[i],
-                   b.status().to_string(), s.frames_received, s.malformed, s.ignored, s.frames_sent,
+      spdlog::info("sim: {}: status {}; IqRef {:g} {:g} A; {} frames in ({} malformed, {} ignored), {} out; bus load {:.1f} %",
+                   channels[i], b.status().to_string(), b.motor_state(0).iq_ref_a, b.motor_state(1).iq_ref_a,
+                   s.frames_received, s.malformed, s.ignored, s.frames_sent,
                    100.0 * registry.find(channels[i])->load(std::chrono::steady_clock::now()));
     }
     const auto& rs = runner.stats();
@@ -344,10 +345,10 @@ void add_sim_commands(CLI::App& app, GlobalOptions&) {
   static SimBlmcOptions blmc;
   auto* b = sim_cmd->add_subcommand("blmc", "simulated blmc motor driver boards, one per bus (can0, can1 ...)");
   b->add_option("--boards", blmc.boards, "number of boards (default 1)")->check(CLI::Range(1u, 64u));
-  b->add_option("--socketcand", blmc.socketcand, "serve socketcand on HOST:PORT (port 0: any)")->required();
+  b->add_option("--socketcand", blmc.socketcand, "serve socketcand on HOST:PORT (default 127.0.0.1:29536; port 0: any)");
   b->add_option("--config", blmc.config, "board/motor parameters YAML (docs/blmc-simulator.md)");
   b->add_option("--fault-plan", blmc.fault_plan, "fault plan YAML (docs/blmc-simulator.md)");
-  b->add_option("--duration", blmc.duration_s, "stop after this many seconds (default: until Ctrl-C)");
+  b->add_option("--duration", blmc.duration_s, "stop after this many seconds (default: until Ctrl-C)")->check(non_negative());
   b->callback([] { exit_code() = run_sim_blmc(blmc); });
 
   add_sim_c4g_command(*sim_cmd);

@@ -57,6 +57,12 @@ asio::awaitable<void> read_loop(std::shared_ptr<Board::Shared> shared, can::Bus*
   }
 }
 
+// IqRef=0, ENABLE_MTR1=0, ENABLE_MTR2=0, ENABLE_SYS=0: how every shutdown path leaves a board.
+std::vector<can::Frame> disable_frames() {
+  return {must(protocol::encode_iq_ref({})), flag_frame(CommandCode::enable_mtr1, false),
+          flag_frame(CommandCode::enable_mtr2, false), flag_frame(CommandCode::enable_sys, false)};
+}
+
 asio::awaitable<void> send_all(can::Bus* bus, std::vector<can::Frame> frames) {
   for (const auto& f : frames) {
     auto r = co_await bus->send(f);
@@ -118,12 +124,17 @@ Board::~Board() {
     boost::system::error_code ec;
     shared_->bell->cancel(ec);
   }
-  if (motors_on_ && !closed_ && bus_->is_open()) {
-    std::vector<can::Frame> frames{must(protocol::encode_iq_ref({})), flag_frame(CommandCode::enable_mtr1, false),
-                                   flag_frame(CommandCode::enable_mtr2, false),
-                                   flag_frame(CommandCode::enable_sys, false)};
-    asio::co_spawn(bus_->get_executor(), send_all(bus_, std::move(frames)), asio::detached);
-  }
+  if (motors_on_) queue_disable();
+}
+
+void Board::queue_disable() {
+  if (closed_ || !bus_->is_open()) return;
+  asio::co_spawn(bus_->get_executor(), send_all(bus_, disable_frames()), asio::detached);
+}
+
+void Board::interrupt() noexcept {
+  interrupted_ = true;
+  wake_.notify();
 }
 
 void Board::frame_hook(const can::Frame& f) {
@@ -172,6 +183,7 @@ asio::awaitable<Result<void>> Board::wait_until(core::TimePoint deadline, const 
   for (;;) {
     if (done()) co_return ok();
     if (closed_) co_return Error(HostErrc::closed, options_.name);
+    if (interrupted_) co_return Error(HostErrc::interrupted, options_.name);
     if (clock_->now() >= deadline) co_return Error(HostErrc::timeout, options_.name);
     wake_.reset();
     // The clock may be a test's manual clock: wait on the real timer in short slices.
@@ -252,6 +264,7 @@ asio::awaitable<Result<void>> Board::set_recv_timeout(std::uint32_t ms) {
 }
 
 asio::awaitable<Result<void>> Board::enable() {
+  if (interrupted_) co_return Error(HostErrc::interrupted, fmt::format("{}: enable", options_.name));
   auto r0 = co_await send_currents({});
   if (!r0) co_return r0;
   const auto sys = Command::flag(CommandCode::enable_sys, true).value();
@@ -289,16 +302,17 @@ asio::awaitable<Result<void>> Board::recover() {
 }
 
 asio::awaitable<Result<void>> Board::disable() {
-  auto r0 = co_await send_currents({});
-  if (!r0) co_return r0;
-  const CommandCode codes[] = {CommandCode::enable_mtr1, CommandCode::enable_mtr2, CommandCode::enable_sys};
-  for (auto code : codes) {
-    const auto c = Command::flag(code, false).value();
-    auto r = co_await command(c);
-    if (!r) co_return r;
+  Result<void> first = ok();
+  if (cyclic_) {
+    auto r = co_await stop_cyclic();
+    if (!r) first = r;
   }
-  motors_on_ = false;
-  co_return ok();
+  for (const auto& f : disable_frames()) {
+    auto r = co_await send_frame(f);
+    if (!r && first) first = r;
+  }
+  if (first) motors_on_ = false;
+  co_return first;
 }
 
 // ---- cyclic mode --------------------------------------------------------------------------------

@@ -14,10 +14,16 @@
 //    After that thread stopped, co_await stop_cyclic() sends the frames still queued and takes
 //    the state back. Coroutine calls made in between fail with HostErrc::cyclic_active.
 //
-// Shutdown: disable() zeroes the currents and disables the motors and the system. A Board
+// Shutdown: disable() zeroes the currents and disables the motors and the system, from any mode
+// (in cyclic mode it ends cyclic mode first) and trying every frame even when one fails. A Board
 // destroyed while it had the motors enabled queues the same frames on the bus's executor (best
 // effort: the bus must outlive that, as it must outlive the Board); the board's own receive
-// timeout is the backstop when the host disappears.
+// timeout is the backstop when the host disappears. MotorSession (motor_session.hpp) makes the
+// disable happen on every way out of a program's work with the motors.
+//
+// Stop requests: interrupt() (from a signal handler's callback on the bus's executor) makes the
+// wait in progress and every later one return HostErrc::interrupted, so that an enable() waiting
+// seconds for the alignment ends at once and the caller can disable. clear_interrupt() undoes it.
 //
 // Only one coroutine may wait on a board at a time (wait_* and the sequences that use them).
 #pragma once
@@ -117,8 +123,19 @@ class Board {
   asio::awaitable<Result<void>> set_recv_timeout(std::uint32_t ms);
   // The documented recovery after an error: ENABLE_SYS=1, IqRef=0, ENABLE_MTRx=1, wait_ready.
   asio::awaitable<Result<void>> recover();
-  // IqRef=0, ENABLE_MTR1=0, ENABLE_MTR2=0, ENABLE_SYS=0.
+  // IqRef=0, ENABLE_MTR1=0, ENABLE_MTR2=0, ENABLE_SYS=0. In cyclic mode it first ends it
+  // (stop_cyclic: the real-time thread must have stopped using port()). Every frame is tried even
+  // when one fails; the first failure is returned.
   asio::awaitable<Result<void>> disable();
+  // The same frames queued on the bus's executor without waiting (destructors, abandoned work).
+  void queue_disable();
+  // The program hands the board on enabled on purpose (`axon blmc enable`): the destructor does
+  // not disable it.
+  void leave_enabled() noexcept { motors_on_ = false; }
+  // See "Stop requests" above.
+  void interrupt() noexcept;
+  void clear_interrupt() noexcept { interrupted_ = false; }
+  [[nodiscard]] bool interrupted() const noexcept { return interrupted_; }
   // The state decoded so far (coroutine mode; in cyclic mode port().latest() is current).
   [[nodiscard]] const Measurements& latest() const noexcept { return state_; }
 
@@ -153,6 +170,7 @@ class Board {
   bool pump_running_ = false;
   bool closed_ = false;
   bool motors_on_ = false;  // we enabled motors and did not disable them yet
+  bool interrupted_ = false;
 };
 
 }  // namespace axon::blmc::host

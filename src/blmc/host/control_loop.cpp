@@ -40,7 +40,10 @@ ControlLoop::ControlLoop(std::vector<CyclicPort*> ports, Controller& controller,
                           fmt::format("control loop: {} safety limits for {} boards", limits.size(), ports_.size())));
   if (options_.period <= core::Duration{0})
     throw Exception(Error(HostErrc::invalid_argument, "control loop: period must be positive"));
-  for (auto& l : limits) safety_.emplace_back(l);
+  for (auto& l : limits) {
+    if (auto v = l.validate(); !v) throw Exception(v.error());
+    safety_.emplace_back(l);
+  }
   inputs_.resize(ports_.size());
   requests_.resize(ports_.size());
   trigger_seen_.resize(ports_.size());
@@ -113,12 +116,16 @@ void ControlLoop::step(core::TimePoint deadline, core::TimePoint now) noexcept {
   }
   if (trip) {
     // Stop everything: zero current and disable the motors of every board, then publish.
-    for (auto* p : ports_) p->send_disable();
+    for (std::size_t i = 0; i < n; ++i) disable_queued_[i] = ports_[i]->send_disable();
     halted_ = true;
     status_at_trip_ = inputs_[fault_.board].status.count;
     faulted_.store(true, std::memory_order_release);
   } else {
-    for (std::size_t i = 0; i < n; ++i) ports_[i]->send_currents(halted_ ? MotorPair{} : requests_[i]);
+    for (std::size_t i = 0; i < n; ++i) {
+      // A disable that found the link full is queued again until it goes in whole.
+      if (halted_ && !disable_queued_[i]) disable_queued_[i] = ports_[i]->send_disable();
+      else ports_[i]->send_currents(halted_ ? MotorPair{} : requests_[i]);
+    }
   }
 
   CycleRecord rec;
@@ -201,6 +208,10 @@ void ControlLoop::run() noexcept {
       if (answered || now - fault_.fault.at >= options_.fault_grace) break;
     }
   }
+  // Stopped on request: the last reference every board gets from this loop is zero current (the
+  // caller disables next; until then the board must not keep the controller's last value).
+  if (!halted_)
+    for (auto* p : ports_) p->send_currents({});
   running_.store(false, std::memory_order_release);
 }
 

@@ -10,9 +10,12 @@
 //   5. push a CycleRecord into a preallocated lock-free queue for logging and monitoring.
 //
 // Nothing in the cycle allocates, locks, throws or logs. On a fault in any board every board gets
-// zero current and ENABLE_MTRx=0 in that same cycle, the fault is published (fault()) and the
-// loop ends (or keeps sending zeros if LoopOptions::stop_on_fault is false). The caller reports
-// it off the real-time thread: fault()->fault.describe() names the board's error code.
+// zero current and ENABLE_MTRx=0 in that same cycle (queued again in later cycles if the link was
+// full), the fault is published (fault()) and the loop ends (or keeps sending zeros if
+// LoopOptions::stop_on_fault is false). The caller reports it off the real-time thread:
+// fault()->fault.describe() names the board's error code. A loop stopped on request queues zero
+// current to every board as its last frame; disabling the boards is the caller's next step
+// (MotorSession does it on every way out).
 //
 // Pacing. Pacing::clock wakes at absolute deadlines (clock_nanosleep, TIMER_ABSTIME) and skips
 // deadlines it missed (counted). Pacing::measurements starts a cycle as soon as every board
@@ -116,7 +119,8 @@ struct LoopFault {
 class ControlLoop {
  public:
   // One SafetyLimits per port (or one for all). Throws axon::Exception (HostErrc::invalid_argument)
-  // for no ports, more than kMaxBoards, or a limits count that fits neither.
+  // for no ports, more than kMaxBoards, a limits count that fits neither, limits that fail
+  // SafetyLimits::validate(), or a period that is not > 0.
   ControlLoop(std::vector<CyclicPort*> ports, Controller& controller, std::vector<SafetyLimits> limits,
               LoopOptions options = {}, const core::Clock& clock = core::SteadyClock::instance());
   ~ControlLoop();  // stops and joins
@@ -175,6 +179,7 @@ class ControlLoop {
   core::TimePoint prev_start_{};
   bool started_controller_ = false;
   bool halted_ = false;  // a fault zeroed everything
+  std::array<bool, kMaxBoards> disable_queued_{};  // the fault's disable frames went into the link
   std::uint64_t status_at_trip_ = 0;
 };
 

@@ -20,6 +20,7 @@ class HostCategory final : public std::error_category {
       case HostErrc::closed: return "the CAN bus closed under the board";
       case HostErrc::invalid_argument: return "invalid argument";
       case HostErrc::homing_failed: return "homing found no encoder index; check the encoder and the homing range";
+      case HostErrc::interrupted: return "stopped on request while waiting for the board";
     }
     return "unknown blmc host error";
   }

@@ -18,6 +18,7 @@ enum class HostErrc {
   closed,            // the bus closed under the board
   invalid_argument,  // a bad option or input from the caller
   homing_failed,     // no encoder index found within the homing range or time
+  interrupted,       // a stop was requested (Board::interrupt) while waiting for the board
 };
 
 const std::error_category& host_category() noexcept;

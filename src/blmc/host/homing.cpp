@@ -1,5 +1,9 @@
 #include "blmc/host/homing.hpp"
 
+#include "blmc/host/error.hpp"
+
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -15,8 +19,23 @@ const char* to_string(MotorHoming::State s) noexcept {
   return "?";
 }
 
+namespace {
+void check_homing(const HomingOptions& o) {
+  auto bad = [](const char* what, double v) {
+    throw Exception(Error(HostErrc::invalid_argument, fmt::format("homing: {}, got {}", what, v)));
+  };
+  if (!std::isfinite(o.speed_rev_s) || o.speed_rev_s == 0) bad("speed must not be 0 (its sign gives the direction)", o.speed_rev_s);
+  if (!std::isfinite(o.kp) || o.kp <= 0) bad("kp must be > 0", o.kp);
+  if (!std::isfinite(o.kd) || o.kd < 0) bad("kd must be >= 0", o.kd);
+  if (!std::isfinite(o.max_current_a) || o.max_current_a <= 0) bad("current limit must be > 0 A", o.max_current_a);
+  if (!std::isfinite(o.max_travel_rev) || o.max_travel_rev <= 0) bad("travel must be > 0 rev", o.max_travel_rev);
+}
+}  // namespace
+
 HomingController::HomingController(std::size_t boards, HomingOptions options)
-    : options_(options), motors_(boards * 2), index_seen_(boards * 2, 0) {}
+    : options_(options), motors_(boards * 2), index_seen_(boards * 2, 0) {
+  check_homing(options_);
+}
 
 bool HomingController::all_found() const noexcept {
   return std::all_of(motors_.begin(), motors_.end(), [](const MotorHoming& m) {

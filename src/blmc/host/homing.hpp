@@ -35,6 +35,8 @@ const char* to_string(MotorHoming::State s) noexcept;
 
 class HomingController final : public Controller {
  public:
+  // Throws axon::Exception (HostErrc::invalid_argument, in words) unless the speed is finite and
+  // not 0, kp, the current limit and the travel are > 0 and kd is >= 0.
   HomingController(std::size_t boards, HomingOptions options);
 
   void start(const ControlInput& in) noexcept override;

@@ -1,5 +1,9 @@
 #include "blmc/host/pd_controller.hpp"
 
+#include "blmc/host/error.hpp"
+
+#include <fmt/format.h>
+
 #include <cmath>
 #include <numbers>
 
@@ -10,7 +14,18 @@ double TrackingStats::rms_rev() const noexcept {
 }
 
 PdController::PdController(std::size_t boards, PdGains gains, std::array<PdTarget, 2> targets, core::Duration settle)
-    : gains_(gains), targets_(targets), settle_(settle), start_(boards * 2, 0.0), stats_(boards * 2) {}
+    : gains_(gains), targets_(targets), settle_(settle), start_(boards * 2, 0.0), stats_(boards * 2) {
+  auto check = [](const char* what, double v) {
+    if (!std::isfinite(v) || v < 0)
+      throw Exception(Error(HostErrc::invalid_argument, fmt::format("pd: {} must be >= 0, got {}", what, v)));
+  };
+  check("kp", gains_.kp);
+  check("kd", gains_.kd);
+  for (const auto& t : targets_) {
+    check("amplitude", t.amplitude_rev);
+    check("frequency", t.frequency_hz);
+  }
+}
 
 void PdController::start(const ControlInput& in) noexcept {
   t0_ = in.now;

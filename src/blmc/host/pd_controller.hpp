@@ -37,7 +37,9 @@ struct TrackingStats {
 
 class PdController final : public Controller {
  public:
-  // One gains/target pair per motor, the same for every board.
+  // One gains/target pair per motor, the same for every board. Throws axon::Exception
+  // (HostErrc::invalid_argument, in words) for gains, amplitudes or frequencies that are negative
+  // or not finite (a negative gain pushes the motor away from its target).
   PdController(std::size_t boards, PdGains gains, std::array<PdTarget, 2> targets,
                core::Duration settle = std::chrono::milliseconds(500));
 

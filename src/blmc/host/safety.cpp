@@ -1,5 +1,7 @@
 #include "blmc/host/safety.hpp"
 
+#include "blmc/host/error.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -36,6 +38,22 @@ std::string Fault::describe() const {
     case FaultKind::bad_command: return fmt::format("controller asked motor {} for a non-finite current", motor + 1);
   }
   return "?";
+}
+
+Result<void> SafetyLimits::validate() const {
+  auto bad = [](std::string text) { return Error(HostErrc::invalid_argument, "safety limits: " + std::move(text)); };
+  if (!std::isfinite(max_current_a) || max_current_a <= 0)
+    return bad(fmt::format("max current must be > 0 A, got {}", max_current_a));
+  if (!std::isfinite(max_velocity_krpm) || max_velocity_krpm <= 0)
+    return bad(fmt::format("max velocity must be > 0 krpm, got {}", max_velocity_krpm));
+  if (stale_after <= core::Duration::zero() || status_stale_after <= core::Duration::zero())
+    return bad("stale limits must be > 0");
+  for (std::size_t i = 0; i < position.size(); ++i) {
+    const auto& p = position[i];
+    if (p.enabled && !(std::isfinite(p.min_rev) && std::isfinite(p.max_rev) && p.min_rev < p.max_rev))
+      return bad(fmt::format("motor {} position limit needs min < max, got {} .. {}", i + 1, p.min_rev, p.max_rev));
+  }
+  return ok();
 }
 
 void Safety::arm(core::TimePoint now) noexcept { armed_ = now; }

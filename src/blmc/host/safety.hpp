@@ -18,6 +18,7 @@
 #include "blmc/host/measurements.hpp"
 #include "blmc/protocol/status.hpp"
 #include "core/clock.hpp"
+#include "core/error.hpp"
 
 #include <array>
 #include <chrono>
@@ -42,6 +43,10 @@ struct SafetyLimits {
   core::Duration stale_after = 10ms;       // current, position, velocity (and ADC if checked)
   core::Duration status_stale_after = 2500ms;  // the board sends status once per second
   bool check_adc = false;                  // ADC frames are optional for control
+
+  // HostErrc::invalid_argument, in words, for a current or velocity limit that is not a finite
+  // number > 0, a stale limit that is not > 0, or an enabled position limit with min >= max.
+  [[nodiscard]] Result<void> validate() const;
 };
 
 enum class FaultKind : std::uint8_t {

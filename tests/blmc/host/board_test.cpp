@@ -189,6 +189,64 @@ TEST(BlmcBoard, DestroyedWhileEnabledDisablesTheMotors) {
                                       "COMMAND ENABLE_SYS=0"}));
 }
 
+// disable() is the way out of every path, cyclic mode included (the real-time thread stopped but
+// stop_cyclic() was never reached, e.g. an exception): it ends cyclic mode and sends the sequence.
+TEST(BlmcBoard, DisableInCyclicModeEndsItAndDisables) {
+  Rig rig;
+  EnablingPeer peer;
+  rig.script = std::ref(peer);
+  rig.run([&]() -> asio::awaitable<void> {
+    BoardOptions o;
+    o.recv_timeout_ms = 0;
+    Board board(*rig.host, o);
+    auto r = co_await board.enable();
+    CO_ASSERT(r);
+    auto c = co_await board.start_cyclic();
+    CO_ASSERT(c);
+    EXPECT_TRUE(board.port().send_currents({0.5, 0.5}));
+    co_await eventually([&] { return rig.received.size() >= 7; });
+    auto d = co_await board.disable();
+    EXPECT_TRUE(d) << (d ? "" : d.error().message());
+    EXPECT_FALSE(board.cyclic());
+    co_await eventually([&] { return !peer.st.system_enabled; });
+  });
+  const auto t = texts(rig.received);
+  ASSERT_GE(t.size(), 4u);
+  EXPECT_EQ(std::vector<std::string>(t.end() - 4, t.end()),
+            (std::vector<std::string>{"IQ_REF m1=0 m2=0", "COMMAND ENABLE_MTR1=0", "COMMAND ENABLE_MTR2=0",
+                                      "COMMAND ENABLE_SYS=0"}));
+  EXPECT_FALSE(peer.st.motor1_enabled || peer.st.motor2_enabled);
+}
+
+TEST(BlmcBoard, InterruptEndsTheWaitAndRefusesANewEnable) {
+  Rig rig;
+  EnablingPeer peer;
+  peer.become_ready = false;  // the enable would wait for the whole ready timeout
+  rig.script = std::ref(peer);
+  rig.run([&]() -> asio::awaitable<void> {
+    BoardOptions o;
+    o.ready_timeout = 30s;
+    Board board(*rig.host, o);
+    asio::co_spawn(
+        rig.io,
+        [&]() -> asio::awaitable<void> {
+          co_await eventually([&] { return peer.st.motor2_enabled; });
+          board.interrupt();
+        },
+        asio::detached);
+    auto r = co_await board.enable();
+    CO_ASSERT(!r);
+    EXPECT_EQ(r.error(), HostErrc::interrupted);
+    const auto before = rig.received.size();
+    auto again = co_await board.enable();
+    EXPECT_EQ(again.error(), HostErrc::interrupted);
+    EXPECT_EQ(rig.received.size(), before) << "an interrupted board sends no enable";
+    auto d = co_await board.disable();  // the way out still works
+    EXPECT_TRUE(d);
+    co_await eventually([&] { return !peer.st.system_enabled; });
+  });
+}
+
 TEST(BlmcBoard, CyclicModeSetsTheReceiveTimeoutAndExchangesFramesThroughThePort) {
   Rig rig;
   core::ManualClock clock;

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <thread>
 
 namespace axon::blmc::host {
@@ -145,6 +146,94 @@ TEST(BlmcControlLoop, RejectsBadConfiguration) {
   CyclicPort p(4);
   EXPECT_THROW(ControlLoop({}, ctl, {SafetyLimits{}}), Exception);
   EXPECT_THROW(ControlLoop({&p}, ctl, {SafetyLimits{}, SafetyLimits{}, SafetyLimits{}}), Exception);
+}
+
+// Negative or zero limits would make the clamp undefined (lo > hi) or let no current through;
+// both are refused with words when the loop is built.
+TEST(BlmcControlLoop, RejectsLimitsThatAreNotPositive) {
+  Constant ctl;
+  CyclicPort p(4);
+  auto refused = [&](SafetyLimits lim) -> std::string {
+    try {
+      ControlLoop loop({&p}, ctl, {lim});
+    } catch (const Exception& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  SafetyLimits a;
+  a.max_current_a = -1;
+  EXPECT_NE(refused(a).find("max current must be > 0 A, got -1"), std::string::npos) << refused(a);
+  SafetyLimits b;
+  b.max_velocity_krpm = 0;
+  EXPECT_NE(refused(b).find("max velocity must be > 0"), std::string::npos) << refused(b);
+  SafetyLimits c;
+  c.stale_after = -1ms;
+  EXPECT_NE(refused(c).find("stale limits must be > 0"), std::string::npos) << refused(c);
+  SafetyLimits d;
+  d.position[1] = {true, 1.0, -1.0};
+  EXPECT_NE(refused(d).find("motor 2 position limit"), std::string::npos) << refused(d);
+  SafetyLimits e;
+  e.max_current_a = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(refused(e).find("max current"), std::string::npos) << refused(e);
+}
+
+// A disable that finds the link to the bus full is queued again in the next cycles, not lost.
+TEST(BlmcControlLoop, FaultDisableIsRetriedWhenTheLinkWasFull) {
+  core::ManualClock clock;
+  CyclicPort port(5);
+  Constant ctl;
+  ctl.value = {1, 1};
+  ControlLoop loop({&port}, ctl, {SafetyLimits{}}, {}, clock);
+  feed(port, {status_frame(true, true, true, true, true)});
+  feed_data(port);
+  for (int i = 0; i < 3; ++i) {
+    loop.step(clock.now(), clock.now());  // three IqRef frames wait in the link (room for 5)
+    clock.advance(1ms);
+  }
+  feed(port, {status_frame(false, false, true, false, true, protocol::ErrorCode::encoder)});
+  loop.step(clock.now(), clock.now());  // trips: only part of the disable fits
+  ASSERT_TRUE(loop.faulted());
+  drain(port);
+  clock.advance(1ms);
+  loop.step(clock.now(), clock.now());
+  const auto t = drain(port);
+  ASSERT_EQ(t.size(), 3u);
+  EXPECT_EQ(protocol::decode_pair(MessageId::iq_ref, t[0]).value(), (MotorPair{0, 0}));
+  EXPECT_EQ(protocol::decode_command(t[1]).value().to_string(), "ENABLE_MTR1=0");
+  EXPECT_EQ(protocol::decode_command(t[2]).value().to_string(), "ENABLE_MTR2=0");
+  clock.advance(1ms);
+  loop.step(clock.now(), clock.now());  // then zero current as before
+  const auto z = drain(port);
+  ASSERT_EQ(z.size(), 1u);
+  EXPECT_EQ(protocol::decode_pair(MessageId::iq_ref, z[0]).value(), (MotorPair{0, 0}));
+}
+
+// Stopped on request, the loop's last frame is zero current: the board must not keep the
+// controller's last value while the caller gets round to disabling it.
+TEST(BlmcControlLoop, StopOnRequestEndsWithZeroCurrent) {
+  CyclicPort port(4096);
+  Constant ctl;
+  ctl.value = {0.5, -0.5};
+  SafetyLimits lim;
+  lim.stale_after = std::chrono::hours(1);
+  lim.status_stale_after = std::chrono::hours(1);
+  LoopOptions opt;
+  opt.realtime = false;
+  ControlLoop loop({&port}, ctl, {lim}, opt);
+  ASSERT_TRUE(loop.start());
+  std::vector<can::Frame> sent;
+  for (int i = 0; i < 5000 && sent.size() < 5; ++i) {
+    can::Frame f;
+    while (port.link().take(f)) sent.push_back(f);
+    std::this_thread::sleep_for(1ms);
+  }
+  loop.stop();
+  can::Frame f;
+  while (port.link().take(f)) sent.push_back(f);
+  ASSERT_GE(sent.size(), 6u);
+  EXPECT_EQ(protocol::decode_pair(MessageId::iq_ref, sent.front()).value(), (MotorPair{0.5, -0.5}));
+  EXPECT_EQ(protocol::decode_pair(MessageId::iq_ref, sent.back()).value(), (MotorPair{0, 0}));
 }
 
 TEST(BlmcControlLoop, ThreadRunsTheControllerAndStops) {
