@@ -3,6 +3,7 @@
 // tracking error, the loop's timing and the board's state after the motors were disabled.
 #include "blmc/host/board.hpp"
 #include "blmc/host/control_loop.hpp"
+#include "blmc/host/motor_session.hpp"
 #include "blmc/host/pd_controller.hpp"
 #include "blmc/sim/runner.hpp"
 #include "can/virtual_bus.hpp"
@@ -65,30 +66,28 @@ asio::awaitable<int> demo_blmc(asio::any_io_executor ex, std::function<void(std:
   bh::Board board(*bus);
   fmt::print("1. simulated board on the virtual bus can0 (motor physics, alignment, receive timeout)\n");
 
-  auto e = co_await board.enable();
-  need(std::move(e));
-  fmt::print("2. enabled and aligned; PD control of both motors (kp 10 A/rev, kd 0.1 A/(rev/s)), a {:g} rev {:g} Hz sine, {:g} s\n",
+  fmt::print("2. enable and align, then PD control of both motors (kp 10 A/rev, kd 0.1 A/(rev/s)), a {:g} rev {:g} Hz sine, {:g} s\n",
              kAmplitudeRev, kFrequencyHz, kRunS);
   bh::PdTarget sine{true, kAmplitudeRev, kFrequencyHz, 0.0};
   bh::PdController pd(1, {10.0, 0.1}, {sine, sine}, 300ms);
   bh::LoopStats st;
-  std::optional<bh::LoopFault> fault;
-  std::exception_ptr failure;
   bool stop = false;
-  set_on_signal([&stop] { stop = true; });
-  try {
-    fault = co_await run_pd(board, pd, st, stop);
-  } catch (...) {
-    failure = std::current_exception();
-  }
-  auto off = co_await board.disable();  // whatever happened above
+  set_on_signal([&stop, &board] {
+    stop = true;
+    board.interrupt();  // ends a wait for the alignment at once
+  });
+  // Every way out of the body (its end, a fault, an exception, a failed enable) leaves the motors
+  // with zero current and disabled: the library's MotorSession.
+  auto run = co_await bh::with_motors_enabled<std::optional<bh::LoopFault>>(
+      board, [&]() -> asio::awaitable<std::optional<bh::LoopFault>> { co_return co_await run_pd(board, pd, st, stop); });
   set_on_signal([] {});
   co_await core::sleep_for(50ms);
   const auto status = board_sim->status();
   runner.stop();
   bus->close();
-  if (failure) std::rethrow_exception(failure);
-  need(std::move(off));
+  need(std::move(run.enable));
+  need(std::move(run.disable));
+  const std::optional<bh::LoopFault> fault = run.value ? *run.value : std::nullopt;
 
   fmt::print("\n3. result\n");
   for (int k = 0; k < 2; ++k) {
