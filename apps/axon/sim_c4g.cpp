@@ -7,6 +7,7 @@
 #include "c4g/sim/scenario.hpp"
 #include "c4g/sim/udp_client.hpp"
 #include "checks.hpp"
+#include "exit_codes.hpp"
 #include "commands.hpp"
 #include "net/endpoint.hpp"
 #include "run.hpp"
@@ -92,14 +93,16 @@ int run_sim_c4g(const SimC4gOptions& o) {
   const bool completed = controller.scenario_done() || (controller.scenario_running_forever() && report.stopped);
   int rc = 0;
   std::string outcome = "completed";
+  // The exit-code scheme of every command (exit_codes.hpp): the controller's communication error
+  // is its safety reaction (drives off): 4; a scenario that failed or did not finish: 1.
   if (controller.communication_error()) {
-    rc = 1;
+    rc = exit_code_value::safety_stop;
     outcome = "communication error";
   } else if (controller.scenario_failed()) {
-    rc = 2;
+    rc = exit_code_value::failed;
     outcome = "scenario error: " + controller.scenario_error();
   } else if (!completed) {
-    rc = 2;
+    rc = exit_code_value::failed;
     outcome = "scenario incomplete";
   }
   const auto& h = report.rtt;

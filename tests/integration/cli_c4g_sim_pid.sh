@@ -56,7 +56,7 @@ run_sim_c4g "steps:
   - go_open: {type: B, mode: 2, arms: [1]}
   - move: {arm: 1, deg: [5, 0, 0, 0, 0, 0], duration: 0.3}
   - exit_open"
-[ "$SIM_RC" = 2 ] || fail "move during the switch: simulator exit code $SIM_RC (expected 2)"
+[ "$SIM_RC" = 1 ] || fail "move during the switch: simulator exit code $SIM_RC (expected 1: scenario error)"
 grep -q "SCS_ROBOT_MOVED" "$TMP/sim.err" || fail "move during the switch: no SCS_ROBOT_MOVED"
 kill "$SERVE_PID" 2>/dev/null; wait "$SERVE_PID" 2>/dev/null || true
 echo ok

@@ -60,7 +60,7 @@ assert summary['rtt_us']['count'] > 100, summary['rtt_us']
 assert any(e['name'] == 'DRIVES_ON' for e in summary['events']), summary['events']
 
 p = run(['--duration', '10'], silent_after_init=True)
-assert p.returncode == 1, (p.returncode, p.stdout, p.stderr)
+assert p.returncode == 4, (p.returncode, p.stdout, p.stderr)  # the controller's safety reaction (drives off)
 assert 'ERR_C4GOPEN_UDP' in p.stderr, p.stderr
 assert 'communication error' in p.stdout, p.stdout
 
@@ -68,7 +68,7 @@ with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
     f.write('steps:\n  - drive_on\n  - go_open: {type: A, mode: 3}\n')
 try:
     p = run(['--scenario', f.name])
-    assert p.returncode != 0, (p.returncode, p.stdout, p.stderr)
+    assert p.returncode == 2, (p.returncode, p.stdout, p.stderr)  # a bad scenario file: usage error
     assert '%s:3:30' % f.name in p.stderr, p.stderr
 finally:
     os.unlink(f.name)
