@@ -17,6 +17,7 @@
 #include "c4g/protocol/axis_map.hpp"
 #include "c4g/protocol/init_packet.hpp"
 #include "checks.hpp"
+#include "rotation_options.hpp"
 #include "commands.hpp"
 #include "net/endpoint.hpp"
 #include "run.hpp"
@@ -83,6 +84,7 @@ struct ServeOptions {
   // server
   std::string numbering = "same";
   std::string pcap;
+  RotationArgs pcap_rotation, csv_rotation;
   int rt_priority = 0;
   std::vector<int> cpus;
   bool busy_poll = false;
@@ -289,6 +291,7 @@ host::ServerOptions server_options(const ServeOptions& o) {
   else if (o.numbering == "next") so.numbering = protocol::ReplyNumbering::next;
   else throw bad("--numbering must be same or next");
   so.pcap_path = o.pcap;
+  so.pcap.rotation = o.pcap_rotation.limits();
   so.soft_switch = {o.switch_t1_ms * 1e-3, o.switch_t2_ms * 1e-3, o.switch_t3_ms * 1e-3};
   so.cycle.realtime.fifo_priority = o.rt_priority;
   so.cycle.realtime.lock_memory = o.rt_priority > 0;
@@ -323,13 +326,23 @@ void print_report(const ServeOptions& o, const host::Server& server, const apps:
            {"safety_fault", std::string(host::to_string(server.safety().reason()))},
            {"currents_clamped", server.safety().counters().currents_clamped.load()},
            {"timing", timing_json(server)}};
-    if (csv) j["csv_rows"] = csv->rows();
-    if (server.recorder()) j["pcap_written"] = server.recorder()->written();
+    if (csv) {
+      j["csv_rows"] = csv->rows();
+      j["csv_rotations"] = csv->rotations();
+      j["csv_write_errors"] = csv->write_errors();
+    }
+    if (server.recorder()) {
+      j["pcap_written"] = server.recorder()->written();
+      j["pcap_rotations"] = server.recorder()->rotations();
+      j["pcap_write_failures"] = server.recorder()->write_failures();
+    }
     std::printf("%s\n", j.dump(2).c_str());
   } else {
     std::printf("stopped: %s\n%s%s", why.c_str(), server.summary().c_str(), app.summary().c_str());
-    if (csv) std::printf("CSV %s: %llu rows (moni type %d)\n", csv->path().c_str(), static_cast<unsigned long long>(csv->rows()),
-                         o.moni < 0 ? 0 : o.moni);
+    if (csv)
+      std::printf("CSV %s: %llu rows (moni type %d), %llu rotations, %llu write errors\n", csv->path().c_str(),
+                  static_cast<unsigned long long>(csv->rows()), o.moni < 0 ? 0 : o.moni,
+                  static_cast<unsigned long long>(csv->rotations()), static_cast<unsigned long long>(csv->write_errors()));
     if (app.has_error()) std::printf("error: %s\n", app.error().c_str());
   }
   std::fflush(stdout);
@@ -384,7 +397,7 @@ int run_serve(const ServeOptions& o) {
 
   std::unique_ptr<apps::MoniCsvWriter> csv;
   if (!o.csv.empty()) {
-    csv = need(apps::MoniCsvWriter::open(o.csv, o.moni < 0 ? 0 : o.moni));
+    csv = need(apps::MoniCsvWriter::open(o.csv, o.moni < 0 ? 0 : o.moni, o.csv_rotation.limits()));
     app->record_samples(8192);
   } else if (o.moni >= 0) {
     throw bad("--moni needs --csv FILE");
@@ -597,8 +610,10 @@ void add_c4g_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("--switch-t3-ms", so.switch_t3_ms, "the controller's soft switching T3 [ms] (default 50)")->check(CLI::Range(0.0, 60000.0));
   s->add_option("--moni", so.moni, "with --csv: monitoring view 19..24 of the manual (default 0: every field)");
   s->add_option("--csv", so.csv, "write every cycle to this CSV file");
+  add_rotation_options(s, so.csv_rotation, "csv", "--csv");
   s->add_option("--numbering", so.numbering, "reply number: same (the manual) or next (NUM + 1)");
   s->add_option("--pcap", so.pcap, "record every datagram into this pcap file");
+  add_rotation_options(s, so.pcap_rotation, "pcap", "--pcap");
   s->add_option("--rt-priority", so.rt_priority, "SCHED_FIFO priority of the cycle thread (and mlockall)")->check(CLI::Range(0, 99));
   s->add_option("--cpu", so.cpus, "pin the cycle thread to this CPU (repeatable)");
   s->add_flag("--busy-poll", so.busy_poll, "spin on the socket instead of sleeping (a dedicated core)");

@@ -7,6 +7,7 @@
 #include "can/socketcand_server.hpp"
 #include "can/virtual_bus.hpp"
 #include "checks.hpp"
+#include "rotation_options.hpp"
 #include "commands.hpp"
 #include "core/clock.hpp"
 #include "run.hpp"
@@ -48,9 +49,7 @@ struct DumpOptions {
   std::uint64_t count = 0;
   double timeout_s = 0;
   bool quiet_frames = false;
-  std::uint64_t log_max_bytes = 0;
-  double log_max_seconds = 0;
-  unsigned log_keep = 10;
+  RotationArgs rotation;
 };
 
 int run_dump(const DumpOptions& o) {
@@ -63,13 +62,7 @@ int run_dump(const DumpOptions& o) {
     auto bus = need(std::move(r1));
     bus->set_filters(filters);
     std::optional<can::CandumpWriter> log;
-    if (!o.log.empty()) {
-      core::RotationLimits limits;
-      limits.max_bytes = o.log_max_bytes;
-      limits.max_age = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.log_max_seconds));
-      limits.keep = o.log_keep;
-      log.emplace(need(can::CandumpWriter::create(o.log, limits)));
-    }
+    if (!o.log.empty()) log.emplace(need(can::CandumpWriter::create(o.log, o.rotation.limits())));
     set_on_signal([&] {
       signal_is_normal_end().store(true);  // a dump runs until Ctrl-C: that is its normal end
       bus->close();
@@ -343,19 +336,9 @@ void add_can_commands(CLI::App& app, GlobalOptions&) {
   d->add_option("-l,--log", dump.log, "also write a candump log file");
   d->add_option("-f,--filter", dump.filters, "receive filter ID:MASK in hex (repeatable; any match passes)");
   d->add_option("-n,--count", dump.count, "stop after this many frames");
-  d->add_option("-t,--timeout", dump.timeout_s, "seconds; with --count: fail (exit 3) if not reached, else run this long");
+  d->add_option("-t,--timeout", dump.timeout_s, "seconds; with --count: fail (exit 1) if not reached, else run this long");
   d->add_flag("--no-print", dump.quiet_frames, "do not print frames (log only)");
-  d->add_option("--log-max-size", dump.log_max_bytes,
-                "rotate the log before it passes this size (bytes; k, M, G suffixes): the full file becomes "
-                "FILE.1, the older ones FILE.2 ...")
-      ->transform(CLI::AsSizeValue(false))
-      ->needs("--log");
-  d->add_option("--log-max-seconds", dump.log_max_seconds, "rotate the log once it is this many seconds old")
-      ->check(CLI::PositiveNumber)
-      ->needs("--log");
-  d->add_option("--log-keep", dump.log_keep, "rotated files kept, FILE.1 .. FILE.N (default 10; older ones are deleted)")
-      ->check(CLI::Range(1u, 100000u))
-      ->needs("--log");
+  add_rotation_options(d, dump.rotation, "log", "--log");
   d->callback([] { exit_code() = run_dump(dump); });
 
   static SendOptions send;

@@ -52,19 +52,30 @@ Result<void> RotatingFile::open_file(bool append, TimePoint now) {
   return ok();
 }
 
-Result<void> RotatingFile::rotate(TimePoint now) {
-  file_.reset();
+Result<void> RotatingFile::shift(const fs::path& path, unsigned keep) {
   std::error_code ec;
-  fs::remove(rotated_name(path_, limits_.keep), ec);
-  for (unsigned k = limits_.keep; k > 1; --k) {
-    const auto from = rotated_name(path_, k - 1);
-    if (fs::exists(from, ec)) fs::rename(from, rotated_name(path_, k), ec);
+  fs::remove(rotated_name(path, keep), ec);
+  for (unsigned k = keep; k > 1; --k) {
+    const auto from = rotated_name(path, k - 1);
+    if (fs::exists(from, ec)) fs::rename(from, rotated_name(path, k), ec);
     if (ec) return Error(CoreErrc::io, fmt::format("rotating {}: {}", from.string(), ec.message()));
   }
-  fs::rename(path_, rotated_name(path_, 1), ec);
-  if (ec) return Error(CoreErrc::io, fmt::format("rotating {}: {}", path_.string(), ec.message()));
+  fs::rename(path, rotated_name(path, 1), ec);
+  if (ec) return Error(CoreErrc::io, fmt::format("rotating {}: {}", path.string(), ec.message()));
+  return ok();
+}
+
+Result<void> RotatingFile::rotate(TimePoint now) {
+  file_.reset();
+  AXON_TRY(shift(path_, limits_.keep));
   ++rotations_;
   return open_file(false, now);
+}
+
+Result<void> RotatingFile::set_header(std::string header) {
+  header_ = std::move(header);
+  if (size_ != 0 || !file_) return ok();
+  return put(header_);
 }
 
 Result<void> RotatingFile::put(std::string_view bytes) {

@@ -54,8 +54,15 @@ class RotatingFile {
   [[nodiscard]] const std::filesystem::path& path() const noexcept { return path_; }
   [[nodiscard]] std::uint64_t size() const noexcept { return size_; }            // of the current file
   [[nodiscard]] std::uint64_t rotations() const noexcept { return rotations_; }
+  // The header of every file from now on (a CSV title line known only once the first row is); it
+  // is written at once when the current file holds nothing yet.
+  Result<void> set_header(std::string header);
+
   // NAME.k, the k-th older file (k >= 1).
   [[nodiscard]] static std::filesystem::path rotated_name(const std::filesystem::path& path, unsigned k);
+  // Moves NAME to NAME.1, NAME.1 to NAME.2, ... and deletes NAME.<keep>: the renaming of a rotation,
+  // for writers that keep their own file handle (a libpcap dumper). CoreErrc::io naming the file.
+  static Result<void> shift(const std::filesystem::path& path, unsigned keep);
 
  private:
   RotatingFile(std::filesystem::path path, RotationLimits limits, std::string header);

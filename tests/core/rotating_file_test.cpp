@@ -119,5 +119,38 @@ TEST(RotatingFile, RefusesKeepZeroAndUnwritablePaths) {
   EXPECT_EQ(RotatingFile::open(d.dir / "missing" / "log", {}, t0).error(), CoreErrc::io);
 }
 
+
+// A writer with its own file handle (a libpcap dumper) renames with shift(): NAME -> NAME.1 ->
+// NAME.2, the oldest beyond `keep` deleted.
+TEST(RotatingFile, ShiftRenamesTheChainAndDropsTheOldest) {
+  TempDir t;
+  const auto name = t.dir / "cap.pcap";
+  for (const char* text : {"first", "second", "third"}) {
+    std::ofstream(name) << text;
+    ASSERT_TRUE(RotatingFile::shift(name, 2));
+  }
+  EXPECT_FALSE(fs::exists(name));
+  EXPECT_EQ(read(RotatingFile::rotated_name(name, 1)), "third");
+  EXPECT_EQ(read(RotatingFile::rotated_name(name, 2)), "second");
+  EXPECT_FALSE(fs::exists(RotatingFile::rotated_name(name, 3)));
+}
+
+// A CSV's title line is known only with the first row: set_header() writes it into the empty file
+// and starts every later file with it.
+TEST(RotatingFile, HeaderSetLaterStartsTheEmptyFileAndEveryRotatedOne) {
+  TempDir t;
+  const auto name = t.dir / "run.csv";
+  RotationLimits lim;
+  lim.max_bytes = 12;
+  auto f = RotatingFile::open(name, lim, t0).value();
+  ASSERT_TRUE(f.set_header("h\n"));
+  ASSERT_TRUE(f.write("row1\n", t0));
+  ASSERT_TRUE(f.write("row2\n", t0));  // 2 + 5 + 5 = 12: fits
+  ASSERT_TRUE(f.write("row3\n", t0));  // would pass 12: rotates
+  ASSERT_TRUE(f.flush());
+  EXPECT_EQ(read(RotatingFile::rotated_name(name, 1)), "h\nrow1\nrow2\n");
+  EXPECT_EQ(read(name), "h\nrow3\n");
+}
+
 }  // namespace
 }  // namespace axon::core

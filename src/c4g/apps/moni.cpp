@@ -1,6 +1,7 @@
 #include "c4g/apps/moni.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <cerrno>
 #include <cstring>
@@ -85,41 +86,38 @@ void append_moni_row(std::string& out, int type, std::uint64_t cycle, double tim
   out += '\n';
 }
 
-Result<std::unique_ptr<MoniCsvWriter>> MoniCsvWriter::open(const std::string& path, int type) {
+Result<std::unique_ptr<MoniCsvWriter>> MoniCsvWriter::open(const std::string& path, int type, core::RotationLimits rotation) {
   if (!is_moni_type(type))
     return Error(CoreErrc::invalid_argument, fmt::format("moni type {} unknown (19..24, or 0 for every field)", type));
   std::unique_ptr<MoniCsvWriter> w(new MoniCsvWriter());
-  w->file_ = std::fopen(path.c_str(), "w");
-  if (!w->file_) return Error(CoreErrc::invalid_argument, fmt::format("cannot write {}: {}", path, std::strerror(errno)));
+  auto f = core::RotatingFile::open(path, rotation, core::steady_now());
+  if (!f) return Error(CoreErrc::invalid_argument, f.error().detail);
+  w->file_.emplace(std::move(f).value());
   w->path_ = path;
   w->type_ = type;
   return w;
 }
 
-MoniCsvWriter::~MoniCsvWriter() {
-  if (file_) {
-    flush();
-    std::fclose(file_);
-  }
-}
+MoniCsvWriter::~MoniCsvWriter() { flush(); }
 
 void MoniCsvWriter::write(std::uint64_t cycle, std::int64_t wall_ns, const protocol::Packet& c4g, const protocol::Packet& pc) {
   if (rows_ == 0) {
     axes_ = c4g.count;
     t0_ = wall_ns;
-    buffer_ += moni_header(type_, axes_);
+    line_.clear();
+    line_ += moni_header(type_, axes_);
+    (void)file_->set_header(line_);
   }
   if (c4g.count != axes_) return;  // another configuration (restart): keep the file rectangular
-  append_moni_row(buffer_, type_, cycle, static_cast<double>(wall_ns - t0_) * 1e-9, c4g, pc);
+  line_.clear();
+  append_moni_row(line_, type_, cycle, static_cast<double>(wall_ns - t0_) * 1e-9, c4g, pc);
   ++rows_;
-  if (buffer_.size() > (1u << 16)) flush();
+  if (auto r = file_->write(line_, core::steady_now()); !r && write_errors_++ == 0)
+    spdlog::error("csv {}: {} (further errors only counted)", path_, r.error().detail);
 }
 
 void MoniCsvWriter::flush() {
-  if (!file_ || buffer_.empty()) return;
-  std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
-  std::fflush(file_);
-  buffer_.clear();
+  if (file_) (void)file_->flush();
 }
 
 }  // namespace axon::c4g::apps

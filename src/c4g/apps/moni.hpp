@@ -23,11 +23,13 @@
 
 #include "c4g/protocol/packet.hpp"
 #include "core/error.hpp"
+#include "core/rotating_file.hpp"
 
 #include <array>
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -52,26 +54,33 @@ void append_moni_row(std::string& out, int type, std::uint64_t cycle, double tim
 // Writes rows to a file; the header goes out with the first row (when the axis count is known).
 class MoniCsvWriter {
  public:
-  static Result<std::unique_ptr<MoniCsvWriter>> open(const std::string& path, int type);
+  // `rotation`: a size or age limit (none by default): the full file becomes PATH.1, and every
+  // file starts with the title line (core::RotatingFile).
+  static Result<std::unique_ptr<MoniCsvWriter>> open(const std::string& path, int type, core::RotationLimits rotation = {});
   ~MoniCsvWriter();
   MoniCsvWriter(const MoniCsvWriter&) = delete;
   MoniCsvWriter& operator=(const MoniCsvWriter&) = delete;
 
+  // Not for the cycle thread (it formats and may rotate the file). A failed write is counted and
+  // logged once.
   void write(std::uint64_t cycle, std::int64_t wall_ns, const protocol::Packet& from_controller,
              const protocol::Packet& from_pc);
   void flush();
   [[nodiscard]] std::uint64_t rows() const noexcept { return rows_; }
+  [[nodiscard]] std::uint64_t write_errors() const noexcept { return write_errors_; }
+  [[nodiscard]] std::uint64_t rotations() const noexcept { return file_ ? file_->rotations() : 0; }
   [[nodiscard]] const std::string& path() const noexcept { return path_; }
 
  private:
   MoniCsvWriter() = default;
   std::string path_;
   int type_ = 0;
-  std::FILE* file_ = nullptr;
+  std::optional<core::RotatingFile> file_;
   std::size_t axes_ = 0;
   std::int64_t t0_ = 0;
   std::uint64_t rows_ = 0;
-  std::string buffer_;
+  std::uint64_t write_errors_ = 0;
+  std::string line_;
 };
 
 }  // namespace axon::c4g::apps

@@ -39,6 +39,8 @@ struct PcapRecorder::Impl {
   std::condition_variable wake_cv;
   bool wake = false;  // under mutex
   std::uint16_t ip_id = 0;
+  std::chrono::steady_clock::time_point opened{};  // of the current file, for the age limit
+  bool records = false;                            // the current file holds a datagram
   std::array<std::byte, net::kUdpFrameOverhead + kSnapPayload> frame{};
 };
 
@@ -51,9 +53,11 @@ Result<std::unique_ptr<PcapRecorder>> PcapRecorder::open(const std::string& path
   r->impl_->handle = pcap_open_dead_with_tstamp_precision(DLT_EN10MB, static_cast<int>(net::kUdpFrameOverhead + kSnapPayload),
                                                           PCAP_TSTAMP_PRECISION_NANO);
   if (r->impl_->handle == nullptr) return Error(CoreErrc::io, "pcap_open_dead failed");
+  AXON_TRY(options.rotation.validate());
   r->impl_->dumper = pcap_dump_open(r->impl_->handle, path.c_str());
   if (r->impl_->dumper == nullptr)
     return Error(CoreErrc::io, fmt::format("pcap file '{}': {}", path, pcap_geterr(r->impl_->handle)));
+  r->impl_->opened = std::chrono::steady_clock::now();
   r->impl_->writer = std::thread([p = r.get()] { p->run(); });
   return r;
 }
@@ -82,10 +86,34 @@ bool PcapRecorder::record(const net::SocketAddress& src, const net::SocketAddres
   return true;
 }
 
+bool PcapRecorder::rotate_if_due(std::size_t bytes) {
+  auto& im = *impl_;
+  if (im.dumper == nullptr) return false;
+  const auto& lim = options_.rotation;
+  if (!lim.any() || !im.records) return true;
+  const auto size = static_cast<std::uint64_t>(pcap_dump_ftell64(im.dumper)) + 16 + bytes;  // 16: record header
+  const bool too_big = lim.max_bytes > 0 && size > lim.max_bytes;
+  const bool too_old = lim.max_age > core::Duration::zero() && std::chrono::steady_clock::now() - im.opened >= lim.max_age;
+  if (!too_big && !too_old) return true;
+  pcap_dump_close(im.dumper);
+  im.dumper = nullptr;
+  if (auto s = core::RotatingFile::shift(path_, lim.keep); !s) return false;
+  im.dumper = pcap_dump_open(im.handle, path_.c_str());
+  im.opened = std::chrono::steady_clock::now();
+  im.records = false;
+  rotations_.fetch_add(1, std::memory_order_relaxed);
+  return im.dumper != nullptr;
+}
+
 void PcapRecorder::run() {
   auto write_one = [this](const Slot& s) {
     const std::size_t wire = std::min<std::size_t>(s.size, net::kMaxUdpPayload);
     const std::size_t n = net::write_udp_frame(impl_->frame, s.src, s.dst, {s.payload.data(), s.captured}, wire, impl_->ip_id++);
+    if (!rotate_if_due(n)) {
+      write_failures_.fetch_add(1, std::memory_order_relaxed);
+      return;
+    }
+    impl_->records = true;
     pcap_pkthdr h{};
     // With nanosecond precision the header's microsecond field carries nanoseconds.
     h.ts.tv_sec = static_cast<time_t>(s.wall_ns / 1'000'000'000);
@@ -110,8 +138,8 @@ void PcapRecorder::run() {
       ++n;
     }
     if (n) {
-      pcap_dump_flush(impl_->dumper);
-      written_.fetch_add(n, std::memory_order_release);
+      if (impl_->dumper != nullptr) pcap_dump_flush(impl_->dumper);
+      written_.fetch_add(n, std::memory_order_release);  // handled (a failed rotation counts its own)
     }
     if (stopping) return;  // the queue was drained after the stop request was seen
   }

@@ -12,6 +12,7 @@
 #pragma once
 
 #include "core/error.hpp"
+#include "core/rotating_file.hpp"
 #include "net/udp_socket.hpp"
 
 #include <atomic>
@@ -27,6 +28,10 @@ namespace axon::c4g::host {
 struct PcapOptions {
   std::size_t queue_capacity = 4096;            // datagrams in flight between the cycle and the writer
   std::chrono::milliseconds drain_interval{2};  // how often the writer wakes up when idle
+  // A size or age limit (none by default): the writer closes the full capture, renames it PATH.1
+  // (older ones PATH.2 ...: core::RotatingFile's naming) and goes on in a fresh PATH, each a
+  // complete pcap file with its own header. Never on the cycle thread.
+  core::RotationLimits rotation;
 };
 
 class PcapRecorder {
@@ -58,11 +63,16 @@ class PcapRecorder {
   [[nodiscard]] std::uint64_t written() const noexcept { return written_.load(std::memory_order_acquire); }
   [[nodiscard]] std::uint64_t dropped() const noexcept { return dropped_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t cut() const noexcept { return cut_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t rotations() const noexcept { return rotations_.load(std::memory_order_relaxed); }
+  // Datagrams not written because a rotation failed (the file could not be renamed or reopened).
+  [[nodiscard]] std::uint64_t write_failures() const noexcept { return write_failures_.load(std::memory_order_relaxed); }
 
  private:
   struct Impl;
   PcapRecorder() = default;
   void run();
+  // Before writing a frame of `bytes`: a new file when the limits say so. False when no file is open.
+  bool rotate_if_due(std::size_t bytes);
 
   std::string path_;
   PcapOptions options_;
@@ -71,6 +81,8 @@ class PcapRecorder {
   std::atomic<std::uint64_t> written_{0};
   std::atomic<std::uint64_t> dropped_{0};
   std::atomic<std::uint64_t> cut_{0};
+  std::atomic<std::uint64_t> rotations_{0};
+  std::atomic<std::uint64_t> write_failures_{0};
   std::atomic<bool> stop_{false};
   std::atomic<bool> closed_{false};
 };

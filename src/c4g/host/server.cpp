@@ -463,7 +463,8 @@ std::string Server::summary() const {
                  safety_.counters().drive_off_replies.load(), safety_.counters().following_error_replies.load());
   out += cycle_->summary();
   if (recorder_)
-    fmt::format_to(it, "Capture {}: {} written, {} dropped\n", recorder_->path(), recorder_->written(), recorder_->dropped());
+    fmt::format_to(it, "Capture {}: {} written, {} dropped, {} rotations, {} write failures\n", recorder_->path(),
+                   recorder_->written(), recorder_->dropped(), recorder_->rotations(), recorder_->write_failures());
   return out;
 }
 

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -74,4 +75,35 @@ TEST(Moni, WriterWritesHeaderAndRowsWithTimeFromTheFirstRow) {
   EXPECT_NE(text.find("\n4,0.002000,1,2,3,4,5,0,"), std::string::npos);
   EXPECT_FALSE(MoniCsvWriter::open("/nonexistent/dir/x.csv", 20));
   EXPECT_FALSE(MoniCsvWriter::open(path.string(), 18));
+}
+
+// With a size limit every CSV file starts with the title line, so each opens alone in a
+// spreadsheet or pandas; rows are never split and none is lost.
+TEST(Moni, RotatedFilesEachStartWithTheHeader) {
+  const auto path = std::filesystem::temp_directory_path() / ("axon_moni_rot_" + std::to_string(::getpid()) + ".csv");
+  axon::core::RotationLimits lim;
+  lim.max_bytes = 2048;
+  lim.keep = 100;
+  std::uint64_t rotations = 0;
+  {
+    auto w = MoniCsvWriter::open(path.string(), 20, lim).value();
+    for (int i = 0; i < 100; ++i) w->write(static_cast<std::uint64_t>(i), 1'000'000'000 + i * 2'000'000, packet(0, 0), packet(0, 0));
+    rotations = w->rotations();
+    EXPECT_EQ(w->write_errors(), 0u);
+  }
+  EXPECT_GE(rotations, 2u);
+  const std::string header = moni_header(20, 2);
+  std::size_t rows = 0;
+  for (std::uint64_t k = 0; k <= rotations; ++k) {
+    const auto name = k == 0 ? path : std::filesystem::path(path.string() + "." + std::to_string(k));
+    std::ifstream in(name);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string text = ss.str();
+    EXPECT_EQ(text.substr(0, header.size()), header) << name;
+    EXPECT_EQ(text.back(), '\n') << name;
+    rows += static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) - 1;
+    std::filesystem::remove(name);
+  }
+  EXPECT_EQ(rows, 100u);
 }

@@ -177,3 +177,36 @@ TEST(PcapRecorder, TcpdumpDecodesTheCaptureWhenInstalled) {
   std::filesystem::remove(path);
   std::filesystem::remove(out);
 }
+
+// A long session's capture with a size limit: the full file moves to PATH.1 (older ones PATH.2 ...)
+// and recording goes on in PATH; every file is a complete capture that libpcap reads, and no
+// datagram is lost or split across files.
+TEST(PcapRecorder, SizeLimitRotatesIntoCompleteCaptures) {
+  const std::string path = temp_path("rotate");
+  for (int k = 0; k <= 3; ++k) std::filesystem::remove(k == 0 ? path : fmt::format("{}.{}", path, k));
+  PcapOptions o;
+  o.rotation.max_bytes = 4096;  // about 10 six-axis datagrams a file
+  o.rotation.keep = 50;
+  auto rec = PcapRecorder::open(path, o).value();
+  const auto payload = pattern(228, 1);
+  const int n = 100;
+  for (int i = 0; i < n; ++i) {
+    ASSERT_TRUE(rec->record(kController, kPc, payload, 1'700'000'000'000'000'000LL + i));
+    if (i % 10 == 9) rec->flush();  // the queue never fills
+  }
+  rec->close();
+  EXPECT_GT(rec->rotations(), 5u);
+  EXPECT_EQ(rec->write_failures(), 0u);
+  std::size_t total = 0;
+  for (unsigned k = 0; k <= rec->rotations(); ++k) {
+    const std::string name = k == 0 ? path : fmt::format("{}.{}", path, k);
+    EXPECT_LE(std::filesystem::file_size(name), 4096u) << name;
+    int linktype = 0;
+    const auto got = read_back(name, &linktype);
+    EXPECT_EQ(linktype, DLT_EN10MB) << name;
+    EXPECT_FALSE(got.empty()) << name;
+    total += got.size();
+    std::filesystem::remove(name);
+  }
+  EXPECT_EQ(total, static_cast<std::size_t>(n));
+}
