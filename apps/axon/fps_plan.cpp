@@ -241,7 +241,10 @@ void add_fps_plan_commands(CLI::App& app, GlobalOptions&) {
   common(pl);
   pl->add_option("--from", a.from, "current poses: a target file, 'folded' (default) or 'random'");
   pl->add_option("--to", a.to, "targets: a target file (YAML/CSV) or 'random'")->required();
-  pl->add_option("-o,--output", a.output, "plan.json to write ('-' for stdout)");
+  auto* out = pl->add_option("-o,--output", a.output, "plan.json to write ('-' for stdout)");
+  // --json as on every command that reports: the plan document alone on stdout (the summary and
+  // logs stay on stderr), i.e. `-o -`.
+  pl->add_flag_callback("--json", [] { a.output = "-"; }, "print the plan (plan.json) on stdout, nothing else")->excludes(out);
   pl->add_option("--svg", a.svg, "also draw the end poses and the fibre paths");
   pl->add_option("--speed", a.speed, "arm speed, deg/s (default 12: 2000 rpm at the motor, 1000:1)")->check(positive());
   pl->add_flag("--reject", a.reject, "fail on bad targets instead of parking those robots");

@@ -29,6 +29,15 @@ grep -q '<svg' "$TMP/plan.svg" || fail "plan --svg wrote no SVG"
   || fail "plot of the plan at 5 s exited with $? ($(cat "$TMP/plot.err"))"
 grep -q 'at 5.00 s' "$TMP/at5.svg" || fail "plot: title"
 
+# --json: the plan document alone on stdout (the summary on stderr); with -o FILE it is a usage error.
+"$AXON" fps plan --layout "$DATA/benchtop.yaml" --to random --seed 2 --json >"$TMP/plan-json.out" 2>"$TMP/plan-json.err" \
+  || fail "plan --json exited $?"
+/usr/bin/python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["format"] == "axon-fps-plan", d.keys()' \
+  "$TMP/plan-json.out" || fail "plan --json: stdout is not the plan alone: $(head -c 300 "$TMP/plan-json.out")"
+grep -q '^plan: ' "$TMP/plan-json.err" || fail "plan --json: summary not on stderr"
+rc=0; "$AXON" fps plan --layout "$DATA/benchtop.yaml" --to random --json -o "$TMP/x.json" 2>/dev/null || rc=$?
+[ "$rc" = 2 ] || fail "plan --json -o FILE: exit $rc, expected 2"
+
 # A target file with a typo'd robot is an error, not a silent drop.
 printf 'targets:\n  - {robot: 99, alpha: 10, beta: 170}\n' >"$TMP/bad.yaml"
 if "$AXON" fps plan --layout "$DATA/benchtop.yaml" --to "$TMP/bad.yaml" 2>"$TMP/bad.err"; then fail "unknown robot accepted"; fi
