@@ -394,10 +394,11 @@ asio::awaitable<int> with_motors(Session& s, const char* command,
     auto r = co_await bh::with_motors_enabled<Outcome>(*s.board, body);
     run = std::move(r);
   } catch (...) {
-    g_motors_may_be_on = false;  // the session ended (a failed disable was logged)
+    // The session sent its disable, but whether it went through is not known here: the flag stays,
+    // so the disable over a new connection runs too (a second disable is harmless).
     throw;
   }
-  g_motors_may_be_on = false;
+  g_motors_may_be_on = !run->disable;  // a failed disable: try again over a new connection
   co_return report(command, *run);
 }
 

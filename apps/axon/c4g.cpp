@@ -390,6 +390,16 @@ class FreezeControl {
 
 Clock::duration seconds(double s) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
 
+// Waits until the server has answered one more packet (the controller is still sending) or
+// `limit_s` passed: a reply latched now (drive off) is then on the wire.
+void wait_for_answer(const host::Server& server, double limit_s) {
+  const auto before = server.counters().packets.load();
+  const auto until = Clock::now() + seconds(limit_s);
+  while (server.counters().packets.load() == before && Clock::now() < until &&
+         server.state() == host::ServerState::running)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+}
+
 int run_serve(const ServeOptions& o) {
   auto app = make_app(o);
   const host::ServerOptions so = server_options(o);
@@ -477,9 +487,11 @@ int run_serve(const ServeOptions& o) {
     return settled();
   };
   if (!wait_until(o.stop_timeout_s)) {
-    spdlog::warn("c4g serve: the controller is still in an open mode after {} s: asking for drive off", o.stop_timeout_s);
+    if (signals.count() >= 2) spdlog::warn("c4g serve: a second signal: asking for drive off now");
+    else spdlog::warn("c4g serve: the controller is still in an open mode after {} s: asking for drive off", o.stop_timeout_s);
     server->safety().trip(host::FaultReason::user_request);
-    wait_until(1.0);
+    if (signals.count() < 2) wait_until(1.0);
+    wait_for_answer(*server, 0.1);  // the drive off must go out before the socket closes
   }
   server->stop();
   pump();
@@ -487,7 +499,8 @@ int run_serve(const ServeOptions& o) {
 
   const bool faulted = server->safety().faulted() && server->safety().reason() != host::FaultReason::user_request;
   print_report(o, *server, *app, why, csv.get());
-  return app->has_error() || faulted ? 1 : 0;
+  if (faulted) return exit_code_value::safety_stop;
+  return app->has_error() ? exit_code_value::failed : exit_code_value::ok;
 }
 
 // The first 1200-byte UDP payload of a capture (Ethernet / IPv4 / UDP, as PcapRecorder and

@@ -140,7 +140,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
              "{} unexpected, {} on the wrong bus ({:.2f} s)\n",
              fpa->bus_count(), seconds(ao.check_window), check.matched.size(), check.missing.size(),
              check.unexpected.size(), check.wrong_bus.size(), seconds(Clock::now() - t0));
-  if (!check.ok()) throw Exception(Error(CoreErrc::invalid_argument, "layout check failed:\n" + check.to_text()));
+  if (!check.ok()) throw Exception(Error(host::HostErrc::sequence_failed, "layout check failed:\n" + check.to_text()));
   auto bits0 = wire_now();
   t0 = Clock::now();
   auto disc = co_await fpa->discover();
@@ -192,7 +192,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
     report_signal_stop(array);
     co_return;
   }
-  if (!folded.completed) throw Exception(Error(CoreErrc::invalid_argument, failure_text(folded)));
+  if (!folded.completed) throw Exception(Error(host::HostErrc::sequence_failed, failure_text(folded)));
 
   // 5. A random reconfiguration of every robot, planned collision-free from the folded lattice
   //    (docs/fps-plan.md) and verified by the planner's independent checker before anything moves.
@@ -215,7 +215,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
              model.size(), plan.stats.plan_s, plan.stats.search_s, plan.stats.check_s, model.size() - plan.not_reached,
              plan.not_reached, plan.stats.duration_s, plan.stats.median_points, plan.stats.max_points,
              plan.verified ? "verified" : "REJECTED", plan.check.min_clearance_mm);
-  if (!plan.verified) throw Exception(Error(CoreErrc::invalid_argument, "the planner's checker rejected the plan"));
+  if (!plan.verified) throw Exception(Error(host::HostErrc::sequence_failed, "the planner's checker rejected the plan"));
   if (plan.not_reached > 0) fmt::print("{}", plan.summary(model));
   const double move_s = plan.stats.duration_s;
   std::map<std::uint16_t, protocol::Trajectory> moves;
@@ -316,7 +316,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
              at_target, run.robots.size(), worst_host, worst_sim, st.neighbour_collisions + st.obstacle_collisions);
 
   if (st.neighbour_collisions + st.obstacle_collisions > 0)
-    throw Exception(Error(CoreErrc::invalid_argument, "the simulator saw collisions during the planned move"));
+    throw Exception(Error(host::HostErrc::collision, "the simulator saw collisions during the planned move"));
   fmt::print("7. timings (floor: wire time of the busiest bus for the frames the phase put on it, 1 Mbit/s):\n");
   for (const auto& p : phases) {
     if (p.floor > 0) {
@@ -339,7 +339,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
              host_cpu, sim_cpu, u.ru_maxrss / 1024, totals.sent, totals.timeouts, overflows);
   co_await fpa->close();
   fmt::print("   the same from a shell: `axon sim fps --layout default` (docs/fps-simulator.md), then `axon fps ...`\n");
-  if (!run.completed) throw Exception(Error(CoreErrc::invalid_argument, failure_text(run)));
+  if (!run.completed) throw Exception(Error(host::HostErrc::sequence_failed, failure_text(run)));
 }
 
 }  // namespace axon::app

@@ -325,6 +325,10 @@ asio::awaitable<int> job_goto(const FpsOptions& o, const GotoArgs& g, host::Arra
   else r = co_await array.goto_absolute(std::move(one));
   auto results = need(std::move(r));
   auto& moved = results.at(g.id);
+  if (!moved && array.locked()) {  // a collision or a lost link stopped everything: a safety stop
+    std::fprintf(stderr, "axon: error: %s\n", moved.error().message().c_str());
+    co_return motion_exit_code(false, array);
+  }
   if (!moved) throw Exception(moved.error());
   const auto m = std::move(moved).value();
   if (o.json) print_json(json{{"id", g.id}, {"target", angles_json(m.target)}, {"reached", angles_json(m.reached)}});

@@ -392,6 +392,9 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
       rc = co_await plane_action(*fpa, a, action, plane, set_on_signal, image, uo);
     } catch (...) {
       failure = std::current_exception();  // close first: the robots and connections are left tidy
+      // The action's own hook may point into its finished frame (cold's stop flag): a signal
+      // during the close stops the array instead.
+      stop_robots_on_signal(set_on_signal, fpa->array());
     }
     std::fflush(stdout);
     co_await fpa->close();

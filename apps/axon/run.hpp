@@ -27,6 +27,9 @@ namespace asio = boost::asio;
 // A command-line mistake (bad option value, missing file): reported to the user as such.
 inline Error usage(std::string text) { return Error(CoreErrc::invalid_argument, std::move(text)); }
 
+// How long a second stop signal lets the first one's stop of the devices finish (run_command).
+inline constexpr std::chrono::milliseconds kSecondSignalGrace{500};
+
 // Set by a command whose normal end is a stop signal (servers, simulators, monitors that run until
 // Ctrl-C): its exit code stays the body's own instead of 128+N.
 inline std::atomic<bool>& signal_is_normal_end() noexcept {
@@ -38,18 +41,31 @@ inline std::atomic<bool>& signal_is_normal_end() noexcept {
 // (axon::Exception becomes "axon: error: ..." in main). SIGINT/SIGTERM/SIGHUP call `on_signal`, which
 // a command that drives devices sets to make them safe (stop the robots, zero the current) so that
 // the body finishes normally and prints what it stopped; without one, the first signal stops the
-// event loop. A second signal stops at once. A command ended by a signal exits 128+N (see
+// event loop. A second signal stops it within kSecondSignalGrace, a third at once. A command ended by a signal exits 128+N (see
 // exit_codes.hpp) unless its normal end is a signal (signal_is_normal_end()).
 inline int run_command(const std::function<asio::awaitable<int>(asio::io_context&, std::function<void(std::function<void()>)>)>& body) {
   asio::io_context io;
   asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);
   std::function<void()> on_signal = [&io] { io.stop(); };
   int signalled = 0;
+  // A second signal (an impatient double Ctrl-C, `timeout` signalling the process and its group)
+  // still lets the first one's stop go out: the loop runs on for at most kSecondSignalGrace (the
+  // abort frames, the disable are queued by then), a third signal ends it at once.
+  asio::steady_timer grace(io);
   std::function<void(const boost::system::error_code&, int)> handler = [&](const boost::system::error_code& ec, int signo) {
     if (ec) return;
     record_stop_signal(signo);
-    if (signalled++ > 0) io.stop();
-    else on_signal();
+    const int n = ++signalled;
+    if (n == 1) {
+      on_signal();
+    } else if (n == 2) {
+      grace.expires_after(kSecondSignalGrace);
+      grace.async_wait([&io](const boost::system::error_code& e) {
+        if (!e) io.stop();
+      });
+    } else {
+      io.stop();
+    }
     signals.async_wait(handler);
   };
   signals.async_wait(handler);
@@ -60,6 +76,7 @@ inline int run_command(const std::function<asio::awaitable<int>(asio::io_context
                    failure = e;
                    rc = r;
                    signals.cancel();
+                   grace.cancel();
                    io.stop();
                  });
   io.run();

@@ -24,6 +24,12 @@ class HostCategory final : public std::error_category {
     }
     return "unknown blmc host error";
   }
+  // A bad option or input from the caller compares equal to std::errc::invalid_argument (the CLI's
+  // exit code 2; core/error.cpp).
+  std::error_condition default_error_condition(int c) const noexcept override {
+    if (static_cast<HostErrc>(c) == HostErrc::invalid_argument) return std::errc::invalid_argument;
+    return {c, *this};
+  }
 };
 }  // namespace
 

@@ -10,6 +10,7 @@
 #include <condition_variable>
 #include <mutex>
 #include <cstring>
+#include <filesystem>
 #include <thread>
 
 namespace axon::c4g::host {
@@ -88,8 +89,8 @@ bool PcapRecorder::record(const net::SocketAddress& src, const net::SocketAddres
 
 bool PcapRecorder::rotate_if_due(std::size_t bytes) {
   auto& im = *impl_;
-  if (im.dumper == nullptr) return false;
   const auto& lim = options_.rotation;
+  if (im.dumper == nullptr) return reopen();  // an earlier rotation failed: try again
   if (!lim.any() || !im.records) return true;
   const auto size = static_cast<std::uint64_t>(pcap_dump_ftell64(im.dumper)) + 16 + bytes;  // 16: record header
   const bool too_big = lim.max_bytes > 0 && size > lim.max_bytes;
@@ -97,12 +98,19 @@ bool PcapRecorder::rotate_if_due(std::size_t bytes) {
   if (!too_big && !too_old) return true;
   pcap_dump_close(im.dumper);
   im.dumper = nullptr;
-  if (auto s = core::RotatingFile::shift(path_, lim.keep); !s) return false;
+  return reopen();
+}
+
+bool PcapRecorder::reopen() {
+  auto& im = *impl_;
+  std::error_code ec;
+  if (std::filesystem::exists(path_, ec) && !core::RotatingFile::shift(path_, options_.rotation.keep)) return false;
   im.dumper = pcap_dump_open(im.handle, path_.c_str());
+  if (im.dumper == nullptr) return false;
   im.opened = std::chrono::steady_clock::now();
   im.records = false;
   rotations_.fetch_add(1, std::memory_order_relaxed);
-  return im.dumper != nullptr;
+  return true;
 }
 
 void PcapRecorder::run() {
@@ -139,7 +147,7 @@ void PcapRecorder::run() {
     }
     if (n) {
       if (impl_->dumper != nullptr) pcap_dump_flush(impl_->dumper);
-      written_.fetch_add(n, std::memory_order_release);  // handled (a failed rotation counts its own)
+      handled_.fetch_add(n, std::memory_order_release);  // written, or counted as a write failure
     }
     if (stopping) return;  // the queue was drained after the stop request was seen
   }
@@ -148,7 +156,7 @@ void PcapRecorder::run() {
 void PcapRecorder::flush() {
   if (!impl_ || !impl_->writer.joinable()) return;
   const std::uint64_t target = queued();
-  while (written() < target) {
+  while (handled_.load(std::memory_order_acquire) < target) {
     {
       std::lock_guard lock(impl_->mutex);
       impl_->wake = true;

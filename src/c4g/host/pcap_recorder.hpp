@@ -60,7 +60,12 @@ class PcapRecorder {
 
   [[nodiscard]] const std::string& path() const noexcept { return path_; }
   [[nodiscard]] std::uint64_t queued() const noexcept { return queued_.load(std::memory_order_relaxed); }
-  [[nodiscard]] std::uint64_t written() const noexcept { return written_.load(std::memory_order_acquire); }
+  // Datagrams in the file(s); queued ones are written, dropped (queue full) or write failures.
+  [[nodiscard]] std::uint64_t written() const noexcept {
+    const auto failed = write_failures_.load(std::memory_order_relaxed);  // may run ahead of handled_ in a batch
+    const auto handled = handled_.load(std::memory_order_acquire);
+    return handled > failed ? handled - failed : 0;
+  }
   [[nodiscard]] std::uint64_t dropped() const noexcept { return dropped_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t cut() const noexcept { return cut_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t rotations() const noexcept { return rotations_.load(std::memory_order_relaxed); }
@@ -73,12 +78,14 @@ class PcapRecorder {
   void run();
   // Before writing a frame of `bytes`: a new file when the limits say so. False when no file is open.
   bool rotate_if_due(std::size_t bytes);
+  // Renames the files (PATH -> PATH.1 ...) and opens a fresh PATH. False when either failed.
+  bool reopen();
 
   std::string path_;
   PcapOptions options_;
   std::unique_ptr<Impl> impl_;
   std::atomic<std::uint64_t> queued_{0};
-  std::atomic<std::uint64_t> written_{0};
+  std::atomic<std::uint64_t> handled_{0};  // taken from the queue by the writer
   std::atomic<std::uint64_t> dropped_{0};
   std::atomic<std::uint64_t> cut_{0};
   std::atomic<std::uint64_t> rotations_{0};
