@@ -6,6 +6,10 @@
 
 #include <fmt/format.h>
 
+#include <arpa/inet.h>
+#include <netdb.h>
+#include <netinet/in.h>
+
 #include <algorithm>
 
 namespace axon::can {
@@ -21,6 +25,22 @@ CanNetOptions cannet_options(const OpenOptions& options) {
 }
 
 bool same_endpoint(const net::Endpoint& a, const net::Endpoint& b) { return a.host == b.host && a.port == b.port; }
+
+// The IPv4 address a host name stands for ("localhost" -> "127.0.0.1"), so that two names of one
+// gateway share its single connection (a second one would take it over). A name that does not
+// resolve stays as written: connecting then reports it.
+std::string canonical_host(const std::string& host) {
+  addrinfo hints{};
+  hints.ai_family = AF_INET;
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  if (::getaddrinfo(host.c_str(), nullptr, &hints, &found) != 0 || found == nullptr) return host;
+  char text[INET_ADDRSTRLEN] = {};
+  const auto* in = reinterpret_cast<const sockaddr_in*>(found->ai_addr);
+  const bool ok = ::inet_ntop(AF_INET, &in->sin_addr, text, sizeof text) != nullptr;
+  ::freeaddrinfo(found);
+  return ok ? std::string(text) : host;
+}
 
 bool same_bus(const BusSpec& a, const BusSpec& b) {
   if (a.kind != b.kind) return false;
@@ -80,6 +100,8 @@ Result<void> check_distinct(const std::vector<BusSpec>& specs) {
 
 asio::awaitable<Result<std::vector<std::unique_ptr<Bus>>>> open_buses(asio::any_io_executor ex,
                                                                       std::vector<BusSpec> specs, OpenOptions options) {
+  for (auto& s : specs)
+    if (s.kind == BusSpec::Kind::cannet || s.kind == BusSpec::Kind::socketcand) s.endpoint.host = canonical_host(s.endpoint.host);
   AXON_CO_TRY(check_distinct(specs));
   // One connection per gateway, with every channel asked of it.
   std::vector<std::pair<net::Endpoint, std::vector<int>>> gateways;

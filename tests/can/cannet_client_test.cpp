@@ -315,6 +315,27 @@ TEST(CanNetClient, BusesOnOneGatewayOpenedTogetherShareOneConnection) {
   });
 }
 
+// Two names of one gateway are one gateway: a second connection would take it over.
+TEST(CanNetClient, TwoNamesOfOneGatewayShareOneConnection) {
+  ClientBench b;
+  run(b.io, [&]() -> asio::awaitable<void> {
+    const auto port = b.emulator->local_endpoint().port;
+    std::vector<BusSpec> specs{parse_bus_spec(fmt::format("cannet://localhost:{}/1", port)).value(),
+                               parse_bus_spec(fmt::format("cannet://127.0.0.1:{}/2", port)).value()};
+    auto opened = co_await open_buses(b.io.get_executor(), specs);
+    CO_ASSERT_TRUE(opened);
+    EXPECT_EQ(opened.value().size(), 2u);
+    EXPECT_EQ(b.emulator->stats().connections, 1u);
+    EXPECT_EQ(b.emulator->stats().replaced, 0u);
+    for (auto& bus : opened.value()) bus->close();
+    // And one bus under two names is the same bus listed twice.
+    std::vector<BusSpec> twice{specs[0], parse_bus_spec(fmt::format("cannet://127.0.0.1:{}/1", port)).value()};
+    auto refused = co_await open_buses(b.io.get_executor(), twice);
+    CO_ASSERT_TRUE(!refused);
+    EXPECT_EQ(refused.error(), CanErrc::bad_spec);
+  });
+}
+
 TEST(CanNetClient, ConnectionLossClosesBusesAfterQueuedFrames) {
   ClientBench b;
   run(b.io, [&]() -> asio::awaitable<void> {
