@@ -3,12 +3,14 @@
 # the exchange (504), records a capture that tcpdump and init-info read, and exits by itself.
 source "$(dirname "$0")/lib.sh"
 skip_without_sim_c4g
-start_c4g_serve --app monitor --pcap "$TMP/run.pcap" --csv "$TMP/moni.csv" --moni 20
-run_sim_c4g "steps:
+# The robot program of both runs: drives on, a short move in mode 0, the end of the exchange.
+PROGRAM="steps:
   - drive_on
   - move: {arm: 1, deg: [5, 0, 0, 0, 0, 0], duration: 0.3}
   - delay: 0.1
   - exit_open"
+start_c4g_serve --app monitor --pcap "$TMP/run.pcap" --csv "$TMP/moni.csv" --moni 20
+run_sim_c4g "$PROGRAM"
 [ "$SIM_RC" = 0 ] || fail "simulator exit code $SIM_RC"
 wait_serve
 [ "$SERVE_RC" = 0 ] || fail "serve exit code $SERVE_RC"
@@ -28,11 +30,7 @@ fi
 # The same with size limits: the recordings rotate (FILE.1, FILE.2 ...), every CSV file starts with
 # the title line, every capture is whole, and the report counts the rotations.
 start_c4g_serve --app monitor --pcap "$TMP/rot.pcap" --pcap-max-size 64k --csv "$TMP/rot.csv" --moni 20 --csv-max-size 8k
-run_sim_c4g "steps:
-  - drive_on
-  - move: {arm: 1, deg: [5, 0, 0, 0, 0, 0], duration: 0.3}
-  - delay: 0.1
-  - exit_open"
+run_sim_c4g "$PROGRAM"
 [ "$SIM_RC" = 0 ] || fail "simulator exit code $SIM_RC (rotation run)"
 wait_serve
 [ -f "$TMP/rot.pcap.1" ] && [ -f "$TMP/rot.csv.1" ] || fail "no rotated files: $(ls "$TMP")"
