@@ -1,5 +1,5 @@
 // blmc control loop benchmark: the ControlLoop at 1 kHz over 1, 2 and 4 simulated boards
-// (src/blmc/sim, one board per virtual bus, as in service), each running a PD position hold.
+// (src/axon/blmc/sim, one board per virtual bus, as in service), each running a PD position hold.
 //
 // Reports per board count: loop period jitter (p50/p99/max of |period - 1 ms|), overruns and
 // missed deadlines, and process CPU per board (the simulator's 1 kHz tick included). Latency: the
@@ -10,13 +10,13 @@
 // io thread, measured in the same run. ratio = latency p50 (measurement pacing) / round trip p50.
 //
 //   blmc_loop [--seconds S]   (default 2 s per configuration; the whole run stays under ~20 s)
-#include "blmc/host/board.hpp"
-#include "blmc/host/control_loop.hpp"
-#include "blmc/host/pd_controller.hpp"
-#include "blmc/sim/runner.hpp"
-#include "can/virtual_bus.hpp"
-#include "core/log.hpp"
-#include "core/wakeup.hpp"
+#include "axon/blmc/host/board.hpp"
+#include "axon/blmc/host/control_loop.hpp"
+#include "axon/blmc/host/pd_controller.hpp"
+#include "axon/blmc/sim/runner.hpp"
+#include "axon/can/virtual_bus.hpp"
+#include "axon/core/log.hpp"
+#include "axon/core/wakeup.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>

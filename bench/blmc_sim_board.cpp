@@ -2,9 +2,9 @@
 // four data messages on, timed in one thread. The baseline is the firmware period itself (1 ms):
 // ratio = CPU time per simulated cycle / 1 ms, i.e. the share of one core a board takes in real
 // time (transport and socket costs excluded).
-#include "blmc/protocol/command.hpp"
-#include "blmc/protocol/frames.hpp"
-#include "blmc/sim/board.hpp"
+#include "axon/blmc/protocol/command.hpp"
+#include "axon/blmc/protocol/frames.hpp"
+#include "axon/blmc/sim/board.hpp"
 
 #include <fmt/format.h>
 

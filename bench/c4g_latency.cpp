@@ -1,5 +1,5 @@
 // c4g latency at 1 kHz with six axes, measured by the controller simulator: two simulated
-// controllers (src/c4g/sim, the paced client loop `axon sim c4g` runs) side by side in one process,
+// controllers (src/axon/c4g/sim, the paced client loop `axon sim c4g` runs) side by side in one process,
 // one against the c4g Server running the `pid` application in mode 1 (the heaviest built-in law:
 // transforms, six PI loops, safety checks), the other against a minimal C UDP echo server, so both
 // see the same machine load.
@@ -11,14 +11,14 @@
 // both.
 // Ratios are server / echo. `--seconds N` (default 5; 60 for the full run).
 // Last line: `BENCH c4g_latency ... ratio=` (round-trip p50 ratio).
-#include "c4g/apps/pid.hpp"
-#include "c4g/host/server.hpp"
-#include "c4g/protocol/init_packet.hpp"
-#include "c4g/sim/client_runner.hpp"
-#include "c4g/sim/controller.hpp"
-#include "c4g/sim/robots.hpp"
-#include "c4g/sim/scenario.hpp"
-#include "c4g/sim/udp_client.hpp"
+#include "axon/c4g/apps/pid.hpp"
+#include "axon/c4g/host/server.hpp"
+#include "axon/c4g/protocol/init_packet.hpp"
+#include "axon/c4g/sim/client_runner.hpp"
+#include "axon/c4g/sim/controller.hpp"
+#include "axon/c4g/sim/robots.hpp"
+#include "axon/c4g/sim/scenario.hpp"
+#include "axon/c4g/sim/udp_client.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>

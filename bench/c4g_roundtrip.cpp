@@ -1,8 +1,8 @@
 // c4g reply round trip on loopback: the Server (decode, safe reply, controller, safety, encode,
 // timing) against a minimal echo server on the same kind of socket, measured in the same run.
 // Prints `BENCH c4g_roundtrip ... ratio=` (server p50 / echo p50).
-#include "c4g/host/server.hpp"
-#include "net/udp_echo.hpp"
+#include "axon/c4g/host/server.hpp"
+#include "axon/net/udp_echo.hpp"
 
 #include <algorithm>
 #include <array>

@@ -4,11 +4,11 @@
 // Path measured: client Bus -> TCP -> server (socketcand server or CAN@net gateway emulator) ->
 // virtual bus -> echo node -> back the same way. The baseline is a client writing a 40-byte line
 // to a TCP echo server and reading it back. ratio = median CAN round trip / median TCP echo.
-#include "can/cannet_client.hpp"
-#include "can/cannet_server.hpp"
-#include "can/socketcand_client.hpp"
-#include "can/socketcand_server.hpp"
-#include "can/virtual_bus.hpp"
+#include "axon/can/cannet_client.hpp"
+#include "axon/can/cannet_server.hpp"
+#include "axon/can/socketcand_client.hpp"
+#include "axon/can/socketcand_server.hpp"
+#include "axon/can/virtual_bus.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>

@@ -10,7 +10,7 @@
 //
 // Plain std::chrono; each throughput figure is the best of several runs because the machine is
 // shared. Build: cmake --preset release && cmake --build --preset release --target can_virtual
-#include "can/virtual_bus.hpp"
+#include "axon/can/virtual_bus.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>

@@ -7,7 +7,7 @@
 // of the busiest bus (best of 2 rounds). The image size is FPS_BENCH_IMAGE_KB (default 8 kB).
 #include "fps_rig.hpp"
 
-#include "fps/sim/firmware_marker.hpp"
+#include "axon/fps/sim/firmware_marker.hpp"
 
 #include <chrono>
 #include <cstdio>

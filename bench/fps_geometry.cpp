@@ -6,7 +6,7 @@
 //    ratio = exact pairs/s / naive pairs/s (how much the exact primitive saves).
 // 2. The dense-sampling trajectory checker on a random move of every robot (12 deg/s), with one
 //    thread and with two, in pair evaluations per second.
-#include "fps/plan/checker.hpp"
+#include "axon/fps/plan/checker.hpp"
 
 #include <fmt/format.h>
 

@@ -11,10 +11,10 @@
 // machine (FIELD-NOTES / issue 5) are printed beside ours and give ratio = 28 s / our median.
 //
 // Usage: fps_plan [--problems N] [--seed S] [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K] [--local-retries N] [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--stop-avoid DEG] [--fold-stop-gap DEG] [--give-up N] [--stall S] [--smooth-points N] [--smooth-clearance MM]
-#include "fps/layout/layout_generator.hpp"
-#include "fps/plan/layout_model.hpp"
-#include "fps/plan/planner.hpp"
-#include "fps/plan/problems.hpp"
+#include "axon/fps/layout/layout_generator.hpp"
+#include "axon/fps/plan/layout_model.hpp"
+#include "axon/fps/plan/planner.hpp"
+#include "axon/fps/plan/problems.hpp"
 
 #include <fmt/format.h>
 

@@ -11,10 +11,10 @@
 // that crossed it during the operation (the media count them with can::frame_bits) at 1 Mbit/s.
 #pragma once
 
-#include "fps/host/focal_plane_array.hpp"
-#include "fps/layout/layout_generator.hpp"
-#include "core/deadline_queue.hpp"
-#include "fps/sim/focal_plane_sim.hpp"
+#include "axon/fps/host/focal_plane_array.hpp"
+#include "axon/fps/layout/layout_generator.hpp"
+#include "axon/core/deadline_queue.hpp"
+#include "axon/fps/sim/focal_plane_sim.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/executor_work_guard.hpp>

@@ -5,7 +5,7 @@
 // rounds). The simulator runs on its own thread (bench/fps_rig.hpp).
 #include "fps_rig.hpp"
 
-#include "fps/host/concurrent.hpp"
+#include "axon/fps/host/concurrent.hpp"
 
 #include <chrono>
 #include <cstdio>

@@ -5,12 +5,12 @@
 // the payload (more than 8 bytes is tried as well) and, read as text, a NAME=value command. Nothing
 // may crash; every decoder must accept or reject with a blmc protocol error; whatever decodes must
 // encode back to the identical frame or text.
-#include "blmc/protocol/command.hpp"
-#include "blmc/protocol/error.hpp"
-#include "blmc/protocol/frames.hpp"
-#include "blmc/protocol/q24.hpp"
-#include "blmc/protocol/status.hpp"
-#include "can/frame.hpp"
+#include "axon/blmc/protocol/command.hpp"
+#include "axon/blmc/protocol/error.hpp"
+#include "axon/blmc/protocol/frames.hpp"
+#include "axon/blmc/protocol/q24.hpp"
+#include "axon/blmc/protocol/status.hpp"
+#include "axon/can/frame.hpp"
 
 #include <cstddef>
 #include <cstdint>

@@ -10,9 +10,9 @@
 //   3  shaft state of a motor: one byte (bit 0 motor), one byte position, one byte velocity
 // Nothing may crash, every frame the board sends must decode as a board message, and the motors'
 // state must stay finite with readings within +-100 revolutions.
-#include "blmc/protocol/frames.hpp"
-#include "blmc/sim/board.hpp"
-#include "can/frame.hpp"
+#include "axon/blmc/protocol/frames.hpp"
+#include "axon/blmc/sim/board.hpp"
+#include "axon/can/frame.hpp"
 
 #include <cmath>
 #include <cstddef>

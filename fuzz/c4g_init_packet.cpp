@@ -4,10 +4,10 @@
 // may crash; a rejection must carry a c4g protocol code; a decoded packet must re-encode to the
 // identical 1200 bytes, print, and either build an axis map and per-arm transforms or reject them
 // with a c4g code.
-#include "c4g/protocol/axis_map.hpp"
-#include "c4g/protocol/error.hpp"
-#include "c4g/protocol/init_packet.hpp"
-#include "c4g/protocol/transform.hpp"
+#include "axon/c4g/protocol/axis_map.hpp"
+#include "axon/c4g/protocol/error.hpp"
+#include "axon/c4g/protocol/init_packet.hpp"
+#include "axon/c4g/protocol/transform.hpp"
 
 #include <array>
 #include <cstddef>

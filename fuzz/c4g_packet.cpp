@@ -5,10 +5,10 @@
 // protocol code; whatever decodes must re-encode to the identical bytes (except -0.0/NaN payload
 // differences, which cannot occur since non-finite floats are rejected) and pass the mode and safety
 // helpers without trouble.
-#include "c4g/protocol/error.hpp"
-#include "c4g/protocol/mode.hpp"
-#include "c4g/protocol/packet.hpp"
-#include "c4g/protocol/safety.hpp"
+#include "axon/c4g/protocol/error.hpp"
+#include "axon/c4g/protocol/mode.hpp"
+#include "axon/c4g/protocol/packet.hpp"
+#include "axon/c4g/protocol/safety.hpp"
 
 #include <array>
 #include <cstddef>

@@ -1,7 +1,7 @@
 // Fuzzes parse_candump_line: it must never crash, refuse only with its two documented codes, and
 // whatever it accepts must survive format_candump_line and a second parse unchanged (timestamps
 // to the microsecond, which is what the format keeps).
-#include "can/candump_log.hpp"
+#include "axon/can/candump_log.hpp"
 
 #include <cstdint>
 #include <cstdlib>

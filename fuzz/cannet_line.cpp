@@ -2,7 +2,7 @@
 // LineSplitter fed in two chunks (cut where the first byte says); both must agree. Every line is
 // parsed; one that parses must format to text that parses back to the same value, and formatting
 // that again must give the same text. Any disagreement traps.
-#include "can/cannet_codec.hpp"
+#include "axon/can/cannet_codec.hpp"
 
 #include <cstddef>
 #include <cstdint>

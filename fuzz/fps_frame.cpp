@@ -5,12 +5,12 @@
 // so out-of-range identifiers are tried too); the rest is the payload (more than 8 bytes is tried as
 // well). Nothing may crash, every decoder must reject or accept cleanly, and whatever decodes must
 // encode back to the same bytes.
-#include "can/frame.hpp"
-#include "fps/protocol/commands.hpp"
-#include "fps/protocol/error.hpp"
-#include "fps/protocol/message.hpp"
-#include "fps/protocol/payloads.hpp"
-#include "fps/protocol/trajectory.hpp"
+#include "axon/can/frame.hpp"
+#include "axon/fps/protocol/commands.hpp"
+#include "axon/fps/protocol/error.hpp"
+#include "axon/fps/protocol/message.hpp"
+#include "axon/fps/protocol/payloads.hpp"
+#include "axon/fps/protocol/trajectory.hpp"
 
 #include <algorithm>
 #include <cstddef>

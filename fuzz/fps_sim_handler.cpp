@@ -12,9 +12,9 @@
 //   7     forced collision: one byte (bit 0: beta)
 // Nothing may crash, and everything the robot sends must be a well-formed frame from its own id
 // whose accepted replies have the size the command table declares.
-#include "fps/protocol/commands.hpp"
-#include "fps/protocol/message.hpp"
-#include "fps/sim/positioner_model.hpp"
+#include "axon/fps/protocol/commands.hpp"
+#include "axon/fps/protocol/message.hpp"
+#include "axon/fps/sim/positioner_model.hpp"
 
 #include <cmath>
 #include <cstddef>

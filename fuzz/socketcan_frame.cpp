@@ -1,6 +1,6 @@
 // Fuzzes the struct can_frame decoder: any bytes either decode or give a typed error; frames
 // re-encode to a record that decodes to the same frame; error reports always describe themselves.
-#include "can/socketcan_frame.hpp"
+#include "axon/can/socketcan_frame.hpp"
 
 #include <cstdint>
 #include <cstdlib>

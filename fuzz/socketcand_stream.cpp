@@ -4,7 +4,7 @@
 // stream is cut; every message is one '<' ... '>' within the length limit; the tokenizer keeps no
 // more than one message's worth of bytes; every message that parses formats to text that parses
 // back to the same message, and formatting that again gives the same text.
-#include "can/socketcand_codec.hpp"
+#include "axon/can/socketcand_codec.hpp"
 
 #include <cstdint>
 #include <cstdlib>

@@ -4,20 +4,20 @@
 // start, an exception, a closed stdout, Ctrl-C/SIGTERM/SIGHUP) the board gets zero current and is
 // disabled, and the disable's result decides the exit code. Tables and results go to stdout (JSON
 // Lines with --json), logs to stderr.
-#include "blmc/host/board.hpp"
-#include "blmc/host/control_loop.hpp"
-#include "blmc/host/error.hpp"
-#include "blmc/host/homing.hpp"
-#include "blmc/host/motor_session.hpp"
-#include "blmc/host/pd_controller.hpp"
-#include "blmc/protocol/command.hpp"
-#include "blmc/protocol/frames.hpp"
-#include "can/bus_spec.hpp"
-#include "can/candump_log.hpp"
-#include "can/open.hpp"
+#include "axon/blmc/host/board.hpp"
+#include "axon/blmc/host/control_loop.hpp"
+#include "axon/blmc/host/error.hpp"
+#include "axon/blmc/host/homing.hpp"
+#include "axon/blmc/host/motor_session.hpp"
+#include "axon/blmc/host/pd_controller.hpp"
+#include "axon/blmc/protocol/command.hpp"
+#include "axon/blmc/protocol/frames.hpp"
+#include "axon/can/bus_spec.hpp"
+#include "axon/can/candump_log.hpp"
+#include "axon/can/open.hpp"
 #include "checks.hpp"
 #include "commands.hpp"
-#include "core/wakeup.hpp"
+#include "axon/core/wakeup.hpp"
 #include "run.hpp"
 
 #include <boost/asio/detached.hpp>

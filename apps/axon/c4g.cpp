@@ -1,25 +1,25 @@
 // `axon c4g`: the PC side of the robot controller's open interface.
-//   serve      runs a c4g::host::Server with one of the built-in applications (src/c4g/apps)
+//   serve      runs a c4g::host::Server with one of the built-in applications (src/axon/c4g/apps)
 //   init-info  prints an initialization packet from a 1200-byte file or from a capture
 // The ready line `listening c4g HOST:PORT`, events and status lines go to stdout; logs to stderr.
 // With --json, stdout carries one JSON document and nothing else: the lines go to stderr.
-#include "c4g/apps/app.hpp"
-#include "c4g/apps/contribute.hpp"
-#include "c4g/apps/correct.hpp"
-#include "c4g/apps/echo.hpp"
-#include "c4g/apps/handover.hpp"
-#include "c4g/apps/moni.hpp"
-#include "c4g/apps/monitor.hpp"
-#include "c4g/apps/pid.hpp"
-#include "c4g/apps/stream.hpp"
-#include "c4g/apps/trajectory.hpp"
-#include "c4g/host/server.hpp"
-#include "c4g/protocol/axis_map.hpp"
-#include "c4g/protocol/init_packet.hpp"
+#include "axon/c4g/apps/app.hpp"
+#include "axon/c4g/apps/contribute.hpp"
+#include "axon/c4g/apps/correct.hpp"
+#include "axon/c4g/apps/echo.hpp"
+#include "axon/c4g/apps/handover.hpp"
+#include "axon/c4g/apps/moni.hpp"
+#include "axon/c4g/apps/monitor.hpp"
+#include "axon/c4g/apps/pid.hpp"
+#include "axon/c4g/apps/stream.hpp"
+#include "axon/c4g/apps/trajectory.hpp"
+#include "axon/c4g/host/server.hpp"
+#include "axon/c4g/protocol/axis_map.hpp"
+#include "axon/c4g/protocol/init_packet.hpp"
 #include "checks.hpp"
 #include "rotation_options.hpp"
 #include "commands.hpp"
-#include "net/endpoint.hpp"
+#include "axon/net/endpoint.hpp"
 #include "run.hpp"
 #include "stop_signals.hpp"
 

@@ -1,15 +1,15 @@
 // `axon can ...`: dump, send, bridge and replay, on any transport (can/bus_spec.hpp).
-#include "can/bus_spec.hpp"
-#include "can/candump_log.hpp"
-#include "can/cannet_server.hpp"
-#include "can/open.hpp"
-#include "can/relay.hpp"
-#include "can/socketcand_server.hpp"
-#include "can/virtual_bus.hpp"
+#include "axon/can/bus_spec.hpp"
+#include "axon/can/candump_log.hpp"
+#include "axon/can/cannet_server.hpp"
+#include "axon/can/open.hpp"
+#include "axon/can/relay.hpp"
+#include "axon/can/socketcand_server.hpp"
+#include "axon/can/virtual_bus.hpp"
 #include "checks.hpp"
 #include "rotation_options.hpp"
 #include "commands.hpp"
-#include "core/clock.hpp"
+#include "axon/core/clock.hpp"
 #include "run.hpp"
 
 #include <boost/asio/detached.hpp>

@@ -1,10 +1,10 @@
 // `axon demo`: runs what axon can do today against its embedded simulators and says what happened.
 // It grows with every device family.
-#include "can/cannet_client.hpp"
-#include "can/cannet_server.hpp"
-#include "can/socketcand_client.hpp"
-#include "can/socketcand_server.hpp"
-#include "can/virtual_bus.hpp"
+#include "axon/can/cannet_client.hpp"
+#include "axon/can/cannet_server.hpp"
+#include "axon/can/socketcand_client.hpp"
+#include "axon/can/socketcand_server.hpp"
+#include "axon/can/virtual_bus.hpp"
 #include "commands.hpp"
 #include "demo_fps.hpp"
 #include "demo_parts.hpp"

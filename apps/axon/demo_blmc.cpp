@@ -1,13 +1,13 @@
 // `axon demo`, blmc part: a simulated dual motor driver board on the in-process virtual bus, both
 // motors under PD control at 1 kHz in the real-time ControlLoop following a sine; then the
 // tracking error, the loop's timing and the board's state after the motors were disabled.
-#include "blmc/host/board.hpp"
-#include "blmc/host/control_loop.hpp"
-#include "blmc/host/motor_session.hpp"
-#include "blmc/host/pd_controller.hpp"
-#include "blmc/sim/runner.hpp"
-#include "can/virtual_bus.hpp"
-#include "core/wakeup.hpp"
+#include "axon/blmc/host/board.hpp"
+#include "axon/blmc/host/control_loop.hpp"
+#include "axon/blmc/host/motor_session.hpp"
+#include "axon/blmc/host/pd_controller.hpp"
+#include "axon/blmc/sim/runner.hpp"
+#include "axon/can/virtual_bus.hpp"
+#include "axon/core/wakeup.hpp"
 #include "demo_parts.hpp"
 #include "run.hpp"
 

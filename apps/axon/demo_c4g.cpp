@@ -2,15 +2,15 @@
 // mode 4, waits for the PC, closes) against the PC server playing a short joint trajectory, both in
 // this process over UDP on loopback; then the reply round trip is set beside a plain UDP echo on
 // the same kind of socket, measured in the same run.
-#include "c4g/apps/stream.hpp"
-#include "c4g/host/server.hpp"
-#include "c4g/sim/client_runner.hpp"
-#include "c4g/sim/robots.hpp"
-#include "c4g/sim/scenario.hpp"
-#include "c4g/sim/udp_client.hpp"
-#include "core/text.hpp"
+#include "axon/c4g/apps/stream.hpp"
+#include "axon/c4g/host/server.hpp"
+#include "axon/c4g/sim/client_runner.hpp"
+#include "axon/c4g/sim/robots.hpp"
+#include "axon/c4g/sim/scenario.hpp"
+#include "axon/c4g/sim/udp_client.hpp"
+#include "axon/core/text.hpp"
 #include "demo_parts.hpp"
-#include "net/udp_echo.hpp"
+#include "axon/net/udp_echo.hpp"
 #include "run.hpp"
 
 #include <fmt/format.h>

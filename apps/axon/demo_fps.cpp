@@ -3,20 +3,20 @@
 // check, discovery, the cold policy from the PLC, status sweep, a fold, then a collision-free random reconfiguration of every
 // robot from the path planner, both started by the PLC's sync line, final positions and the
 // simulator's collision count verified, each phase timed against the wire time of its busiest bus.
-// The simulated plane runs on a thread of its own (sim_thread.hpp), the host on the caller's.
+// The simulated plane runs on a thread of its own (core::LoopThread), the host on the caller's.
 #include "demo_fps.hpp"
-#include "core/progress.hpp"
+#include "axon/core/progress.hpp"
 
-#include "fps/host/cold_control.hpp"
-#include "fps/host/focal_plane_array.hpp"
-#include "fps/plan/layout_model.hpp"
-#include "fps/plan/planner.hpp"
-#include "fps/plan/problems.hpp"
-#include "fps/sim/focal_plane_sim.hpp"
+#include "axon/fps/host/cold_control.hpp"
+#include "axon/fps/host/focal_plane_array.hpp"
+#include "axon/fps/plan/layout_model.hpp"
+#include "axon/fps/plan/planner.hpp"
+#include "axon/fps/plan/problems.hpp"
+#include "axon/fps/sim/focal_plane_sim.hpp"
 #include "layout_name.hpp"
 #include "fps_stop.hpp"
 #include "run.hpp"
-#include "sim_thread.hpp"
+#include "axon/core/loop_thread.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
@@ -103,10 +103,10 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
   fps::sim::FocalPlaneSimOptions so;
   so.simulator.time_scale = kTimeScale;
   so.seed = 7;
-  SimThread sim_thread;
+  core::LoopThread sim_thread;
   auto sim = sim_thread.call([&] { return need(fps::sim::FocalPlaneSimulator::start(sim_thread.executor(), plane, so)); });
   struct StopSim {
-    SimThread& t;
+    core::LoopThread& t;
     fps::sim::FocalPlaneSimulator& s;
     ~StopSim() {
       t.call([this] { s.stop(); });

@@ -1,20 +1,20 @@
 // `axon fps ...`: fiber positioners on one or more CAN buses, through the host driver
 // (docs/fps-host.md). Every subcommand opens the buses, discovers the robots, does its job and
 // closes; data goes to stdout (text or --json), progress and logs to stderr.
-#include "can/bus_spec.hpp"
-#include "can/cannet_client.hpp"
-#include "can/open.hpp"
+#include "axon/can/bus_spec.hpp"
+#include "axon/can/cannet_client.hpp"
+#include "axon/can/open.hpp"
 #include "commands.hpp"
 #include "fps_array.hpp"
 #include "fps_stop.hpp"
 #include "checks.hpp"
-#include "core/config.hpp"
-#include "fps/host/array.hpp"
-#include "fps/protocol/commands.hpp"
-#include "fps/protocol/response.hpp"
-#include "fps/protocol/trajectory.hpp"
+#include "axon/core/config.hpp"
+#include "axon/fps/host/array.hpp"
+#include "axon/fps/protocol/commands.hpp"
+#include "axon/fps/protocol/response.hpp"
+#include "axon/fps/protocol/trajectory.hpp"
 #include "id_list.hpp"
-#include "net/endpoint.hpp"
+#include "axon/net/endpoint.hpp"
 #include "run.hpp"
 
 #include <fmt/format.h>

@@ -2,7 +2,7 @@
 // options (--gateway, --socketcand, --bus, --config, --timeout) select, after discovery.
 #pragma once
 
-#include "fps/host/array.hpp"
+#include "axon/fps/host/array.hpp"
 
 #include <boost/asio/awaitable.hpp>
 

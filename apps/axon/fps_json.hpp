@@ -1,7 +1,7 @@
 // JSON of fps results shared by several `axon fps` subcommands (fps_layout.cpp, fps_plane.cpp).
 #pragma once
 
-#include "fps/layout/layout_check.hpp"
+#include "axon/fps/layout/layout_check.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,15 +1,15 @@
 // `axon fps layout ...`: the focal-plane layout file (docs/fps-layout.md): generate the default,
 // summarise one, check one against the robots that answer on the buses.
-#include "can/bus_spec.hpp"
-#include "can/cannet_client.hpp"
+#include "axon/can/bus_spec.hpp"
+#include "axon/can/cannet_client.hpp"
 #include "commands.hpp"
 #include "fps_json.hpp"
-#include "fps/host/command_client.hpp"
-#include "fps/layout/layout_check.hpp"
-#include "fps/layout/layout_file.hpp"
-#include "fps/layout/layout_generator.hpp"
-#include "fps/layout/layout_sweep.hpp"
-#include "net/endpoint.hpp"
+#include "axon/fps/host/command_client.hpp"
+#include "axon/fps/layout/layout_check.hpp"
+#include "axon/fps/layout/layout_file.hpp"
+#include "axon/fps/layout/layout_generator.hpp"
+#include "axon/fps/host/layout_sweep.hpp"
+#include "axon/net/endpoint.hpp"
 #include "run.hpp"
 
 #include <fmt/format.h>

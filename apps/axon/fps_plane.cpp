@@ -3,18 +3,18 @@
 // broadcast or by the sync line, firmware upgrade, the cold policy and correction iterations after
 // a measurement of the fibres.
 #include "commands.hpp"
-#include "fps/host/focal_plane_array.hpp"
-#include "fps/host/cold_control.hpp"
-#include "fps/host/plane_correct.hpp"
-#include "fps/host/plane_upgrade.hpp"
-#include "fps/host/trajectory_speed.hpp"
+#include "axon/fps/host/focal_plane_array.hpp"
+#include "axon/fps/host/cold_control.hpp"
+#include "axon/fps/host/plane_correct.hpp"
+#include "axon/fps/host/plane_upgrade.hpp"
+#include "axon/fps/host/trajectory_speed.hpp"
 #include "checks.hpp"
 #include "fps_json.hpp"
 #include "fps_stop.hpp"
-#include "fps/plan/layout_model.hpp"
+#include "axon/fps/plan/layout_model.hpp"
 #include "layout_name.hpp"
-#include "net/endpoint.hpp"
-#include "core/progress.hpp"
+#include "axon/net/endpoint.hpp"
+#include "axon/core/progress.hpp"
 #include "run.hpp"
 
 #include <fmt/format.h>

@@ -2,10 +2,10 @@
 // relays for sextant power, gateway power and the sync line; temperatures, humidity, pressure,
 // coolant flow; the cold-temperature policy those temperatures call for.
 #include "commands.hpp"
-#include "core/config.hpp"
-#include "fps/plc/client.hpp"
-#include "fps/plc/cold_policy.hpp"
-#include "net/endpoint.hpp"
+#include "axon/core/config.hpp"
+#include "axon/fps/plc/client.hpp"
+#include "axon/fps/plc/cold_policy.hpp"
+#include "axon/net/endpoint.hpp"
 #include "run.hpp"
 
 #include <fmt/format.h>

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "exit_codes.hpp"
-#include "fps/host/array.hpp"
+#include "axon/fps/host/array.hpp"
 
 #include <fmt/format.h>
 

@@ -1,7 +1,7 @@
 // Robot id lists on the command line: "1-20", "3", "1,4,7-9".
 #pragma once
 
-#include "core/error.hpp"
+#include "axon/core/error.hpp"
 
 #include <fmt/format.h>
 

@@ -2,9 +2,9 @@
 // data/layouts; `default` is also generated when the data directory is not there).
 #pragma once
 
-#include "fps/layout/focal_plane.hpp"
-#include "fps/layout/layout_file.hpp"
-#include "fps/layout/layout_generator.hpp"
+#include "axon/fps/layout/focal_plane.hpp"
+#include "axon/fps/layout/layout_file.hpp"
+#include "axon/fps/layout/layout_generator.hpp"
 
 #include <filesystem>
 #include <string>

@@ -1,7 +1,7 @@
 // axon: command-line entry point. Subcommand groups live in their own files (can.cpp, demo.cpp, ...).
 #include "commands.hpp"
-#include "core/error.hpp"
-#include "core/log.hpp"
+#include "axon/core/error.hpp"
+#include "axon/core/log.hpp"
 #include "exit_codes.hpp"
 
 #include <fmt/format.h>

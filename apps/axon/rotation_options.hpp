@@ -3,7 +3,7 @@
 #pragma once
 
 #include "checks.hpp"
-#include "core/rotating_file.hpp"
+#include "axon/core/rotating_file.hpp"
 
 #include <CLI/CLI.hpp>
 

@@ -1,7 +1,7 @@
 // Running a command's coroutine on its own io_context, with Ctrl-C handling.
 #pragma once
 
-#include "core/error.hpp"
+#include "axon/core/error.hpp"
 #include "exit_codes.hpp"
 
 #include <boost/asio/co_spawn.hpp>

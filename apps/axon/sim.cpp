@@ -3,21 +3,21 @@
 // the host software in service) can drive them.
 // `axon sim blmc`: simulated motor driver boards, one per virtual bus (can0, can1 ...), served the
 // same way over socketcand.
-#include "blmc/sim/board_config.hpp"
-#include "blmc/sim/fault_plan.hpp"
-#include "blmc/sim/runner.hpp"
-#include "can/bus_spec.hpp"
-#include "can/cannet_server.hpp"
-#include "can/socketcand_server.hpp"
-#include "can/virtual_bus.hpp"
+#include "axon/blmc/sim/board_config.hpp"
+#include "axon/blmc/sim/fault_plan.hpp"
+#include "axon/blmc/sim/runner.hpp"
+#include "axon/can/bus_spec.hpp"
+#include "axon/can/cannet_server.hpp"
+#include "axon/can/socketcand_server.hpp"
+#include "axon/can/virtual_bus.hpp"
 #include "checks.hpp"
 #include "commands.hpp"
-#include "core/config.hpp"
-#include "fps/sim/focal_plane_sim.hpp"
-#include "fps/sim/simulator_config.hpp"
+#include "axon/core/config.hpp"
+#include "axon/fps/sim/focal_plane_sim.hpp"
+#include "axon/fps/sim/simulator_config.hpp"
 #include "id_list.hpp"
 #include "layout_name.hpp"
-#include "net/endpoint.hpp"
+#include "axon/net/endpoint.hpp"
 #include "run.hpp"
 
 #include <boost/asio/redirect_error.hpp>

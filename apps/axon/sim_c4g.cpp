@@ -1,15 +1,15 @@
 // `axon sim c4g`: a simulated C4G robot controller that plays a robot program (scenario) and talks
 // to a PC server over the open interface's UDP protocol, as the real controller would.
-#include "c4g/host/server.hpp"
-#include "c4g/sim/client_runner.hpp"
-#include "c4g/sim/controller.hpp"
-#include "c4g/sim/robots.hpp"
-#include "c4g/sim/scenario.hpp"
-#include "c4g/sim/udp_client.hpp"
+#include "axon/c4g/host/server.hpp"
+#include "axon/c4g/sim/client_runner.hpp"
+#include "axon/c4g/sim/controller.hpp"
+#include "axon/c4g/sim/robots.hpp"
+#include "axon/c4g/sim/scenario.hpp"
+#include "axon/c4g/sim/udp_client.hpp"
 #include "checks.hpp"
 #include "exit_codes.hpp"
 #include "commands.hpp"
-#include "net/endpoint.hpp"
+#include "axon/net/endpoint.hpp"
 #include "run.hpp"
 #include "stop_signals.hpp"
 

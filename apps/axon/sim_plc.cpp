@@ -2,10 +2,10 @@
 // optional scripted sensor values. Relay changes are logged; prints `listening plc HOST:PORT`
 // once it accepts connections.
 #include "commands.hpp"
-#include "core/clock.hpp"
-#include "core/config.hpp"
-#include "fps/plc/emulator.hpp"
-#include "net/endpoint.hpp"
+#include "axon/core/clock.hpp"
+#include "axon/core/config.hpp"
+#include "axon/fps/plc/emulator.hpp"
+#include "axon/net/endpoint.hpp"
 #include "run.hpp"
 
 #include <boost/asio/redirect_error.hpp>

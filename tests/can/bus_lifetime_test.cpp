@@ -1,6 +1,6 @@
 // A receive() still waiting when its bus and then its io_context go away (a program torn down with
 // work pending) must not touch the destroyed bus. The sanitizer build turns a violation into a failure.
-#include "can/virtual_bus.hpp"
+#include "axon/can/virtual_bus.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>

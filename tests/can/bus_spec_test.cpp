@@ -1,4 +1,4 @@
-#include "can/bus_spec.hpp"
+#include "axon/can/bus_spec.hpp"
 
 #include <gtest/gtest.h>
 

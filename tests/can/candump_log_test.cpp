@@ -1,4 +1,4 @@
-#include "can/candump_log.hpp"
+#include "axon/can/candump_log.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

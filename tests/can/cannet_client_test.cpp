@@ -1,9 +1,9 @@
 // CanNetGateway against the emulator on loopback, over virtual buses: what a host relies on when
 // it drives CAN buses through a CAN@net gateway.
-#include "can/cannet_client.hpp"
-#include "can/cannet_server.hpp"
-#include "can/open.hpp"
-#include "can/virtual_bus.hpp"
+#include "axon/can/cannet_client.hpp"
+#include "axon/can/cannet_server.hpp"
+#include "axon/can/open.hpp"
+#include "axon/can/virtual_bus.hpp"
 
 #include "can/cannet_harness.hpp"
 #include "frame_text.hpp"

@@ -1,6 +1,6 @@
 // The CAN@net ASCII line codec: every line type parsed and formatted, and malformed lines rejected
 // with a message that says what is wrong.
-#include "can/cannet_codec.hpp"
+#include "axon/can/cannet_codec.hpp"
 
 #include <gtest/gtest.h>
 

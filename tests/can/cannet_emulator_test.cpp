@@ -1,7 +1,7 @@
 // The CAN@net gateway emulator seen from the wire: the exact lines it answers to a bare TCP
 // client, and what it forwards between that client and a virtual bus.
-#include "can/cannet_server.hpp"
-#include "can/virtual_bus.hpp"
+#include "axon/can/cannet_server.hpp"
+#include "axon/can/virtual_bus.hpp"
 
 #include "can/cannet_harness.hpp"
 #include "frame_text.hpp"

@@ -3,8 +3,8 @@
 // lines, no interpretation).
 #pragma once
 
-#include "can/cannet_codec.hpp"
-#include "net/endpoint.hpp"
+#include "axon/can/cannet_codec.hpp"
+#include "axon/net/endpoint.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/connect.hpp>

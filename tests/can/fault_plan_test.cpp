@@ -1,6 +1,6 @@
 // Fault plans: reading them from YAML (with errors that point at the offending line) and the
 // injector's decisions, frame by frame.
-#include "can/fault_plan.hpp"
+#include "axon/can/fault_plan.hpp"
 #include "frame_text.hpp"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-#include "can/frame.hpp"
+#include "axon/can/frame.hpp"
 
 #include <gtest/gtest.h>
 

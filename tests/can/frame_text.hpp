@@ -1,7 +1,7 @@
 // A CAN frame from its cansend notation ("123#DEADBEEF"), for tests: a bad string fails loudly.
 #pragma once
 
-#include "can/frame.hpp"
+#include "axon/can/frame.hpp"
 
 namespace axon::can::test {
 

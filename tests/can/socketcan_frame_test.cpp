@@ -1,5 +1,5 @@
 // The struct can_frame codec, checked against records built with the kernel's own header.
-#include "can/socketcan_frame.hpp"
+#include "axon/can/socketcan_frame.hpp"
 
 #include <gtest/gtest.h>
 #include <linux/can.h>

@@ -1,6 +1,6 @@
 // SocketCanBus over a socketpair standing in for the kernel's CAN_RAW socket: the test writes and
 // reads raw struct can_frame records on the other end. Plus open() on this machine's kernel.
-#include "can/socketcan_bus.hpp"
+#include "axon/can/socketcan_bus.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>

@@ -1,9 +1,9 @@
 // SocketcandBus against axon's server over a virtual bus, and against scripted fake servers that
 // misbehave in chosen ways.
-#include "can/socketcand_client.hpp"
+#include "axon/can/socketcand_client.hpp"
 
-#include "can/socketcand_server.hpp"
-#include "can/virtual_bus.hpp"
+#include "axon/can/socketcand_server.hpp"
+#include "axon/can/virtual_bus.hpp"
 #include "socketcand_test_util.hpp"
 #include "frame_text.hpp"
 

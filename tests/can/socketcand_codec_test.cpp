@@ -1,4 +1,4 @@
-#include "can/socketcand_codec.hpp"
+#include "axon/can/socketcand_codec.hpp"
 
 #include <gtest/gtest.h>
 

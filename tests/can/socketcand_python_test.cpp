@@ -1,7 +1,7 @@
 // Interoperability: Debian's python-can 4.1 socketcand client (a child process running
 // tests/integration/python_can_socketcand.py --connect) against the server over a virtual bus.
-#include "can/socketcand_server.hpp"
-#include "can/virtual_bus.hpp"
+#include "axon/can/socketcand_server.hpp"
+#include "axon/can/virtual_bus.hpp"
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>

@@ -1,8 +1,8 @@
 // The socketcand server as a client sees it on the wire: exact text, modes, errors, several clients.
-#include "can/socketcand_server.hpp"
+#include "axon/can/socketcand_server.hpp"
 
-#include "can/socketcand_codec.hpp"
-#include "can/virtual_bus.hpp"
+#include "axon/can/socketcand_codec.hpp"
+#include "axon/can/virtual_bus.hpp"
 #include "socketcand_test_util.hpp"
 #include "frame_text.hpp"
 

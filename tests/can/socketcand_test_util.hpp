@@ -2,7 +2,7 @@
 // speaks the protocol byte by byte (to check exactly what the other side writes).
 #pragma once
 
-#include "can/socketcand_codec.hpp"
+#include "axon/can/socketcand_codec.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/connect.hpp>

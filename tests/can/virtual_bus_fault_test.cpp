@@ -1,5 +1,5 @@
 // A fault plan applied by the virtual bus: what the receivers get and what the medium counts.
-#include "can/virtual_bus.hpp"
+#include "axon/can/virtual_bus.hpp"
 #include "frame_text.hpp"
 
 #include <boost/asio/co_spawn.hpp>

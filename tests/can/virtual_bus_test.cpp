@@ -1,6 +1,6 @@
 // The virtual bus as its users see it: who receives what, in which order, and what happens when
 // queues overflow or nodes go away.
-#include "can/virtual_bus.hpp"
+#include "axon/can/virtual_bus.hpp"
 #include "frame_text.hpp"
 
 #include <boost/asio/co_spawn.hpp>

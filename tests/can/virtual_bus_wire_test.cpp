@@ -1,6 +1,6 @@
 // The virtual bus's wire model: exact bit accounting, real-time pacing and its effect on senders.
 // No upper bounds on time anywhere: the machine may be slow, it can never be faster than the wire.
-#include "can/virtual_bus.hpp"
+#include "axon/can/virtual_bus.hpp"
 #include "frame_text.hpp"
 
 #include <boost/asio/co_spawn.hpp>

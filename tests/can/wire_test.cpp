@@ -1,6 +1,6 @@
 // Frame lengths on the wire. Expected values were worked out bit by bit (the simple cases by hand
 // in the comments, the rest with an independent polynomial-division CRC and stuffing count).
-#include "can/wire.hpp"
+#include "axon/can/wire.hpp"
 #include "frame_text.hpp"
 
 #include <gtest/gtest.h>

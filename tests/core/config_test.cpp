@@ -1,4 +1,4 @@
-#include "core/config.hpp"
+#include "axon/core/config.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
-#include "core/clock.hpp"
-#include "core/error.hpp"
-#include "core/log.hpp"
-#include "core/realtime.hpp"
+#include "axon/core/clock.hpp"
+#include "axon/core/error.hpp"
+#include "axon/core/log.hpp"
+#include "axon/core/realtime.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // DeadlineQueue: one timer for the deadlines of many clients on one execution context.
-#include "core/deadline_queue.hpp"
+#include "axon/core/deadline_queue.hpp"
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>

@@ -1,5 +1,5 @@
 // HeaderTable: the header-first text tables of target and measurement files.
-#include "core/header_table.hpp"
+#include "axon/core/header_table.hpp"
 
 #include <gtest/gtest.h>
 

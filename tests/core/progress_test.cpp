@@ -1,4 +1,4 @@
-#include "core/progress.hpp"
+#include "axon/core/progress.hpp"
 
 #include <gtest/gtest.h>
 

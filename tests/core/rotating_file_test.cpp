@@ -1,5 +1,5 @@
 // Recording files with limits: what lands in NAME, NAME.1, ... after size and age rotations.
-#include "core/rotating_file.hpp"
+#include "axon/core/rotating_file.hpp"
 
 #include <gtest/gtest.h>
 

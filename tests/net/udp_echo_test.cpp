@@ -1,4 +1,4 @@
-#include "net/udp_echo.hpp"
+#include "axon/net/udp_echo.hpp"
 
 #include <gtest/gtest.h>
 

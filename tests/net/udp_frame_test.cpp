@@ -1,4 +1,4 @@
-#include "net/udp_frame.hpp"
+#include "axon/net/udp_frame.hpp"
 
 #include <gtest/gtest.h>
 

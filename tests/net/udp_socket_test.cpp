@@ -1,4 +1,4 @@
-#include "net/udp_socket.hpp"
+#include "axon/net/udp_socket.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>

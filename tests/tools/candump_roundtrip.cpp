@@ -5,7 +5,7 @@
 //
 // The python test holds its own copy of the fixed set, so a mistake here cannot hide one in the
 // library. Exit status: 0 on success, 2 when the file cannot be written or read (the error on stderr).
-#include "can/candump_log.hpp"
+#include "axon/can/candump_log.hpp"
 
 #include <fmt/format.h>
 

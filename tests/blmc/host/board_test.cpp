@@ -1,6 +1,6 @@
 // Board against a scripted peer on the in-process virtual bus.
-#include "blmc/host/board.hpp"
-#include "blmc/host/error.hpp"
+#include "axon/blmc/host/board.hpp"
+#include "axon/blmc/host/error.hpp"
 #include "rig.hpp"
 
 #include <gtest/gtest.h>

@@ -1,8 +1,8 @@
 // ControlLoop without a bus: ports fed by hand, cycles run with step() and a manual clock, and one
 // run of the real thread that asserts behaviour only (no timing).
-#include "blmc/host/control_loop.hpp"
-#include "blmc/host/homing.hpp"
-#include "blmc/host/pd_controller.hpp"
+#include "axon/blmc/host/control_loop.hpp"
+#include "axon/blmc/host/homing.hpp"
+#include "axon/blmc/host/pd_controller.hpp"
 #include "rig.hpp"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-#include "blmc/host/error.hpp"
+#include "axon/blmc/host/error.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "blmc/host/loop_timing.hpp"
+#include "axon/blmc/host/loop_timing.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // MotorSession and with_motors_enabled against the board simulator on the in-process virtual bus:
 // whatever way the work with the motors ends, the simulated firmware ends with the system and both
 // motors off and a zero current reference, and the caller gets the disable's result.
-#include "blmc/host/error.hpp"
-#include "blmc/host/motor_session.hpp"
+#include "axon/blmc/host/error.hpp"
+#include "axon/blmc/host/motor_session.hpp"
 #include "sim_rig.hpp"
 
 #include <gtest/gtest.h>

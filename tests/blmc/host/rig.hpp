@@ -2,9 +2,9 @@
 // node (not a simulator: the test decides what the "board" answers to each frame).
 #pragma once
 
-#include "blmc/protocol/frames.hpp"
-#include "can/virtual_bus.hpp"
-#include "core/wakeup.hpp"
+#include "axon/blmc/protocol/frames.hpp"
+#include "axon/can/virtual_bus.hpp"
+#include "axon/core/wakeup.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>

@@ -1,4 +1,4 @@
-#include "blmc/host/safety.hpp"
+#include "axon/blmc/host/safety.hpp"
 
 #include <gtest/gtest.h>
 

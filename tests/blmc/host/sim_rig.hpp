@@ -1,9 +1,9 @@
-// The host driver against the board simulator (src/blmc/sim) on the in-process virtual bus: the
+// The host driver against the board simulator (src/axon/blmc/sim) on the in-process virtual bus: the
 // simulator ticks at 1 kHz on the test's io thread; a ControlLoop runs on its own thread.
 #pragma once
 
-#include "blmc/host/control_loop.hpp"
-#include "blmc/sim/runner.hpp"
+#include "axon/blmc/host/control_loop.hpp"
+#include "axon/blmc/sim/runner.hpp"
 #include "rig.hpp"
 
 namespace axon::blmc::host::testing {

@@ -1,11 +1,11 @@
-// The host driver against the board simulator (src/blmc/sim) on the in-process virtual bus: the
+// The host driver against the board simulator (src/axon/blmc/sim) on the in-process virtual bus: the
 // simulator ticks at 1 kHz on the test's io thread, the ControlLoop runs on its own thread.
 // Assertions are about behaviour; bounds on tracking error are generous for a loaded machine.
-#include "blmc/host/board.hpp"
-#include "blmc/host/control_loop.hpp"
-#include "blmc/host/error.hpp"
-#include "blmc/host/homing.hpp"
-#include "blmc/host/pd_controller.hpp"
+#include "axon/blmc/host/board.hpp"
+#include "axon/blmc/host/control_loop.hpp"
+#include "axon/blmc/host/error.hpp"
+#include "axon/blmc/host/homing.hpp"
+#include "axon/blmc/host/pd_controller.hpp"
 #include "sim_rig.hpp"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
-#include "blmc/protocol/command.hpp"
+#include "axon/blmc/protocol/command.hpp"
 
-#include "blmc/protocol/error.hpp"
+#include "axon/blmc/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-#include "blmc/protocol/frames.hpp"
+#include "axon/blmc/protocol/frames.hpp"
 
-#include "blmc/protocol/error.hpp"
+#include "axon/blmc/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "blmc/protocol/message_id.hpp"
+#include "axon/blmc/protocol/message_id.hpp"
 
 #include <gtest/gtest.h>
 

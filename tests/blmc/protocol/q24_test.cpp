@@ -1,6 +1,6 @@
-#include "blmc/protocol/q24.hpp"
+#include "axon/blmc/protocol/q24.hpp"
 
-#include "blmc/protocol/error.hpp"
+#include "axon/blmc/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-#include "blmc/protocol/status.hpp"
+#include "axon/blmc/protocol/status.hpp"
 
-#include "blmc/protocol/error.hpp"
+#include "axon/blmc/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

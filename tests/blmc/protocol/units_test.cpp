@@ -1,6 +1,6 @@
-#include "blmc/protocol/units.hpp"
+#include "axon/blmc/protocol/units.hpp"
 
-#include "blmc/protocol/error.hpp"
+#include "axon/blmc/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

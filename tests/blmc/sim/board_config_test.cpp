@@ -1,5 +1,5 @@
 // Board and motor configuration from YAML.
-#include "blmc/sim/board_config.hpp"
+#include "axon/blmc/sim/board_config.hpp"
 
 #include <gtest/gtest.h>
 

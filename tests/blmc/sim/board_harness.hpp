@@ -2,9 +2,9 @@
 // milliseconds, everything the board sent decoded with the protocol codec.
 #pragma once
 
-#include "blmc/protocol/command.hpp"
-#include "blmc/protocol/frames.hpp"
-#include "blmc/sim/board.hpp"
+#include "axon/blmc/protocol/command.hpp"
+#include "axon/blmc/protocol/frames.hpp"
+#include "axon/blmc/sim/board.hpp"
 
 #include <gtest/gtest.h>
 

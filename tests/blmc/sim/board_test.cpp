@@ -2,8 +2,8 @@
 // malformed input. Time is passed by hand; frames are decoded with the protocol codec.
 #include "board_harness.hpp"
 
-#include "blmc/protocol/message_id.hpp"
-#include "blmc/protocol/units.hpp"
+#include "axon/blmc/protocol/message_id.hpp"
+#include "axon/blmc/protocol/units.hpp"
 
 #include <gtest/gtest.h>
 

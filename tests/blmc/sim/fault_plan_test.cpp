@@ -1,7 +1,7 @@
 // Fault plans: YAML form, events at their time, stalled and lossy links.
 #include "board_harness.hpp"
 
-#include "core/config.hpp"
+#include "axon/core/config.hpp"
 
 #include <gtest/gtest.h>
 

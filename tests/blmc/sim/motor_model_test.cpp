@@ -1,6 +1,6 @@
 // MotorModel: the physics a host driver relies on (acceleration, friction, limits, encoder).
-#include "blmc/protocol/units.hpp"
-#include "blmc/sim/motor_model.hpp"
+#include "axon/blmc/protocol/units.hpp"
+#include "axon/blmc/sim/motor_model.hpp"
 
 #include <gtest/gtest.h>
 

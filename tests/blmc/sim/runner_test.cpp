@@ -1,8 +1,8 @@
 // Runner: boards on virtual buses, driven by a manual clock; a host node on each bus.
-#include "blmc/protocol/command.hpp"
-#include "blmc/protocol/frames.hpp"
-#include "blmc/sim/runner.hpp"
-#include "can/virtual_bus.hpp"
+#include "axon/blmc/protocol/command.hpp"
+#include "axon/blmc/protocol/frames.hpp"
+#include "axon/blmc/sim/runner.hpp"
+#include "axon/can/virtual_bus.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>

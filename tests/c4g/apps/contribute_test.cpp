@@ -1,4 +1,4 @@
-#include "c4g/apps/contribute.hpp"
+#include "axon/c4g/apps/contribute.hpp"
 
 #include "harness.hpp"
 

@@ -1,4 +1,4 @@
-#include "c4g/apps/correct.hpp"
+#include "axon/c4g/apps/correct.hpp"
 
 #include "harness.hpp"
 

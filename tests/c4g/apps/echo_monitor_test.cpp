@@ -1,5 +1,5 @@
-#include "c4g/apps/echo.hpp"
-#include "c4g/apps/monitor.hpp"
+#include "axon/c4g/apps/echo.hpp"
+#include "axon/c4g/apps/monitor.hpp"
 
 #include "harness.hpp"
 

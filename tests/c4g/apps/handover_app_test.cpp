@@ -1,5 +1,5 @@
 // HandoverApp: every open phase of a program served in turn, with synthetic packets.
-#include "c4g/apps/handover.hpp"
+#include "axon/c4g/apps/handover.hpp"
 
 #include "harness.hpp"
 

@@ -2,11 +2,11 @@
 // and on_cycle are called directly with a reply pre-filled like the server's safe reply.
 #pragma once
 
-#include "c4g/apps/app.hpp"
-#include "c4g/protocol/axis_map.hpp"
+#include "axon/c4g/apps/app.hpp"
+#include "axon/c4g/protocol/axis_map.hpp"
 #include "c4g/protocol/example_init.hpp"
-#include "c4g/protocol/mode.hpp"
-#include "c4g/protocol/transform.hpp"
+#include "axon/c4g/protocol/mode.hpp"
+#include "axon/c4g/protocol/transform.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "c4g/apps/moni.hpp"
+#include "axon/c4g/apps/moni.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,12 +4,12 @@
 // Bounds (motor turns, all six axes): mode 1 hold and mode 2 hold within kHoldBound, a 0.5 deg /
 // 1 Hz sine on every joint in mode 1 within kSineBound, the controller's 3 deg move in mode 2 within
 // kMoveBound; no current saturation, and every mode is left cleanly.
-#include "c4g/apps/pid.hpp"
-#include "c4g/host/safety.hpp"
-#include "c4g/protocol/mode.hpp"
-#include "c4g/sim/controller.hpp"
-#include "c4g/sim/robots.hpp"
-#include "c4g/sim/scenario.hpp"
+#include "axon/c4g/apps/pid.hpp"
+#include "axon/c4g/host/safety.hpp"
+#include "axon/c4g/protocol/mode.hpp"
+#include "axon/c4g/sim/controller.hpp"
+#include "axon/c4g/sim/robots.hpp"
+#include "axon/c4g/sim/scenario.hpp"
 #include "sim_loop.hpp"
 
 #include <gtest/gtest.h>

@@ -6,12 +6,12 @@
 //   - on the simulated six-axis robot, tick by tick, switching into and out of modes 1 and 2 keeps
 //     every axis within kStillBound motor turns of where the switch started and every reference
 //     current within kCurrentBound, with the reducer in the controller (default) or in the PC.
-#include "c4g/apps/pid.hpp"
-#include "c4g/host/safety.hpp"
-#include "c4g/host/switch_tracker.hpp"
-#include "c4g/protocol/mode.hpp"
-#include "c4g/sim/controller.hpp"
-#include "c4g/sim/robots.hpp"
+#include "axon/c4g/apps/pid.hpp"
+#include "axon/c4g/host/safety.hpp"
+#include "axon/c4g/host/switch_tracker.hpp"
+#include "axon/c4g/protocol/mode.hpp"
+#include "axon/c4g/sim/controller.hpp"
+#include "axon/c4g/sim/robots.hpp"
 #include "harness.hpp"
 #include "sim_loop.hpp"
 

@@ -1,4 +1,4 @@
-#include "c4g/apps/pid.hpp"
+#include "axon/c4g/apps/pid.hpp"
 
 #include "harness.hpp"
 

@@ -1,8 +1,8 @@
-#include "c4g/apps/correct.hpp"
-#include "c4g/apps/sensor_feed.hpp"
+#include "axon/c4g/apps/correct.hpp"
+#include "axon/c4g/apps/sensor_feed.hpp"
 
 #include "harness.hpp"
-#include "net/udp_socket.hpp"
+#include "axon/net/udp_socket.hpp"
 
 #include <fmt/format.h>
 

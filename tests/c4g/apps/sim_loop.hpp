@@ -4,11 +4,11 @@
 // updated, the app called, Safety applied, the reply sent back to the controller.
 #pragma once
 
-#include "c4g/apps/app.hpp"
-#include "c4g/host/safety.hpp"
-#include "c4g/host/switch_tracker.hpp"
-#include "c4g/protocol/mode.hpp"
-#include "c4g/sim/controller.hpp"
+#include "axon/c4g/apps/app.hpp"
+#include "axon/c4g/host/safety.hpp"
+#include "axon/c4g/host/switch_tracker.hpp"
+#include "axon/c4g/protocol/mode.hpp"
+#include "axon/c4g/sim/controller.hpp"
 
 #include <gtest/gtest.h>
 

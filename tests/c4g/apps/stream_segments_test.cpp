@@ -1,5 +1,5 @@
 // StreamApp with trajectory segments chosen by the arm's motion type (CMD byte).
-#include "c4g/apps/stream.hpp"
+#include "axon/c4g/apps/stream.hpp"
 
 #include "harness.hpp"
 

@@ -1,4 +1,4 @@
-#include "c4g/apps/stream.hpp"
+#include "axon/c4g/apps/stream.hpp"
 
 #include "harness.hpp"
 

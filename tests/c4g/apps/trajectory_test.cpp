@@ -1,4 +1,4 @@
-#include "c4g/apps/trajectory.hpp"
+#include "axon/c4g/apps/trajectory.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "c4g/host/cycle_thread.hpp"
+#include "axon/c4g/host/cycle_thread.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>

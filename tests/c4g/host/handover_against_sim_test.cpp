@@ -3,13 +3,13 @@
 // over loopback UDP. The PC's part: a trajectory of its own in mode 4 (type A), corrections on the
 // controller's move in mode 7 (type B), each ended by exit-from-open; type B is run with the PC's
 // exit before and after the end of the controller's move (the manual: either order must work).
-#include "c4g/host/server.hpp"
-#include "c4g/protocol/mode.hpp"
-#include "c4g/sim/client_runner.hpp"
-#include "c4g/sim/controller.hpp"
-#include "c4g/sim/robots.hpp"
-#include "c4g/sim/scenario.hpp"
-#include "c4g/sim/udp_client.hpp"
+#include "axon/c4g/host/server.hpp"
+#include "axon/c4g/protocol/mode.hpp"
+#include "axon/c4g/sim/client_runner.hpp"
+#include "axon/c4g/sim/controller.hpp"
+#include "axon/c4g/sim/robots.hpp"
+#include "axon/c4g/sim/scenario.hpp"
+#include "axon/c4g/sim/udp_client.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-#include "c4g/host/pcap_recorder.hpp"
+#include "axon/c4g/host/pcap_recorder.hpp"
 
-#include "net/udp_frame.hpp"
+#include "axon/net/udp_frame.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>

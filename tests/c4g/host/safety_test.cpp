@@ -1,6 +1,6 @@
-#include "c4g/host/safety.hpp"
+#include "axon/c4g/host/safety.hpp"
 
-#include "c4g/protocol/mode.hpp"
+#include "axon/c4g/protocol/mode.hpp"
 
 #include <gtest/gtest.h>
 

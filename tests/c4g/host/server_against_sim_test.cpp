@@ -3,13 +3,13 @@
 // controllers for what the built-in applications do not cover (modes 8 and 9, the special modes
 // requested by the PC, refused mode changes, malformed and reordered datagrams through a proxy).
 // The command-line pairs (separate processes) are in tests/integration/cli_c4g_sim_*.sh.
-#include "c4g/host/server.hpp"
-#include "c4g/protocol/mode.hpp"
-#include "c4g/sim/client_runner.hpp"
-#include "c4g/sim/controller.hpp"
-#include "c4g/sim/robots.hpp"
-#include "c4g/sim/scenario.hpp"
-#include "c4g/sim/udp_client.hpp"
+#include "axon/c4g/host/server.hpp"
+#include "axon/c4g/protocol/mode.hpp"
+#include "axon/c4g/sim/client_runner.hpp"
+#include "axon/c4g/sim/controller.hpp"
+#include "axon/c4g/sim/robots.hpp"
+#include "axon/c4g/sim/scenario.hpp"
+#include "axon/c4g/sim/udp_client.hpp"
 
 #include <gtest/gtest.h>
 

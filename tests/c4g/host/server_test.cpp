@@ -1,7 +1,7 @@
 // The Server against a tiny scripted controller peer on loopback.
-#include "c4g/host/server.hpp"
+#include "axon/c4g/host/server.hpp"
 
-#include "c4g/protocol/mode.hpp"
+#include "axon/c4g/protocol/mode.hpp"
 
 #include <gtest/gtest.h>
 

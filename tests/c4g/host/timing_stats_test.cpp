@@ -1,4 +1,4 @@
-#include "c4g/host/timing_stats.hpp"
+#include "axon/c4g/host/timing_stats.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-#include "c4g/protocol/axis_map.hpp"
+#include "axon/c4g/protocol/axis_map.hpp"
 
-#include "c4g/protocol/error.hpp"
+#include "axon/c4g/protocol/error.hpp"
 #include "c4g/protocol/example_init.hpp"
 
 #include <gtest/gtest.h>

@@ -3,8 +3,8 @@
 // simulator's robots (c4g/sim/robots.cpp), which announces exactly this packet.
 #pragma once
 
-#include "c4g/protocol/init_packet.hpp"
-#include "c4g/sim/robots.hpp"
+#include "axon/c4g/protocol/init_packet.hpp"
+#include "axon/c4g/sim/robots.hpp"
 
 namespace axon::c4g::protocol::test {
 

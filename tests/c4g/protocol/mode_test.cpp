@@ -1,6 +1,6 @@
-#include "c4g/protocol/mode.hpp"
+#include "axon/c4g/protocol/mode.hpp"
 
-#include "c4g/protocol/error.hpp"
+#include "axon/c4g/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

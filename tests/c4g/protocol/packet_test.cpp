@@ -1,6 +1,6 @@
-#include "c4g/protocol/packet.hpp"
+#include "axon/c4g/protocol/packet.hpp"
 
-#include "c4g/protocol/error.hpp"
+#include "axon/c4g/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

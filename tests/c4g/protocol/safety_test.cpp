@@ -1,4 +1,4 @@
-#include "c4g/protocol/safety.hpp"
+#include "axon/c4g/protocol/safety.hpp"
 
 #include <gtest/gtest.h>
 

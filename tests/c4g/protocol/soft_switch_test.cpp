@@ -1,6 +1,6 @@
 // The linear soft-switching model (manual, chapter 12) against values computed by hand for
 // T1 = 50 ms, T2 = 100 ms, T3 = 50 ms, and the variable-threshold limiter.
-#include "c4g/protocol/soft_switch.hpp"
+#include "axon/c4g/protocol/soft_switch.hpp"
 
 #include <gtest/gtest.h>
 

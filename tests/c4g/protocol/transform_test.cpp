@@ -1,6 +1,6 @@
-#include "c4g/protocol/transform.hpp"
+#include "axon/c4g/protocol/transform.hpp"
 
-#include "c4g/protocol/error.hpp"
+#include "axon/c4g/protocol/error.hpp"
 #include "c4g/protocol/example_init.hpp"
 
 #include <gtest/gtest.h>

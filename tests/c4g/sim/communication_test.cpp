@@ -1,5 +1,5 @@
 // Start-up sequence and reply checking of the simulated controller.
-#include "c4g/sim/controller.hpp"
+#include "axon/c4g/sim/controller.hpp"
 #include "pc_responder.hpp"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // Drive on, the open modes and the PC's special requests, against the simulated physics.
-#include "c4g/sim/controller.hpp"
+#include "axon/c4g/sim/controller.hpp"
 #include "pc_responder.hpp"
 
 #include <gtest/gtest.h>

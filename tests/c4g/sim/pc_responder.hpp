@@ -3,9 +3,9 @@
 // reply or stay silent. Drives a sim::Controller tick by tick without sockets.
 #pragma once
 
-#include "c4g/protocol/init_packet.hpp"
-#include "c4g/protocol/packet.hpp"
-#include "c4g/sim/controller.hpp"
+#include "axon/c4g/protocol/init_packet.hpp"
+#include "axon/c4g/protocol/packet.hpp"
+#include "axon/c4g/sim/controller.hpp"
 
 #include <gtest/gtest.h>
 

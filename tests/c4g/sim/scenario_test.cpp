@@ -1,5 +1,5 @@
 // Scenario files: the steps and the errors, located by file, line and column.
-#include "c4g/sim/scenario.hpp"
+#include "axon/c4g/sim/scenario.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // Soft control switching on the controller's side: the per-axis object against hand-computed
 // values, and the simulated controller tick by tick (intervals packet for packet as the PC infers
 // them, the still-robot watchdog, a switch refused while the robot moves).
-#include "c4g/host/switch_tracker.hpp"
-#include "c4g/sim/soft_switch.hpp"
+#include "axon/c4g/host/switch_tracker.hpp"
+#include "axon/c4g/sim/soft_switch.hpp"
 #include "pc_responder.hpp"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // The simulator over real UDP on loopback against a minimal echo PC (a thread in the test).
-#include "c4g/protocol/packet.hpp"
-#include "c4g/sim/client_runner.hpp"
+#include "axon/c4g/protocol/packet.hpp"
+#include "axon/c4g/sim/client_runner.hpp"
 #include "pc_responder.hpp"
 
 #include <gtest/gtest.h>

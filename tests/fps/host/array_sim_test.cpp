@@ -3,7 +3,7 @@
 // acknowledged, interrupted by a collision), and the collision lock and unlock.
 #include "sim_rig.hpp"
 
-#include "fps/protocol/error.hpp"
+#include "axon/fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // 0 degC and -10 degC, the host reads it, decides and sets every robot's speed and holding current.
 #include "plane_rig.hpp"
 
-#include "fps/host/cold_control.hpp"
+#include "axon/fps/host/cold_control.hpp"
 
 #include <boost/asio/detached.hpp>
 #include <gtest/gtest.h>

@@ -1,13 +1,13 @@
 // The command client against a scripted fake device on a virtual bus: uid allocation and reuse,
 // the 63-in-flight limit, timeouts, retries (reads only), late and unmatched replies, broadcast
 // collection, response codes as typed errors, unsolicited frames, and the bus in-flight bound.
-#include "fps/host/command_client.hpp"
+#include "axon/fps/host/command_client.hpp"
 
 #include "fake_device.hpp"
 #include "rig.hpp"
 
-#include "fps/host/concurrent.hpp"
-#include "fps/protocol/error.hpp"
+#include "axon/fps/host/concurrent.hpp"
+#include "axon/fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // Correction moves, the pure part: measurement files and the angles a measured miss leads to.
-#include "fps/host/correction.hpp"
+#include "axon/fps/host/correction.hpp"
 
 #include <gtest/gtest.h>
 

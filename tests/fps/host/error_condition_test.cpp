@@ -1,5 +1,5 @@
-#include "fps/host/error.hpp"
-#include "fps/plc/error.hpp"
+#include "axon/fps/host/error.hpp"
+#include "axon/fps/plc/error.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,9 +3,9 @@
 // frames, each after an optional delay, or nothing at all).
 #pragma once
 
-#include "can/virtual_bus.hpp"
-#include "core/wakeup.hpp"
-#include "fps/protocol/message.hpp"
+#include "axon/can/virtual_bus.hpp"
+#include "axon/core/wakeup.hpp"
+#include "axon/fps/protocol/message.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>

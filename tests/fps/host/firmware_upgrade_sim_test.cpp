@@ -3,8 +3,8 @@
 // by a lost frame (half-written, said so), an image too large for the robot.
 #include "sim_rig.hpp"
 
-#include "fps/protocol/firmware_image.hpp"
-#include "fps/sim/firmware_marker.hpp"
+#include "axon/fps/protocol/firmware_image.hpp"
+#include "axon/fps/sim/firmware_marker.hpp"
 
 #include <gtest/gtest.h>
 

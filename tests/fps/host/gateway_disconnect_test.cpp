@@ -4,10 +4,10 @@
 // must come back with a report naming every robot's state, and no robot may have moved.
 #include "sim_rig.hpp"
 
-#include "can/cannet_client.hpp"
-#include "can/cannet_server.hpp"
-#include "can/virtual_bus.hpp"
-#include "fps/sim/simulator_config.hpp"
+#include "axon/can/cannet_client.hpp"
+#include "axon/can/cannet_server.hpp"
+#include "axon/can/virtual_bus.hpp"
+#include "axon/fps/sim/simulator_config.hpp"
 
 #include <boost/asio/detached.hpp>
 #include <gtest/gtest.h>

@@ -4,8 +4,8 @@
 // the simulator's true arm angles put through the planner's kinematics.
 #include "plane_rig.hpp"
 
-#include "fps/host/plane_correct.hpp"
-#include "fps/plan/layout_model.hpp"
+#include "axon/fps/host/plane_correct.hpp"
+#include "axon/fps/plan/layout_model.hpp"
 
 #include <gtest/gtest.h>
 

@@ -5,8 +5,8 @@
 
 #include "sim_rig.hpp"
 
-#include "fps/host/focal_plane_array.hpp"
-#include "fps/sim/focal_plane_sim.hpp"
+#include "axon/fps/host/focal_plane_array.hpp"
+#include "axon/fps/sim/focal_plane_sim.hpp"
 
 #include <limits>
 

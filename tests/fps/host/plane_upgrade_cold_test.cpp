@@ -2,9 +2,9 @@
 // default speed and holding current; the upgrade applies the cold policy again at its end.
 #include "plane_rig.hpp"
 
-#include "fps/host/cold_control.hpp"
-#include "fps/host/plane_upgrade.hpp"
-#include "fps/sim/firmware_marker.hpp"
+#include "axon/fps/host/cold_control.hpp"
+#include "axon/fps/host/plane_upgrade.hpp"
+#include "axon/fps/sim/firmware_marker.hpp"
 
 #include <gtest/gtest.h>
 

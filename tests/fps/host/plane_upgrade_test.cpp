@@ -3,8 +3,8 @@
 // bootloader, upgraded, retried, powered back into the application and their version checked.
 #include "plane_rig.hpp"
 
-#include "fps/host/plane_upgrade.hpp"
-#include "fps/sim/firmware_marker.hpp"
+#include "axon/fps/host/plane_upgrade.hpp"
+#include "axon/fps/sim/firmware_marker.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // the calibration sequence waiting on the status flags.
 #include "sim_rig.hpp"
 
-#include "fps/protocol/error.hpp"
+#include "axon/fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

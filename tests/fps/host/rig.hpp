@@ -2,8 +2,8 @@
 // coroutine and then stop everything that keeps the io_context busy (client readers, fakes).
 #pragma once
 
-#include "can/virtual_bus.hpp"
-#include "core/wakeup.hpp"
+#include "axon/can/virtual_bus.hpp"
+#include "axon/core/wakeup.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/io_context.hpp>

@@ -6,9 +6,9 @@
 
 #include "rig.hpp"
 
-#include "can/virtual_bus.hpp"
-#include "fps/host/array.hpp"
-#include "fps/sim/simulator.hpp"
+#include "axon/can/virtual_bus.hpp"
+#include "axon/fps/host/array.hpp"
+#include "axon/fps/sim/simulator.hpp"
 
 #include <functional>
 #include <memory>

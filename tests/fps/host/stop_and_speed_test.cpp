@@ -3,7 +3,7 @@
 // uploaded: the host driver against simulated robots on virtual buses.
 #include "sim_rig.hpp"
 
-#include "fps/host/trajectory_speed.hpp"
+#include "axon/fps/host/trajectory_speed.hpp"
 
 #include <gtest/gtest.h>
 

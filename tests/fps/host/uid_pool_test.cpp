@@ -1,5 +1,5 @@
 // The uid pool on its own: round-robin order, 63 at most, quarantine after a timeout.
-#include "fps/host/uid_pool.hpp"
+#include "axon/fps/host/uid_pool.hpp"
 
 #include <gtest/gtest.h>
 

@@ -5,9 +5,9 @@
 // pipeline and the robot.
 #include "sim_rig.hpp"
 
-#include "can/cannet_client.hpp"
-#include "can/cannet_server.hpp"
-#include "fps/host/concurrent.hpp"
+#include "axon/can/cannet_client.hpp"
+#include "axon/can/cannet_server.hpp"
+#include "axon/fps/host/concurrent.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>

@@ -1,6 +1,6 @@
 // Checking a layout against what answered: the pure rules, then a real sweep over simulated buses.
-#include "fps/layout/layout_check.hpp"
-#include "fps/layout/layout_sweep.hpp"
+#include "axon/fps/layout/layout_check.hpp"
+#include "axon/fps/host/layout_sweep.hpp"
 
 #include "fps/host/sim_rig.hpp"
 

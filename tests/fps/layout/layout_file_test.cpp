@@ -1,6 +1,6 @@
 // Layout files: what loads, and every error points at the offending line.
-#include "fps/layout/layout_file.hpp"
-#include "fps/layout/layout_generator.hpp"
+#include "axon/fps/layout/layout_file.hpp"
+#include "axon/fps/layout/layout_generator.hpp"
 
 #include <gtest/gtest.h>
 

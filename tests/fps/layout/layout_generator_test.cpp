@@ -1,5 +1,5 @@
 // The generated default layout: the counts the electrical interface prescribes and a clean grid.
-#include "fps/layout/layout_generator.hpp"
+#include "axon/fps/layout/layout_generator.hpp"
 
 #include <gtest/gtest.h>
 

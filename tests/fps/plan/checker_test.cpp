@@ -1,5 +1,5 @@
 // The dense-sampling checker: collisions that only happen mid-move, clearances, sampling step.
-#include "fps/plan/checker.hpp"
+#include "axon/fps/plan/checker.hpp"
 #include "model_util.hpp"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // The collision model: neighbour pairs and clearances in configurations worked out by hand.
-#include "fps/plan/collision.hpp"
+#include "axon/fps/plan/collision.hpp"
 #include "model_util.hpp"
 
 #include <gtest/gtest.h>

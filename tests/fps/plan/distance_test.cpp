@@ -1,5 +1,5 @@
 // Exact segment distances against cases worked out by hand.
-#include "fps/plan/distance.hpp"
+#include "axon/fps/plan/distance.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // Forward and inverse kinematics of the positioner: hand-worked poses and round trips.
-#include "fps/plan/kinematics.hpp"
+#include "axon/fps/plan/kinematics.hpp"
 
 #include <gtest/gtest.h>
 

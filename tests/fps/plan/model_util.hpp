@@ -1,7 +1,7 @@
 // Small collision models the planner tests build by hand, and the clearance of a static pose.
 #pragma once
 
-#include "fps/plan/collision.hpp"
+#include "axon/fps/plan/collision.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // The planner on small hand-made focal planes: every plan is verified by the independent checker
 // here (not only by the planner's own report), stays within the firmware's limits, and robots
 // that cannot reach their targets are reported with a reason, never dropped.
-#include "fps/plan/planner.hpp"
-#include "fps/plan/problems.hpp"
+#include "axon/fps/plan/planner.hpp"
+#include "axon/fps/plan/problems.hpp"
 #include "model_util.hpp"
 
 #include <gtest/gtest.h>

@@ -6,18 +6,18 @@
 //
 // 500 robots in a Release build (a few seconds); under sanitizers the robots within 70 mm of the
 // plane's centre (about 37), so the test stays quick there too.
-#include "fps/layout/layout_generator.hpp"
-#include "fps/plan/layout_model.hpp"
-#include "fps/plan/planner.hpp"
-#include "fps/plan/problems.hpp"
-#include "fps/protocol/commands.hpp"
-#include "fps/protocol/message.hpp"
-#include "fps/protocol/payloads.hpp"
-#include "fps/sim/simulator.hpp"
-#include "fps/sim/simulator_config.hpp"
+#include "axon/fps/layout/layout_generator.hpp"
+#include "axon/fps/plan/layout_model.hpp"
+#include "axon/fps/plan/planner.hpp"
+#include "axon/fps/plan/problems.hpp"
+#include "axon/fps/protocol/commands.hpp"
+#include "axon/fps/protocol/message.hpp"
+#include "axon/fps/protocol/payloads.hpp"
+#include "axon/fps/sim/simulator.hpp"
+#include "axon/fps/sim/simulator_config.hpp"
 
-#include "can/virtual_bus.hpp"
-#include "core/clock.hpp"
+#include "axon/can/virtual_bus.hpp"
+#include "axon/core/clock.hpp"
 
 #include <boost/asio/io_context.hpp>
 #include <gtest/gtest.h>

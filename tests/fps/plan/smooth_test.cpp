@@ -1,8 +1,8 @@
 // Shortcuts on jagged arms (smooth_arms) and the planner's verification with fallback layers:
 // dithering goes where nothing is near, an excursion that keeps an arm out of a neighbour's way
 // stays, and a flattened arm the checker flags falls back to the certified one.
-#include "fps/plan/planner.hpp"
-#include "fps/plan/smooth.hpp"
+#include "axon/fps/plan/planner.hpp"
+#include "axon/fps/plan/smooth.hpp"
 #include "model_util.hpp"
 
 #include <gtest/gtest.h>

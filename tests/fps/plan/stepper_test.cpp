@@ -1,8 +1,8 @@
 // The motion engine with scripted robots (the planner's local re-plans): planned robots certify
 // their moves against the scripted ones, and a planned robot that a scripted one would run into
 // is reported (a violation), so that the planner discards that run.
-#include "fps/plan/checker.hpp"
-#include "fps/plan/stepper.hpp"
+#include "axon/fps/plan/checker.hpp"
+#include "axon/fps/plan/stepper.hpp"
 #include "model_util.hpp"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // The SVG plot: well-formed XML with the expected elements.
-#include "fps/plan/svg.hpp"
+#include "axon/fps/plan/svg.hpp"
 
 #include <gtest/gtest.h>
 

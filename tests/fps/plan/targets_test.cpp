@@ -1,5 +1,5 @@
 // Target files (YAML, CSV) and their validation against a small focal plane.
-#include "fps/plan/targets.hpp"
+#include "axon/fps/plan/targets.hpp"
 
 #include <gtest/gtest.h>
 

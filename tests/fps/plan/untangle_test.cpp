@@ -1,7 +1,7 @@
 // The untangle phase: a robot left away from its fold is planned alone on its angle grid, and the
 // move it gets is clear (independent checker) and ends folded.
-#include "fps/plan/checker.hpp"
-#include "fps/plan/untangle.hpp"
+#include "axon/fps/plan/checker.hpp"
+#include "axon/fps/plan/untangle.hpp"
 #include "model_util.hpp"
 
 #include <gtest/gtest.h>

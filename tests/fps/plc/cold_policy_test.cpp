@@ -1,5 +1,5 @@
 // The cold-temperature policy at and around its thresholds.
-#include "fps/plc/cold_policy.hpp"
+#include "axon/fps/plc/cold_policy.hpp"
 
 #include <gtest/gtest.h>
 

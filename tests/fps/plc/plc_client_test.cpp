@@ -1,7 +1,7 @@
 // The PLC client against the emulator over loopback Modbus TCP.
-#include "fps/plc/client.hpp"
-#include "fps/plc/emulator.hpp"
-#include "fps/plc/error.hpp"
+#include "axon/fps/plc/client.hpp"
+#include "axon/fps/plc/emulator.hpp"
+#include "axon/fps/plc/error.hpp"
 
 #include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/io_context.hpp>

@@ -1,7 +1,7 @@
 // The PLC emulator facing clients that are not the host: what they send never changes a relay
 // unnoticed, and bad frames are counted without disturbing anyone else.
-#include "fps/plc/client.hpp"
-#include "fps/plc/emulator.hpp"
+#include "axon/fps/plc/client.hpp"
+#include "axon/fps/plc/emulator.hpp"
 
 #include <gtest/gtest.h>
 

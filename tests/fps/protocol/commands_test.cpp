@@ -1,6 +1,6 @@
-#include "fps/protocol/commands.hpp"
+#include "axon/fps/protocol/commands.hpp"
 
-#include "fps/protocol/error.hpp"
+#include "axon/fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

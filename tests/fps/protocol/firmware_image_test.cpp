@@ -1,6 +1,6 @@
-#include "fps/protocol/firmware_image.hpp"
+#include "axon/fps/protocol/firmware_image.hpp"
 
-#include "fps/protocol/error.hpp"
+#include "axon/fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

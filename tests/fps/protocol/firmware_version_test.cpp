@@ -1,6 +1,6 @@
-#include "fps/protocol/firmware_version.hpp"
+#include "axon/fps/protocol/firmware_version.hpp"
 
-#include "fps/protocol/error.hpp"
+#include "axon/fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

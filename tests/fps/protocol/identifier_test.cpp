@@ -1,7 +1,7 @@
-#include "fps/protocol/identifier.hpp"
+#include "axon/fps/protocol/identifier.hpp"
 
-#include "fps/protocol/error.hpp"
-#include "fps/protocol/message.hpp"
+#include "axon/fps/protocol/error.hpp"
+#include "axon/fps/protocol/message.hpp"
 
 #include <gtest/gtest.h>
 

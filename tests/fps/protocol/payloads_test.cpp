@@ -1,6 +1,6 @@
-#include "fps/protocol/payloads.hpp"
+#include "axon/fps/protocol/payloads.hpp"
 
-#include "fps/protocol/error.hpp"
+#include "axon/fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

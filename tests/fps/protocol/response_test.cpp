@@ -1,6 +1,6 @@
-#include "fps/protocol/response.hpp"
+#include "axon/fps/protocol/response.hpp"
 
-#include "fps/protocol/error.hpp"
+#include "axon/fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

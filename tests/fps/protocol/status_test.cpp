@@ -1,7 +1,7 @@
-#include "fps/protocol/bootloader_status.hpp"
-#include "fps/protocol/status.hpp"
+#include "axon/fps/protocol/bootloader_status.hpp"
+#include "axon/fps/protocol/status.hpp"
 
-#include "fps/protocol/error.hpp"
+#include "axon/fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-#include "fps/protocol/trajectory.hpp"
+#include "axon/fps/protocol/trajectory.hpp"
 
-#include "fps/protocol/error.hpp"
+#include "axon/fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-#include "fps/protocol/units.hpp"
+#include "axon/fps/protocol/units.hpp"
 
-#include "fps/protocol/error.hpp"
+#include "axon/fps/protocol/error.hpp"
 
 #include <gtest/gtest.h>
 

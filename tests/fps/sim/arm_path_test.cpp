@@ -1,5 +1,5 @@
 // ArmPath: interpolation, stop crossings, and arms that cannot pass their stops.
-#include "fps/sim/arm_path.hpp"
+#include "axon/fps/sim/arm_path.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // Geometry and the collision monitor: segment distances, beta capsules, and which contacts count.
-#include "fps/sim/collision_monitor.hpp"
+#include "axon/fps/sim/collision_monitor.hpp"
 
 #include <gtest/gtest.h>
 

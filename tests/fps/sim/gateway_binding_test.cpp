@@ -1,7 +1,7 @@
 // Where the focal-plane simulator's gateway emulators listen: counted addresses on one port, the
 // layout's own addresses, one shared address.
-#include "fps/layout/layout_generator.hpp"
-#include "fps/sim/focal_plane_sim.hpp"
+#include "axon/fps/layout/layout_generator.hpp"
+#include "axon/fps/sim/focal_plane_sim.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>

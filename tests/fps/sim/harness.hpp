@@ -1,9 +1,9 @@
 // Drives one PositionerModel by hand: requests as the host would send them, time moved explicitly.
 #pragma once
 
-#include "fps/protocol/message.hpp"
-#include "fps/protocol/payloads.hpp"
-#include "fps/sim/positioner_model.hpp"
+#include "axon/fps/protocol/message.hpp"
+#include "axon/fps/protocol/payloads.hpp"
+#include "axon/fps/sim/positioner_model.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // What the simulated firmware answers depends on its version where the interface document or the
 // field notes tie a behaviour to one: one test per command family.
-#include "core/config.hpp"
-#include "fps/protocol/firmware_image.hpp"
-#include "fps/sim/firmware_marker.hpp"
+#include "axon/core/config.hpp"
+#include "axon/fps/protocol/firmware_image.hpp"
+#include "axon/fps/sim/firmware_marker.hpp"
 #include "harness.hpp"
 
 namespace axon::fps::sim::testing {

@@ -1,7 +1,7 @@
 // PositionerModel: power cycles (what survives, what is reset), the bootloader, firmware upgrades
 // with good and bad CRCs, and the watchdog's return to the previous image.
-#include "fps/protocol/firmware_image.hpp"
-#include "fps/sim/firmware_marker.hpp"
+#include "axon/fps/protocol/firmware_image.hpp"
+#include "axon/fps/sim/firmware_marker.hpp"
 #include "harness.hpp"
 
 using namespace axon;

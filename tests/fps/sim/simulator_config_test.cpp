@@ -1,7 +1,7 @@
 // SimulatorConfig and make_simulator: a focal plane from YAML, served on named virtual buses.
-#include "can/virtual_bus.hpp"
-#include "fps/protocol/message.hpp"
-#include "fps/sim/simulator_config.hpp"
+#include "axon/can/virtual_bus.hpp"
+#include "axon/fps/protocol/message.hpp"
+#include "axon/fps/sim/simulator_config.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>

@@ -1,9 +1,9 @@
 // Simulator: robots on a virtual bus answering raw frames from a host node.
-#include "can/virtual_bus.hpp"
-#include "fps/protocol/message.hpp"
-#include "fps/protocol/payloads.hpp"
-#include "fps/protocol/trajectory.hpp"
-#include "fps/sim/simulator.hpp"
+#include "axon/can/virtual_bus.hpp"
+#include "axon/fps/protocol/message.hpp"
+#include "axon/fps/protocol/payloads.hpp"
+#include "axon/fps/protocol/trajectory.hpp"
+#include "axon/fps/sim/simulator.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/io_context.hpp>

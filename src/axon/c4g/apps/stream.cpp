@@ -1,0 +1,316 @@
+#include "axon/c4g/apps/stream.hpp"
+
+#include "axon/c4g/protocol/mode.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace axon::c4g::apps {
+
+using protocol::code;
+using protocol::Mode;
+
+namespace {
+constexpr double kDeg = 180.0 / std::numbers::pi;
+}
+
+StreamApp::StreamApp(StreamOptions options) : options_(std::move(options)) {
+  if (!options_.trajectory && options_.segments.empty())
+    throw Exception(Error(CoreErrc::invalid_argument, "stream: no trajectory"));
+  if (options_.trajectory && !options_.segments.empty())
+    throw Exception(Error(CoreErrc::invalid_argument, "stream: give one trajectory or segments, not both"));
+  for (std::size_t i = 0; i < options_.segments.size(); ++i) {
+    const auto& seg = options_.segments[i];
+    if (!seg.trajectory || seg.motion_type == 0)
+      throw Exception(Error(CoreErrc::invalid_argument, "stream: a segment needs a trajectory and a motion type 1..255"));
+    for (std::size_t k = 0; k < i; ++k)
+      if (options_.segments[k].motion_type == seg.motion_type)
+        throw Exception(Error(CoreErrc::invalid_argument, fmt::format("stream: two segments for motion type {}", seg.motion_type)));
+  }
+  if (options_.mode != 4 && options_.mode != 5)
+    throw Exception(Error(CoreErrc::invalid_argument, fmt::format("stream: mode {} (4 or 5)", options_.mode)));
+}
+
+void StreamApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) {
+  if ((phase() == Phase::done && !options_.rearm) || phase() == Phase::refused) return;  // one run per serve
+  set_phase(Phase::waiting);
+  auto v = make_arm_view(init, axes, options_.arm);
+  if (!v) {
+    fail("stream: %s", v.error().detail.c_str());
+    set_phase(Phase::refused);
+    return;
+  }
+  view_ = std::move(v).value();
+  const double period = view_->period_s;
+  period_.store(period, std::memory_order_relaxed);
+  tables_.clear();
+  if (options_.trajectory) tables_.push_back(Table{0, options_.trajectory, {}, 0});
+  for (const auto& seg : options_.segments) tables_.push_back(Table{seg.motion_type, seg.trajectory, {}, 0});
+  for (auto& t : tables_)
+    if (!build(*t.trajectory, t.motor, t.rows)) {
+      set_phase(Phase::refused);
+      return;
+    }
+  table_ = tables_.front().motor.data();
+  rows_ = tables_.front().rows;
+  hold_cycles_ = static_cast<std::size_t>(std::ceil(options_.hold_s / period - 1e-9));
+}
+
+bool StreamApp::build(const Trajectory& traj, std::vector<double>& table, std::size_t& rows) {
+  const std::size_t n = view_->count;
+  if (traj.axes() != n) {
+    fail("stream: the trajectory has %zu axes, arm %zu has %zu", traj.axes(), options_.arm, n);
+    return false;
+  }
+  const double period = view_->period_s;
+  rows = static_cast<std::size_t>(std::floor(traj.duration() / period + 1e-9)) + 1;
+  if (traj.start_time() + static_cast<double>(rows - 1) * period < traj.end_time() - 1e-12) ++rows;  // end exactly
+  table.assign(rows * n, 0.0);
+  std::vector<double> pos(n), vel(n);
+  protocol::ArmTransform::Vector link(static_cast<Eigen::Index>(n));
+  for (std::size_t k = 0; k < rows; ++k) {
+    const double t = std::min(traj.start_time() + static_cast<double>(k) * period, traj.end_time());
+    traj.sample(t, pos, vel);
+    for (std::size_t j = 0; j < n; ++j) link[static_cast<Eigen::Index>(j)] = pos[j];
+    const auto motor = view_->transform.motor_velocity(link);  // the linear part K_r q / 2 pi
+    for (std::size_t j = 0; j < n; ++j) table[k * n + j] = motor[static_cast<Eigen::Index>(j)];
+  }
+  const double max_step = options_.max_motor_speed * period;
+  for (std::size_t k = 1; k < rows; ++k)
+    for (std::size_t j = 0; j < n; ++j) {
+      const double step = std::fabs(table[k * n + j] - table[(k - 1) * n + j]);
+      if (step > max_step) {
+        fail("stream: the trajectory is not continuous: axis %zu moves %.4f motor turns in one cycle at t=%.3f s "
+             "(limit %.4f = %.1f turns/s x %.4f s)",
+             j + 1, step, traj.start_time() + static_cast<double>(k) * period, max_step, options_.max_motor_speed, period);
+        return false;
+      }
+    }
+  return true;
+}
+
+std::size_t StreamApp::find(std::uint8_t type) const noexcept {
+  for (std::size_t i = 0; i < tables_.size(); ++i)
+    if (tables_[i].motion_type == type && type != 0) return i;
+  return static_cast<std::size_t>(-1);
+}
+
+bool StreamApp::start(std::size_t idx, const protocol::Packet& req, bool from_command) noexcept {
+  const std::size_t n = view_->count, first = view_->first;
+  const Table& t = tables_[idx];
+  protocol::ArmTransform::Vector motor(static_cast<Eigen::Index>(n));
+  for (std::size_t j = 0; j < n; ++j) motor[static_cast<Eigen::Index>(j)] = req.axes[first + j].d3;
+  const auto link = view_->transform.link_position(motor);
+  const auto& q0 = view_->transform.calibration();
+  const Trajectory& traj = *t.trajectory;
+  for (std::size_t j = 0; j < n; ++j) {
+    const double begin = traj.value(0, j);
+    const double here = options_.relative ? 0.0 : link[static_cast<Eigen::Index>(j)];
+    if (std::fabs(begin - here) > options_.start_tolerance_rad) {
+      if (options_.relative)
+        fail("stream: start point: a relative trajectory must start at 0, axis %zu starts at %.3f deg", j + 1, begin * kDeg);
+      else
+        fail("stream: start point: axis %zu is at %.3f deg, the trajectory%s starts at %.3f deg (tolerance %.3f deg)",
+             j + 1, here * kDeg, t.motion_type != 0 ? " segment" : "", begin * kDeg, options_.start_tolerance_rad * kDeg);
+      set_phase(Phase::refused);
+      return false;
+    }
+  }
+  table_ = t.motor.data();
+  rows_ = t.rows;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (options_.relative) base_[j] = (from_command ? last_[j] : req.axes[first + j].d3) - table_[j];
+    else base_[j] = q0[static_cast<Eigen::Index>(j)];
+  }
+  if (!from_command)
+    for (std::size_t j = 0; j < n; ++j) last_[j] = command(j, 0);
+  s_ = 0;
+  rate_ = 1;
+  held_ = 0;
+  hold_last_ = false;
+  segment_.store(t.motion_type, std::memory_order_relaxed);
+  set_phase(Phase::playing);
+  return true;
+}
+
+double StreamApp::command(std::size_t j, double s) const noexcept {
+  const std::size_t n = view_->count;
+  const double top = static_cast<double>(rows_ - 1);
+  s = std::clamp(s, 0.0, top);
+  const auto k = static_cast<std::size_t>(std::floor(s));
+  const double a = s - static_cast<double>(k);
+  const double p0 = table_[k * n + j];
+  const double p1 = k + 1 < rows_ ? table_[(k + 1) * n + j] : p0;
+  return base_[j] + p0 + a * (p1 - p0);
+}
+
+void StreamApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
+  if (!view_ || (rows_ == 0 && phase() != Phase::refused)) return;
+  const auto& req = ctx.request;
+  const std::size_t n = view_->count, first = view_->first;
+  if (first + n > req.count) return;
+  const std::int32_t mode = options_.mode;
+  const std::int32_t standby = mode == 4 ? code(Mode::mode4_standby) : code(Mode::mode5_standby);
+  bool all_in = true;
+  for (std::size_t j = 0; j < n; ++j) all_in = all_in && req.axes[first + j].mode == mode;
+  const std::int32_t m0 = req.axes[first].mode;
+  Phase ph = phase();
+  if (ph == Phase::done && options_.rearm && m0 == code(Mode::mode0)) {
+    set_phase(Phase::waiting);
+    ph = Phase::waiting;
+  }
+
+  const bool segmented = !options_.segments.empty();
+  const std::uint8_t type = ctx.motion_type(view_->arm);
+  if (ph == Phase::waiting) {
+    if (!all_in || stop_requested()) return;
+    type_ = type;
+    played_ = false;
+    const std::size_t idx = segmented ? find(type) : 0;
+    if (idx == static_cast<std::size_t>(-1)) {
+      for (std::size_t j = 0; j < n; ++j) last_[j] = req.axes[first + j].d3;
+      hold_last_ = true;
+      set_phase(Phase::idle);
+      ph = Phase::idle;
+      note(kNoteUnknownType + type);
+    } else if (start(idx, req, false)) {
+      ph = Phase::playing;
+      played_ = true;
+      runs_.fetch_add(1, std::memory_order_relaxed);
+      note(segmented ? kNoteSegment + type : kNoteStarted);
+    } else {
+      ph = Phase::refused;
+    }
+  } else if (segmented && type != type_ && (ph == Phase::playing || ph == Phase::holding || ph == Phase::idle) && all_in) {
+    // The program picked another segment.
+    type_ = type;
+    const std::size_t idx = find(type);
+    if (type == 0 && played_) {
+      set_phase(Phase::exiting);
+      ph = Phase::exiting;
+      note(kNoteTypeCleared);
+    } else if (idx == static_cast<std::size_t>(-1)) {
+      hold_last_ = true;
+      set_phase(Phase::idle);
+      ph = Phase::idle;
+      note(kNoteUnknownType + type);
+    } else if (start(idx, req, true)) {
+      ph = Phase::playing;
+      played_ = true;
+      note(kNoteSegment + type);
+    } else {
+      ph = Phase::refused;
+    }
+  }
+
+  if (ph == Phase::refused) {
+    // Nothing moves: mode 4 holds (the server's safe reply: last target or actual position), mode 5
+    // adds nothing; leave the open mode.
+    if (all_in) exit_from_open(reply, view_->arm);
+    return;
+  }
+  if (ph == Phase::done) return;
+
+  if (ph == Phase::playing || ph == Phase::holding || ph == Phase::exiting || ph == Phase::idle) {
+    if (m0 == code(Mode::mode0) && ph == Phase::exiting) {
+      set_phase(Phase::done);
+      note(kNoteDone);
+      return;
+    }
+    if (!all_in && m0 != standby) {
+      fail("stream: the controller left mode %d during the trajectory (axis 1 of arm %zu in mode %d) at t=%.3f s", mode,
+           view_->arm, m0, s_ * view_->period_s);
+      set_phase(Phase::refused);
+      return;
+    }
+  }
+
+  // Advance.
+  if (ph == Phase::playing) {
+    if (stop_requested() && rate_ == 1.0) note(kNoteStopping);
+    if (stop_requested()) rate_ = std::max(0.0, rate_ - view_->period_s / std::max(options_.stop_ramp_s, view_->period_s));
+    if (rate_ < 1e-9) rate_ = 0;
+    s_ += rate_;
+    if (s_ >= static_cast<double>(rows_ - 1)) {
+      s_ = static_cast<double>(rows_ - 1);
+      set_phase(Phase::holding);
+      ph = Phase::holding;
+      note(kNoteEnded);
+    } else if (rate_ <= 0.0) {
+      set_phase(Phase::exiting);
+      ph = Phase::exiting;
+    }
+  } else if (ph == Phase::holding || ph == Phase::idle) {
+    // Segments: hold until the motion type changes (or a stop request).
+    if ((!segmented && ++held_ >= hold_cycles_) || stop_requested()) {
+      set_phase(Phase::exiting);
+      ph = Phase::exiting;
+    }
+  }
+  if (m0 == standby) {
+    // Leaving (4' / 5'): hold the last target, no increments.
+    for (std::size_t j = 0; j < n; ++j) {
+      auto& r = reply.axis(first + j);
+      r.d1 = mode == 4 ? static_cast<float>(last_[j]) : 0.0f;
+      r.d2 = 0;
+    }
+    if (ph == Phase::playing || ph == Phase::holding) set_phase(Phase::exiting);
+    return;
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    const double c = hold_last_ ? last_[j] : command(j, s_);
+    const double delta = c - last_[j];
+    auto& r = reply.axis(first + j);
+    r.d1 = static_cast<float>(mode == 4 ? c : delta);
+    r.d2 = static_cast<float>(delta);
+    last_[j] = c;
+  }
+  progress_.store(s_, std::memory_order_relaxed);
+  if (ph == Phase::exiting) exit_from_open(reply, view_->arm);
+}
+
+void StreamApp::silence() noexcept {
+  const Phase p = phase();
+  if (p == Phase::playing || p == Phase::holding) {
+    fail("stream: packets stopped during the trajectory");
+    set_phase(Phase::refused);
+  }
+}
+
+std::string StreamApp::note_text(std::int32_t c) const {
+  switch (c) {
+    case kNoteStarted: return fmt::format("stream: trajectory started (mode {}, arm {}, {} cycles)", options_.mode, options_.arm, rows_);
+    case kNoteEnded: return "stream: trajectory ended, holding the last point";
+    case kNoteDone: return "stream: done, the arm is back in mode 0";
+    case kNoteStopping: return "stream: stop requested, slowing down to rest";
+    case kNoteTypeCleared: return "stream: motion type 0: the segments are over, leaving the open mode";
+    default:
+      if (c >= kNoteUnknownType && c < kNoteUnknownType + 256)
+        return fmt::format("stream: no segment for motion type {}: holding", c - kNoteUnknownType);
+      if (c >= kNoteSegment && c < kNoteSegment + 256) {
+        const auto i = find(static_cast<std::uint8_t>(c - kNoteSegment));
+        return fmt::format("stream: segment for motion type {} started (mode {}, arm {}, {} cycles)", c - kNoteSegment,
+                           options_.mode, options_.arm, i < tables_.size() ? tables_[i].rows : 0);
+      }
+      return App::note_text(c);
+  }
+}
+
+std::string StreamApp::status() const {
+  static constexpr std::string_view names[] = {"waiting for mode", "playing", "holding", "exiting", "done", "refused", "holding (no segment)"};
+  const double period = period_.load(std::memory_order_relaxed);
+  return App::status() + fmt::format(" {} t={:.3f}/{:.3f} s", names[static_cast<int>(phase())], progress() * period,
+                                     rows_ > 0 ? static_cast<double>(rows_ - 1) * period : 0.0);
+}
+
+std::string StreamApp::summary() const {
+  static constexpr std::string_view names[] = {"waiting", "playing", "holding", "exiting", "done", "refused", "idle"};
+  const double period = period_.load(std::memory_order_relaxed);
+  return App::summary() + fmt::format("stream: played {:.3f} s of {:.3f} s, phase {}\n", progress() * period,
+                                      rows_ > 0 ? static_cast<double>(rows_ - 1) * period : 0.0,
+                                      names[static_cast<int>(phase())]);
+}
+
+}  // namespace axon::c4g::apps

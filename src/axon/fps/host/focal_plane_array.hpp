@@ -1,0 +1,125 @@
+// FocalPlaneArray: the whole focal plane of a layout driven as one fps::Array.
+//
+// connect() opens one CAN@net connection per gateway of the layout (all at once) with the
+// channels its robots use, and builds one Array over every bus, on one executor. Bus i of the
+// array is bus_ref(i) of the layout. The layout's robots (all but the offline ones) are known to
+// the array from the start, each on its own bus; discover() and check_layout() compare that with
+// what answers.
+//
+// With a PLC endpoint, the PLC is reached through AsyncPlc (its own thread): trajectories can be
+// started by the sync line instead of the START_TRAJECTORY broadcast (run_trajectories with
+// by_sync_line), and sextants powered off and on.
+//
+// Faults: the array already stops every bus on a collision anywhere. Here, besides, a gateway
+// whose connection drops stops everything too (TRAJECTORY_ABORT broadcast on every bus still
+// reachable, array locked, the reason naming the gateway and why its connection ended): a watch
+// checks the connections every `connection_poll`.
+//
+// The robots behind the lost gateway cannot hear that stop. When some of them were moving under
+// this host, it reconnects to that gateway once (reconnect_to_stop) and broadcasts TRAJECTORY_ABORT
+// on its channels, then closes again. Why: their neighbours behind the other gateways have just been
+// stopped, and paths planned to be collision-free together are no longer so when half the plane
+// stops and the other half follows its trajectories to the end. The price is that a client that
+// took the gateway over (a CAN@net NT serves one client at a time) loses its connection for that
+// moment; stopping moving robots comes first. Only once: a gateway that cannot be reached again is
+// reported (link_stops()), not retried.
+#pragma once
+
+#include "axon/can/cannet_client.hpp"
+#include "axon/fps/host/array.hpp"
+#include "axon/fps/layout/focal_plane.hpp"
+#include "axon/fps/layout/layout_check.hpp"
+#include "axon/fps/plc/async_client.hpp"
+
+#include <boost/asio/awaitable.hpp>
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace axon::fps::host {
+
+struct FocalPlaneArrayOptions {
+  ArrayOptions array;
+  can::CanNetOptions gateway;
+  core::Duration check_window = 500ms;      // GET_ID collection of check_layout()
+  std::optional<net::Endpoint> plc;         // the PLC, if any
+  plc::RegisterMap plc_map;
+  plc::PlcClientOptions plc_client;
+  core::Duration sync_hold = 100ms;         // sync line high this long for a start
+  core::Duration connection_poll = 20ms;    // how often the gateway connections are checked
+  // Replaces the layout's gateway addresses (e.g. emulators on other ports), by gateway id.
+  std::map<std::uint16_t, net::Endpoint> addresses;
+  // A lost gateway behind which robots were moving: reconnect once to stop them (see above).
+  bool reconnect_to_stop = true;
+  core::Duration reconnect_timeout = 1s;    // connect and set-up of that one reconnection
+  core::Duration reconnect_window = 300ms;  // collecting the robots' acknowledgements of the abort
+};
+
+struct GatewayLink {
+  std::uint16_t id = 0;
+  net::Endpoint endpoint;
+  std::shared_ptr<can::CanNetGateway> gateway;
+  std::vector<std::size_t> buses;  // array bus indices
+};
+
+class FocalPlaneArray {
+ public:
+  // Errors: a gateway that cannot be reached (named), a layout without robots.
+  static asio::awaitable<Result<std::unique_ptr<FocalPlaneArray>>> connect(asio::any_io_executor executor,
+                                                                         const FocalPlane& plane,
+                                                                         FocalPlaneArrayOptions options = {});
+  ~FocalPlaneArray();
+  FocalPlaneArray(const FocalPlaneArray&) = delete;
+  FocalPlaneArray& operator=(const FocalPlaneArray&) = delete;
+
+  [[nodiscard]] Array& array() noexcept { return *array_; }
+  [[nodiscard]] const FocalPlane& plane() const noexcept { return plane_; }
+  [[nodiscard]] const FocalPlaneArrayOptions& options() const noexcept { return options_; }
+  [[nodiscard]] std::size_t bus_count() const noexcept { return refs_.size(); }
+  [[nodiscard]] const BusRef& bus_ref(std::size_t index) const { return refs_.at(index); }
+  [[nodiscard]] std::optional<std::size_t> bus_index(const BusRef& ref) const;
+  [[nodiscard]] const std::vector<GatewayLink>& gateways() const noexcept { return gateways_; }
+  // nullptr without a PLC endpoint.
+  [[nodiscard]] plc::AsyncPlc* plc() noexcept { return plc_.get(); }
+
+  // GET_ID on every bus at once, checked against the layout (missing, unexpected, wrong bus...).
+  asio::awaitable<LayoutCheck> check_layout();
+  // Array::discover, each bus collecting until the layout's robots there answered (or the window).
+  asio::awaitable<Result<DiscoveryReport>> discover();
+  // Array::run_trajectories; with by_sync_line the start is a pulse of the PLC's sync line
+  // (HostErrc::invalid_argument without a PLC).
+  asio::awaitable<Result<TrajectoryReport>> run_trajectories(std::map<std::uint16_t, protocol::Trajectory> trajectories,
+                                                             TrajectoryOptions options = {}, bool by_sync_line = false);
+
+  // Gateways whose connection dropped (by id), in the order noticed.
+  [[nodiscard]] const std::vector<std::uint16_t>& lost_gateways() const noexcept { return lost_; }
+  // What was done for the robots behind each lost gateway (one line each): the stop sent through
+  // a reconnection, or why they could not be stopped.
+  [[nodiscard]] const std::vector<std::string>& link_stops() const noexcept { return link_stops_; }
+
+  // Stops the watch, closes the array and every gateway connection.
+  asio::awaitable<void> close();
+
+ private:
+  FocalPlaneArray(const FocalPlane& plane, FocalPlaneArrayOptions options);
+  static asio::awaitable<void> watch(FocalPlaneArray* self, std::shared_ptr<bool> alive);
+  void link_lost(const GatewayLink& link);
+  asio::awaitable<void> stop_behind(GatewayLink link, std::vector<std::uint16_t> robots, std::size_t moving);
+
+  FocalPlane plane_;
+  FocalPlaneArrayOptions options_;
+  std::vector<GatewayLink> gateways_;
+  std::vector<BusRef> refs_;
+  std::vector<std::unique_ptr<can::Bus>> buses_;
+  std::unique_ptr<Array> array_;
+  std::unique_ptr<plc::AsyncPlc> plc_;
+  std::vector<std::uint16_t> lost_;
+  std::vector<std::string> link_stops_;
+  std::size_t reconnecting_ = 0;  // stop_behind() coroutines running
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+  bool closed_ = false;
+};
+
+}  // namespace axon::fps::host

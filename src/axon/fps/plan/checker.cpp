@@ -1,0 +1,160 @@
+#include "axon/fps/plan/checker.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <thread>
+
+namespace axon::fps::plan {
+
+namespace {
+
+void merge(PairOutcome& into, const PairOutcome& from) {
+  if (from.collided && (!into.collided || from.first_collision_s < into.first_collision_s)) {
+    into.collided = true;
+    into.first_collision_s = from.first_collision_s;
+  }
+  if (from.min_clearance_mm < into.min_clearance_mm) {
+    into.min_clearance_mm = from.min_clearance_mm;
+    into.min_clearance_s = from.min_clearance_s;
+  }
+}
+
+void note(PairOutcome& o, double clearance, double t) {
+  if (clearance < o.min_clearance_mm) {
+    o.min_clearance_mm = clearance;
+    o.min_clearance_s = t;
+  }
+  if (clearance < 0 && !o.collided) {
+    o.collided = true;
+    o.first_collision_s = t;
+  }
+}
+
+}  // namespace
+
+Result<void> TrajectoryChecker::check(std::span<const RobotTrajectory> trajectories, const CheckOptions& options,
+                                      CheckReport& out) {
+  const CollisionModel& m = *model_;
+  const std::size_t n = m.size();
+  if (trajectories.size() != n)
+    return make_error(PlanErrc::bad_trajectory,
+                      fmt::format("{} trajectories for {} robots", trajectories.size(), n));
+  if (!(options.max_step_mm > 0))
+    return make_error(PlanErrc::bad_trajectory, fmt::format("max_step_mm must be > 0, not {}", options.max_step_mm));
+
+  // Time span and the fastest-moving point of any robot.
+  double start = std::numeric_limits<double>::infinity();
+  double end = -std::numeric_limits<double>::infinity();
+  double point_speed = 0;  // mm/s
+  for (std::size_t i = 0; i < n; ++i) {
+    const RobotTrajectory& t = trajectories[i];
+    if (auto v = validate(t); !v)
+      return make_error(PlanErrc::bad_trajectory, fmt::format("robot {} {}", m.robot(i).id(), v.error().detail));
+    start = std::min({start, t.alpha.front().t_s, t.beta.front().t_s});
+    end = std::max({end, t.alpha.back().t_s, t.beta.back().t_s});
+    const Positioner& p = m.robot(i);
+    point_speed = std::max(point_speed, max_speed(t.alpha) * kRad * p.reach_mm() +
+                                            max_speed(t.beta) * kRad * p.collision_length_mm());
+  }
+  if (n == 0) start = end = 0;
+
+  out.start_s = start;
+  out.end_s = end;
+  out.step_s = 0;
+  out.samples = 1;
+  if (end > start && point_speed > 0) {
+    const double dt = options.max_step_mm / point_speed;
+    const auto intervals = static_cast<std::size_t>(std::ceil((end - start) / dt));
+    out.samples = std::max<std::size_t>(intervals, 1) + 1;
+    out.step_s = (end - start) / static_cast<double>(out.samples - 1);
+  }
+  out.robot_pairs.assign(m.robot_pairs().size(), PairOutcome{});
+  out.obstacle_pairs.assign(options.obstacles ? m.obstacle_pairs().size() : 0, PairOutcome{});
+
+  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  // Below a few hundred samples threads cost more than they save.
+  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, out.samples / 256)));
+  if (workers_.size() < threads) workers_.resize(threads);
+
+  const std::size_t per = (out.samples + threads - 1) / threads;
+  if (threads == 1) {
+    run(workers_[0], trajectories, 0, out.samples, out, options.obstacles);
+  } else {
+    std::vector<std::thread> pool;
+    pool.reserve(threads);
+    for (unsigned k = 0; k < threads; ++k) {
+      const std::size_t first = k * per;
+      const std::size_t last = std::min(out.samples, first + per);
+      pool.emplace_back([this, k, first, last, trajectories, &out, &options] {
+        run(workers_[k], trajectories, first, last, out, options.obstacles);
+      });
+    }
+    for (auto& t : pool) t.join();
+  }
+  out.collided_pairs = 0;
+  out.min_clearance_mm = std::numeric_limits<double>::infinity();
+  for (unsigned k = 0; k < threads; ++k) {
+    for (std::size_t p = 0; p < out.robot_pairs.size(); ++p) merge(out.robot_pairs[p], workers_[k].robot_pairs[p]);
+    for (std::size_t p = 0; p < out.obstacle_pairs.size(); ++p)
+      merge(out.obstacle_pairs[p], workers_[k].obstacle_pairs[p]);
+  }
+  for (const auto* v : {&out.robot_pairs, &out.obstacle_pairs})
+    for (const auto& o : *v) {
+      out.collided_pairs += o.collided ? 1 : 0;
+      out.min_clearance_mm = std::min(out.min_clearance_mm, o.min_clearance_mm);
+    }
+  return ok();
+}
+
+void TrajectoryChecker::run(Worker& w, std::span<const RobotTrajectory> trajectories, std::size_t first,
+                            std::size_t last, const CheckReport& shape, bool obstacles) const {
+  const CollisionModel& m = *model_;
+  const std::size_t n = m.size();
+  w.poses.assign(n, Pose{std::numeric_limits<double>::quiet_NaN(), 0});
+  w.segs.resize(n);
+  w.mid.resize(n);
+  w.half.resize(n);
+  for (std::size_t i = 0; i < n; ++i) w.half[i] = 0.5 * m.robot(i).collision_length_mm();
+  w.alpha.resize(n);
+  w.beta.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    w.alpha[i] = AngleCursor(trajectories[i].alpha);
+    w.beta[i] = AngleCursor(trajectories[i].beta);
+  }
+  w.robot_pairs.assign(shape.robot_pairs.size(), PairOutcome{});
+  w.obstacle_pairs.assign(shape.obstacle_pairs.size(), PairOutcome{});
+  const auto rp = m.robot_pairs();
+  const auto op = m.obstacle_pairs();
+
+  for (std::size_t s = first; s < last; ++s) {
+    const double t = s + 1 == shape.samples ? shape.end_s : shape.start_s + static_cast<double>(s) * shape.step_s;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Pose p{w.alpha[i].at(t), w.beta[i].at(t)};
+      if (p != w.poses[i]) {  // a robot standing still keeps its segment (NaN at start: always differs)
+        w.poses[i] = p;
+        w.segs[i] = m.robot(i).collision_segment(p);
+        w.mid[i] = 0.5 * (w.segs[i].a + w.segs[i].b);
+      }
+    }
+    for (std::size_t k = 0; k < rp.size(); ++k) {
+      // Each segment lies within half its length of its midpoint, so the midpoints' distance
+      // minus both half lengths and the limit is a lower bound of the clearance. When that bound
+      // cannot beat the pair's smallest clearance so far (which is >= 0 unless it collided
+      // already), the sample can change nothing for this pair: skip the exact distance.
+      const RobotPair& p = rp[k];
+      PairOutcome& o = w.robot_pairs[k];
+      const double room = w.half[p.a] + w.half[p.b] + p.limit_mm + o.min_clearance_mm;
+      if (room >= 0 && room < std::numeric_limits<double>::infinity() &&
+          norm2(w.mid[p.a] - w.mid[p.b]) > room * room && (o.collided || o.min_clearance_mm >= 0))
+        continue;
+      note(o, m.clearance(p, w.segs), t);
+    }
+    if (obstacles)
+      for (std::size_t k = 0; k < op.size(); ++k) note(w.obstacle_pairs[k], m.clearance(op[k], w.segs), t);
+  }
+}
+
+}  // namespace axon::fps::plan

@@ -1,0 +1,61 @@
+#include "axon/fps/plan/trajectory.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace axon::fps::plan {
+
+Result<void> validate(std::span<const TimedAngle> points, std::string_view what) {
+  if (points.empty()) return make_error(PlanErrc::bad_trajectory, fmt::format("{}: no points", what));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!std::isfinite(points[i].t_s) || !std::isfinite(points[i].deg))
+      return make_error(PlanErrc::bad_trajectory, fmt::format("{}: point {} is not finite", what, i));
+    if (i > 0 && !(points[i].t_s > points[i - 1].t_s))
+      return make_error(PlanErrc::bad_trajectory,
+                        fmt::format("{}: point {} at {} s does not come after {} s", what, i, points[i].t_s,
+                                    points[i - 1].t_s));
+  }
+  return ok();
+}
+
+Result<void> validate(const RobotTrajectory& t) {
+  AXON_TRY(validate(t.alpha, "alpha"));
+  return validate(t.beta, "beta");
+}
+
+namespace {
+double lerp(const TimedAngle& a, const TimedAngle& b, double t) noexcept {
+  const double f = (t - a.t_s) / (b.t_s - a.t_s);
+  return a.deg + f * (b.deg - a.deg);
+}
+}  // namespace
+
+double angle_at(std::span<const TimedAngle> points, double t_s) noexcept {
+  if (points.empty()) return 0;
+  if (t_s <= points.front().t_s) return points.front().deg;
+  if (t_s >= points.back().t_s) return points.back().deg;
+  const auto it = std::upper_bound(points.begin(), points.end(), t_s,
+                                   [](double t, const TimedAngle& p) { return t < p.t_s; });
+  return lerp(*(it - 1), *it, t_s);
+}
+
+double max_speed(std::span<const TimedAngle> points) noexcept {
+  double v = 0;
+  for (std::size_t i = 1; i < points.size(); ++i)
+    v = std::max(v, std::abs(points[i].deg - points[i - 1].deg) / (points[i].t_s - points[i - 1].t_s));
+  return v;
+}
+
+double AngleCursor::at(double t_s) noexcept {
+  if (points_.empty()) return 0;
+  if (t_s < last_t_) i_ = 0;
+  last_t_ = t_s;
+  if (t_s <= points_.front().t_s) return points_.front().deg;
+  if (t_s >= points_.back().t_s) return points_.back().deg;
+  while (i_ + 1 < points_.size() && points_[i_ + 1].t_s <= t_s) ++i_;
+  return lerp(points_[i_], points_[i_ + 1], t_s);
+}
+
+}  // namespace axon::fps::plan

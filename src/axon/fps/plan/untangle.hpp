@@ -1,0 +1,30 @@
+// Untangling after a half: robots the lock-step engine left away from their fold are planned one
+// at a time on a grid of their own two angles, everyone else standing still, to *any* fold (beta at
+// the fold angle, whatever alpha: the turn to the planned fold alpha happens later, while folded).
+//
+// With one robot moving and every other body still, the step certificate is exact: a point of the
+// collision segment moves at most |d alpha| * reach + |d beta| * collision length over a step, so
+// with clearances c0 and c1 at a step's ends the clearance inside it is at least (c0 + c1 - S) / 2.
+// A grid edge is used only where that is positive (and every cell but the start keeps the engine's
+// margin). Breadth-first search over the 8-connected grid (one engine step per edge) finds the
+// quickest way out if there is one at this resolution.
+//
+// Robots are moved in waves: in a wave, stuck robots that are not neighbours of each other move at
+// once (neighbours of a moving robot wait for the next wave, so every plan sees still neighbours);
+// waves repeat while they make progress. The paths are appended after the half's end.
+#pragma once
+
+#include "axon/fps/plan/collision.hpp"
+#include "axon/fps/plan/stepper.hpp"
+
+#include <span>
+
+namespace axon::fps::plan {
+
+// `robots` and `result` as from drive_to_goals (goals are folds at `fold_beta_deg`). Robots not
+// reached whose goal beta is the fold beta are untangled where possible: their paths, `end`,
+// `reached` and the result's duration are updated. Returns how many were untangled.
+std::size_t untangle_to_fold(const CollisionModel& model, std::span<const StepperRobot> robots, StepperResult& result,
+                             const StepperOptions& options, std::size_t max_cells_per_robot = 200'000);
+
+}  // namespace axon::fps::plan
