@@ -330,46 +330,46 @@ void add_can_commands(CLI::App& app, GlobalOptions&) {
   auto* can_cmd = app.add_subcommand("can", "CAN buses: dump, send, bridge, replay");
   can_cmd->require_subcommand(1);
 
-  static DumpOptions dump;
+  auto dump = std::make_shared<DumpOptions>();
   auto* d = can_cmd->add_subcommand("dump", "print frames from a bus (candump -L format), optionally log them");
-  d->add_option("-b,--bus", dump.bus, kBusHelp)->required();
-  d->add_option("-l,--log", dump.log, "also write a candump log file");
-  d->add_option("-f,--filter", dump.filters, "receive filter ID:MASK in hex (repeatable; any match passes)");
-  d->add_option("-n,--count", dump.count, "stop after this many frames");
-  d->add_option("-t,--timeout", dump.timeout_s, "seconds; with --count: fail (exit 1) if not reached, else run this long");
-  d->add_flag("--no-print", dump.quiet_frames, "do not print frames (log only)");
-  add_rotation_options(d, dump.rotation, "log", "--log");
-  d->callback([] { exit_code() = run_dump(dump); });
+  d->add_option("-b,--bus", dump->bus, kBusHelp)->required();
+  d->add_option("-l,--log", dump->log, "also write a candump log file");
+  d->add_option("-f,--filter", dump->filters, "receive filter ID:MASK in hex (repeatable; any match passes)");
+  d->add_option("-n,--count", dump->count, "stop after this many frames");
+  d->add_option("-t,--timeout", dump->timeout_s, "seconds; with --count: fail (exit 1) if not reached, else run this long");
+  d->add_flag("--no-print", dump->quiet_frames, "do not print frames (log only)");
+  add_rotation_options(d, dump->rotation, "log", "--log");
+  d->callback([dump] { exit_code() = run_dump(*dump); });
 
-  static SendOptions send;
+  auto send = std::make_shared<SendOptions>();
   auto* s = can_cmd->add_subcommand("send", "send frames given as ID#DATA (cansend notation)");
-  s->add_option("-b,--bus", send.bus, kBusHelp)->required();
-  s->add_option("frames", send.frames, "frames: 123#DEADBEEF, 12345678#00.11, 123#R, 123#R4")->required();
-  s->add_option("-r,--repeat", send.repeat, "send the list this many times")->check(positive());
-  s->add_option("-i,--interval", send.interval_ms, "milliseconds between frames")->check(non_negative());
-  s->callback([] { exit_code() = run_send(send); });
+  s->add_option("-b,--bus", send->bus, kBusHelp)->required();
+  s->add_option("frames", send->frames, "frames: 123#DEADBEEF, 12345678#00.11, 123#R, 123#R4")->required();
+  s->add_option("-r,--repeat", send->repeat, "send the list this many times")->check(positive());
+  s->add_option("-i,--interval", send->interval_ms, "milliseconds between frames")->check(non_negative());
+  s->callback([send] { exit_code() = run_send(*send); });
 
-  static BridgeOptions bridge;
+  auto bridge = std::make_shared<BridgeOptions>();
   auto* b = can_cmd->add_subcommand("bridge", "serve buses over socketcand and/or as a CAN@net gateway emulator");
-  b->add_option("-L,--listen", bridge.listen, "[socketcand://]HOST:PORT or cannet://HOST:PORT (port 0: any)")->required();
-  b->add_option("-b,--bus", bridge.buses, std::string(kBusHelp) + " (repeatable; default: one virtual bus vcan0)");
-  b->add_flag("--wire-model", bridge.wire_model, "account exact bit times on the virtual buses");
-  b->add_flag("--pace", bridge.pace, "deliver frames at the real bus speed (implies --wire-model)");
-  b->add_option("--bitrate", bridge.bitrate, "bit rate of the virtual buses")->check(CLI::Range(10'000u, 1'000'000u));
-  b->add_option("--duration", bridge.duration_s, "stop after this many seconds (default: until Ctrl-C)");
-  b->add_option("--fault-plan", bridge.fault_plan, "YAML fault plan applied to every virtual bus (docs/can-virtual.md)");
-  b->callback([] { exit_code() = run_bridge(bridge); });
+  b->add_option("-L,--listen", bridge->listen, "[socketcand://]HOST:PORT or cannet://HOST:PORT (port 0: any)")->required();
+  b->add_option("-b,--bus", bridge->buses, std::string(kBusHelp) + " (repeatable; default: one virtual bus vcan0)");
+  b->add_flag("--wire-model", bridge->wire_model, "account exact bit times on the virtual buses");
+  b->add_flag("--pace", bridge->pace, "deliver frames at the real bus speed (implies --wire-model)");
+  b->add_option("--bitrate", bridge->bitrate, "bit rate of the virtual buses")->check(CLI::Range(10'000u, 1'000'000u));
+  b->add_option("--duration", bridge->duration_s, "stop after this many seconds (default: until Ctrl-C)");
+  b->add_option("--fault-plan", bridge->fault_plan, "YAML fault plan applied to every virtual bus (docs/can-virtual.md)");
+  b->callback([bridge] { exit_code() = run_bridge(*bridge); });
 
-  static ReplayOptions replay;
+  auto replay = std::make_shared<ReplayOptions>();
   auto* r = can_cmd->add_subcommand("replay", "play a candump log onto a bus, keeping its timing");
-  r->add_option("-b,--bus", replay.bus, kBusHelp)->required();
-  r->add_option("file", replay.file, "candump log file")->required();
-  r->add_option("--speed", replay.speed, "time scale: 2 plays twice as fast");
-  r->add_flag("--no-timing", replay.no_timing, "send as fast as the bus takes them");
-  r->add_option("--loop", replay.loops, "play the file this many times")->check(positive());
-  r->add_option("--only", replay.only_iface, "only frames logged on this interface");
-  r->add_flag("--skip-bad", replay.skip_bad, "skip malformed lines (counted) instead of stopping at the first");
-  r->callback([] { exit_code() = run_replay(replay); });
+  r->add_option("-b,--bus", replay->bus, kBusHelp)->required();
+  r->add_option("file", replay->file, "candump log file")->required();
+  r->add_option("--speed", replay->speed, "time scale: 2 plays twice as fast");
+  r->add_flag("--no-timing", replay->no_timing, "send as fast as the bus takes them");
+  r->add_option("--loop", replay->loops, "play the file this many times")->check(positive());
+  r->add_option("--only", replay->only_iface, "only frames logged on this interface");
+  r->add_flag("--skip-bad", replay->skip_bad, "skip malformed lines (counted) instead of stopping at the first");
+  r->callback([replay] { exit_code() = run_replay(*replay); });
 }
 
 }  // namespace axon::app

@@ -14,6 +14,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <memory>
 
 namespace axon::app {
 namespace {
@@ -59,15 +60,15 @@ int run_sim_plc(const SimPlcOptions& o) {
 
 void add_sim_plc_command(CLI::App& app, GlobalOptions&) {
   CLI::App* sim_cmd = app.get_subcommand("sim");
-  static SimPlcOptions o;
+  auto o = std::make_shared<SimPlcOptions>();
   auto* p = sim_cmd->add_subcommand("plc", "PLC emulator (Modbus TCP): power and sync relays, sensors");
-  p->add_option("--listen", o.listen, "serve on HOST:PORT (default 127.0.0.1:0, any free port)");
-  p->add_option("--map", o.map_file, "register map YAML (default: docs/fps-plc.md)");
-  p->add_option("--script", o.script_file, "sensor script YAML: [{t: S, sensor: NAME, value: V}, ...]");
-  p->add_option("--time-scale", o.time_scale, "script seconds per real second (default 1)");
-  p->add_option("--temperature", o.temperature_c, "initial temperature of every sensor, degC (default 15)");
-  p->add_option("--duration", o.duration_s, "stop after this many seconds (default: until Ctrl-C)");
-  p->callback([] { exit_code() = run_sim_plc(o); });
+  p->add_option("--listen", o->listen, "serve on HOST:PORT (default 127.0.0.1:0, any free port)");
+  p->add_option("--map", o->map_file, "register map YAML (default: docs/fps-plc.md)");
+  p->add_option("--script", o->script_file, "sensor script YAML: [{t: S, sensor: NAME, value: V}, ...]");
+  p->add_option("--time-scale", o->time_scale, "script seconds per real second (default 1)");
+  p->add_option("--temperature", o->temperature_c, "initial temperature of every sensor, degC (default 15)");
+  p->add_option("--duration", o->duration_s, "stop after this many seconds (default: until Ctrl-C)");
+  p->callback([o] { exit_code() = run_sim_plc(*o); });
 }
 
 }  // namespace axon::app
