@@ -40,8 +40,8 @@ cat >"$work/pc.cpp" <<'CPP'
 #include <cstdio>
 int main() {
   auto f = axon::can::Frame::parse("123#DEADBEEF");
-  if (!f || f->to_string() != "123#DEADBEEF") return 1;
-  std::printf("%s\n", f->to_string().c_str());
+  if (!f || f.value().to_string() != "123#DEADBEEF") return 1;
+  std::printf("%s\n", f.value().to_string().c_str());
   return 0;
 }
 CPP
