@@ -4,9 +4,12 @@
 // client, the Positioner and Array motion calls); reads, settings and stops still go out, and
 // after unlock() the moves go out again. "Leaves the host" is checked on the wire: a listener node
 // on each virtual bus records every frame, and a refused command must not appear there at all
-// (neither its request nor a reply to it).
+// (neither its request nor a reply to it). The commands come from the command table's flags.
 #include "fake_device.hpp"
+#include "plane_rig.hpp"
 #include "sim_rig.hpp"
+
+#include "axon/fps/host/focal_plane_array.hpp"
 
 #include "axon/fps/protocol/commands.hpp"
 
@@ -24,16 +27,16 @@ namespace {
 
 using Trajectories = std::map<std::uint16_t, protocol::Trajectory>;
 
-// The commands that set a robot moving or arm a motion (spec 5.3.4-5.3.6, 5.3.8, 5.3.11-5.3.19,
-// 5.3.21-5.3.22, 5.3.31-5.3.33).
-const std::vector<CommandId> kMoving{
-    CommandId::send_new_trajectory,     CommandId::send_trajectory_data,    CommandId::trajectory_data_end,
-    CommandId::start_trajectory,        CommandId::go_to_datums,            CommandId::go_to_datum_alpha,
-    CommandId::go_to_datum_beta,        CommandId::calibrate_datum,         CommandId::calibrate_datum_alpha,
-    CommandId::calibrate_datum_beta,    CommandId::calibrate_motors,        CommandId::calibrate_motor_alpha,
-    CommandId::calibrate_motor_beta,    CommandId::go_to_absolute_position, CommandId::go_to_relative_position,
-    CommandId::calibrate_cogging,       CommandId::calibrate_cogging_alpha, CommandId::calibrate_cogging_beta,
-};
+// The commands of the table with a given flag.
+std::vector<CommandId> commands_where(bool protocol::CommandInfo::*flag) {
+  std::vector<CommandId> out;
+  for (const auto& c : protocol::kCommands) {
+    if (c.*flag) out.push_back(c.id);
+  }
+  return out;
+}
+const std::vector<CommandId> kMoving = commands_where(&protocol::CommandInfo::moves);
+const std::vector<CommandId> kReads = commands_where(&protocol::CommandInfo::read_only);
 
 // A request payload of the size the command table asks for (zeros: a move to (0, 0), a
 // trajectory of no points ...). Never sent while locked; valid enough for the ones that are.
@@ -102,6 +105,9 @@ TEST(MotionLock, RawRequestsOnTheArraysClientsDoNotMoveARobotWhileLocked) {
     }
     auto call = co_await client.call<CommandId::go_to_absolute_position>(3, protocol::ArmPositions{});
     expect_locked(call, "call<GO_TO_ABSOLUTE_POSITION>");
+    EXPECT_EQ(kMoving.size(), 18u);
+    EXPECT_EQ(client.counters().refused, kMoving.size() + 1);  // each refusal counted once
+    EXPECT_EQ(t.rig.array->client_totals().refused, kMoving.size() + 1);
     EXPECT_EQ(t.moving_frames(), 0u);
     EXPECT_FALSE(t.rig.model(3).moving());
   });
@@ -261,5 +267,101 @@ TEST(MotionLock, AfterUnlockTheSameRawMoveGoesOut) {
     EXPECT_TRUE(moved.has_value()) << (moved ? "" : moved.error().message());
     EXPECT_EQ(t.on_wire(CommandId::go_to_absolute_position), 2u);  // the request and its reply
     EXPECT_TRUE(t.rig.model(5).moving());
+  });
+}
+
+TEST(MotionLock, EveryReadOnlyCommandStillGoesOutWhileLocked) {
+  LockRig t;
+  t.rig.run([&]() -> asio::awaitable<void> {
+    co_await t.lock();
+    CommandClient& client = t.rig.array->client(0);
+    for (auto c : kReads) {
+      if (!protocol::command_info(c).application) continue;  // robot 3 runs its main application
+      auto r = co_await client.request(3, c, zeros_for(c));
+      if (!r) { EXPECT_NE(r.error(), HostErrc::locked) << protocol::command_name(c); }
+      EXPECT_GT(t.on_wire(c), 0u) << protocol::command_name(c) << " was not sent";
+    }
+    EXPECT_EQ(client.counters().refused, 0u);
+  });
+}
+
+TEST(MotionLock, AFocalPlaneRunStartedByTheSyncLineIsRefusedWithoutAPulse) {
+  PlaneRig rig;
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    auto found = co_await rig.fpa->discover();
+    EXPECT_TRUE(found.has_value());
+    co_await rig.fpa->array().emergency_stop("test lock");
+    Trajectories runs;
+    runs.emplace(1, trajectory({{10, 1.0}}, {}));
+    auto run = co_await rig.fpa->run_trajectories(std::move(runs), {}, true);
+    expect_locked(run, "FocalPlaneArray::run_trajectories by the sync line");
+    // The chokepoint itself, below the array's up-front check: a triggered start on a bus client.
+    bool pulsed = false;
+    BroadcastOptions by_sync;
+    by_sync.trigger = [&]() -> asio::awaitable<Result<void>> {
+      pulsed = true;
+      co_return ok();
+    };
+    auto start = co_await rig.fpa->array().client(0).broadcast(CommandId::start_trajectory, {}, by_sync);
+    expect_locked(start, "START_TRAJECTORY by trigger");
+    EXPECT_FALSE(pulsed);
+    EXPECT_EQ(rig.sim->counters().sync_edges, 0u);
+  });
+}
+
+TEST(MotionLock, AClientWithALockOfItsOwnRefusesMovesCountsThemAndLetsTheRestThrough) {
+  Runner runner;
+  auto medium = can::VirtualBus::create(runner.io.get_executor(), "fps0");
+  auto host_bus = medium->attach("host");
+  FakeDevice device(*medium, [](const protocol::Message& m) {
+    std::vector<Outgoing> out;
+    if (!m.id.is_broadcast()) out.push_back({reply_to(m, m.id.positioner)});
+    return out;
+  });
+  auto lock = std::make_shared<MotionLock>();
+  CommandClient client(*host_bus, {}, lock);
+  runner.on_stop([&]() -> asio::awaitable<void> {
+    co_await client.stop();
+    device.stop();
+  });
+  runner.run([&]() -> asio::awaitable<void> {
+    EXPECT_EQ(client.motion_lock(), lock.get());
+    EXPECT_TRUE(lock->lock("operator"));
+    EXPECT_FALSE(lock->lock("second reason"));  // the first reason stays
+    std::size_t broadcastable = 0;
+    for (auto c : kMoving) {
+      auto r = co_await client.request(7, c, zeros_for(c));
+      expect_locked(r, protocol::command_name(c));
+      if (!r) { EXPECT_NE(r.error().message().find("operator"), std::string::npos) << r.error().message(); }
+      if (protocol::command_info(c).broadcast) {
+        ++broadcastable;
+        {
+          const auto r_ = co_await client.broadcast(c, zeros_for(c));
+          expect_locked(r_, "broadcast");
+        }
+        {
+          const auto r_ = co_await client.broadcast_now(c);
+          expect_locked(r_, "broadcast_now");
+        }
+      }
+    }
+    EXPECT_EQ(broadcastable, 1u);  // START_TRAJECTORY
+    EXPECT_EQ(client.counters().refused, kMoving.size() + 2 * broadcastable);
+    EXPECT_EQ(client.counters().sent, 0u);
+    EXPECT_TRUE(device.requests().empty());
+    // Stops and settings go out.
+    EXPECT_TRUE((co_await client.request(7, CommandId::stop_trajectory)).has_value());
+    EXPECT_TRUE((co_await client.request(7, CommandId::set_speed, zeros_for(CommandId::set_speed))).has_value());
+    EXPECT_TRUE((co_await client.broadcast_now(CommandId::trajectory_abort)).has_value());
+    // Released: the same moves go out.
+    lock->clear();
+    EXPECT_FALSE(lock->locked());
+    for (auto c : kMoving) {
+      auto r = co_await client.request(7, c, zeros_for(c));
+      EXPECT_TRUE(r.has_value()) << protocol::command_name(c) << ": " << (r ? "" : r.error().message());
+    }
+    EXPECT_EQ(device.requests().size(), kMoving.size() + 3);
   });
 }
