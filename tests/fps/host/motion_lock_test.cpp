@@ -46,6 +46,17 @@ protocol::Payload zeros_for(CommandId c) {
   return p;
 }
 
+// A START_TRAJECTORY broadcast started by a trigger, as the sync line starts one; `pulsed` says
+// whether the trigger ran.
+asio::awaitable<Result<BroadcastResult>> start_by_trigger(CommandClient& client, bool& pulsed) {
+  BroadcastOptions by_sync;
+  by_sync.trigger = [&pulsed]() -> asio::awaitable<Result<void>> {
+    pulsed = true;
+    co_return ok();
+  };
+  co_return co_await client.broadcast(CommandId::start_trajectory, {}, std::move(by_sync));
+}
+
 FakeDevice::Script silent() {
   return [](const protocol::Message&) { return std::vector<Outgoing>{}; };
 }
@@ -108,6 +119,7 @@ TEST(MotionLock, RawRequestsOnTheArraysClientsDoNotMoveARobotWhileLocked) {
     EXPECT_EQ(kMoving.size(), 18u);
     EXPECT_EQ(client.counters().refused, kMoving.size() + 1);  // each refusal counted once
     EXPECT_EQ(t.rig.array->client_totals().refused, kMoving.size() + 1);
+    EXPECT_EQ(t.rig.array->motion_lock()->refused(), kMoving.size() + 1);
     EXPECT_EQ(t.moving_frames(), 0u);
     EXPECT_FALSE(t.rig.model(3).moving());
   });
@@ -127,12 +139,7 @@ TEST(MotionLock, PipelinesAndBroadcastsDoNotMoveARobotWhileLocked) {
     auto start = co_await client.broadcast(CommandId::start_trajectory);
     expect_locked(start, "START_TRAJECTORY broadcast");
     bool pulsed = false;
-    BroadcastOptions by_sync;
-    by_sync.trigger = [&]() -> asio::awaitable<Result<void>> {
-      pulsed = true;
-      co_return ok();
-    };
-    auto synced = co_await client.broadcast(CommandId::start_trajectory, {}, by_sync);
+    auto synced = co_await start_by_trigger(client, pulsed);
     expect_locked(synced, "START_TRAJECTORY by trigger");
     EXPECT_FALSE(pulsed) << "the sync line trigger ran while locked";
     auto now = co_await client.broadcast_now(CommandId::start_trajectory);
@@ -297,14 +304,10 @@ TEST(MotionLock, AFocalPlaneRunStartedByTheSyncLineIsRefusedWithoutAPulse) {
     runs.emplace(1, trajectory({{10, 1.0}}, {}));
     auto run = co_await rig.fpa->run_trajectories(std::move(runs), {}, true);
     expect_locked(run, "FocalPlaneArray::run_trajectories by the sync line");
+    EXPECT_EQ(rig.fpa->array().motion_lock()->refused(), 1u);  // refused up front, for the whole run
     // The chokepoint itself, below the array's up-front check: a triggered start on a bus client.
     bool pulsed = false;
-    BroadcastOptions by_sync;
-    by_sync.trigger = [&]() -> asio::awaitable<Result<void>> {
-      pulsed = true;
-      co_return ok();
-    };
-    auto start = co_await rig.fpa->array().client(0).broadcast(CommandId::start_trajectory, {}, by_sync);
+    auto start = co_await start_by_trigger(rig.fpa->array().client(0), pulsed);
     expect_locked(start, "START_TRAJECTORY by trigger");
     EXPECT_FALSE(pulsed);
     EXPECT_EQ(rig.sim->counters().sync_edges, 0u);

@@ -21,9 +21,10 @@
 // sends, and every broadcast trigger (the sync line), first passes the lock it was given: while
 // that lock is held, a command the table marks `moves` is refused with HostErrc::locked, nothing
 // goes on the bus and ClientCounters::refused counts it. Reads, settings and stops always go out.
-// An Array gives all its clients its own lock, so whoever holds one of them (Array::client(bus),
-// a Positioner, a pipeline of trajectory points) cannot move a robot of a locked array. A client
-// made without a lock refuses nothing. Frames written to the can::Bus directly bypass it.
+// An Array gives the clients of all its buses its one lock, so whoever holds one of them
+// (Array::client(bus), a Positioner, a pipeline of trajectory points) cannot move a robot of a
+// locked array. A client made without a lock refuses nothing. Frames written to the can::Bus
+// directly bypass it.
 //
 // Threading: everything runs on the bus's executor (single-threaded). Lifetime: call `co_await
 // stop()` before destroying the client, and keep the bus alive until the reader has stopped (stop()

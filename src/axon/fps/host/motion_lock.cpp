@@ -9,6 +9,7 @@ namespace axon::fps::host {
 Result<void> MotionLock::admit(protocol::CommandId command, std::uint16_t positioner) const {
   const auto& info = protocol::command_info(command);
   if (!state_.locked || !info.moves) return ok();
+  ++refused_;
   const std::string to = positioner == 0 ? std::string("broadcast") : fmt::format("positioner {}", positioner);
   return Error(HostErrc::locked, fmt::format("{}: {}; {} not sent", to, state_.reason, info.name));
 }

@@ -7,7 +7,8 @@
 // frame or a sync-line trigger leaves it. Every client of an Array shares the array's lock, so no
 // handle on those buses (Array::client(bus), a Positioner, the firmware upgrade, a pipeline, a raw
 // request or broadcast) can send a move while the array is locked. A refusal is HostErrc::locked,
-// nothing goes on the bus, and the client counts it (ClientCounters::refused).
+// nothing goes on the bus, and it is counted: by the lock (refused(), whoever asked) and by the
+// client that refused it (ClientCounters::refused).
 //
 // The Array locks and unlocks (a collision report, a collision flag seen while polling, a lost
 // gateway, emergency_stop / request_stop; unlock() after STOP_TRAJECTORY went out on every bus). A
@@ -49,8 +50,10 @@ class MotionLock {
   [[nodiscard]] const LockState& state() const noexcept { return state_; }
 
   // The rule: HostErrc::locked when `command` moves (its table flag) and the lock is held, naming
-  // the robot (0: a broadcast), the command and the reason; ok otherwise.
+  // the robot (0: a broadcast), the command and the reason; ok otherwise. Counts each refusal.
   [[nodiscard]] Result<void> admit(protocol::CommandId command, std::uint16_t positioner) const;
+  // Refusals since this lock was made (every path, every time it was held).
+  [[nodiscard]] std::uint64_t refused() const noexcept { return refused_; }
   // The error of a motion step on `positioner` that the lock ended while it was under way.
   [[nodiscard]] Error interrupted(std::uint16_t positioner) const;
 
@@ -63,6 +66,7 @@ class MotionLock {
 
  private:
   LockState state_;
+  mutable std::uint64_t refused_ = 0;  // a statistic: admit() stays a question about the state
 };
 
 }  // namespace axon::fps::host
