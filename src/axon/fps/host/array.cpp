@@ -40,7 +40,7 @@ Array::Array(std::vector<can::Bus*> buses, ArrayOptions options) : options_(std:
   for (std::size_t i = 0; i < buses.size(); ++i) {
     BusSlot slot;
     slot.bus = buses[i];
-    slot.client = std::make_unique<CommandClient>(*buses[i], options_.client);
+    slot.client = std::make_unique<CommandClient>(*buses[i], options_.client, lock_);
     slot.subscription = slot.client->subscribe([this, i](const Unsolicited& u) { on_unsolicited(i, u); });
     buses_.push_back(std::move(slot));
   }
@@ -222,9 +222,11 @@ asio::awaitable<StatusTable> Array::status_table(bool positions) {
 
 // --- safety --------------------------------------------------------------------------------------
 
-Result<void> Array::may_move(std::uint16_t positioner) const {
-  if (!lock_.locked) return ok();
-  return Error(HostErrc::locked, fmt::format("positioner {}: {}", positioner, lock_.reason));
+Result<void> Array::admit_all(CommandId c, const std::vector<std::uint16_t>& ids) const {
+  for (auto id : ids) {
+    if (auto a = lock_->admit(c, id); !a) return a;
+  }
+  return ok();
 }
 
 void Array::on_unsolicited(std::size_t bus, const Unsolicited& u) {
@@ -237,15 +239,15 @@ void Array::on_unsolicited(std::size_t bus, const Unsolicited& u) {
     return;
   }
   Collision c{u.positioner, bus, u.code, u.timestamp, false};
-  if (lock_.locked) {
-    lock_.collisions.push_back(c);
+  if (lock_->locked()) {
+    lock_->record_collision(c);
     ++counters_.expected_collisions;
     spdlog::info("fps array: positioner {} on bus {} reports a collision ({}) after the stop", u.positioner,
                  bus_name(bus), arm_of(u.code));
     return;
   }
   c.caused_lock = true;
-  lock_.collisions.push_back(c);
+  lock_->record_collision(c);
   ++counters_.collision_locks;
   lock_for(fmt::format("collision ({}) reported by positioner {} on bus {}", arm_of(u.code), u.positioner,
                        bus_name(bus)));
@@ -253,14 +255,14 @@ void Array::on_unsolicited(std::size_t bus, const Unsolicited& u) {
 }
 
 void Array::collision_seen(std::uint16_t positioner, const protocol::PositionerStatus& status) {
-  if (lock_.locked) return;
+  if (lock_->locked()) return;
   Collision c;
   c.positioner = positioner;
   if (auto b = bus_of(positioner)) c.bus = b.value();
   c.code = status.has(protocol::StatusBit::collision_alpha) ? ResponseCode::alpha_collision
                                                              : ResponseCode::beta_collision;
   c.caused_lock = true;
-  lock_.collisions.push_back(c);
+  lock_->record_collision(c);
   ++counters_.collision_locks;
   lock_for(fmt::format("collision flag ({}) in the status of positioner {} on bus {} (its collision report was "
                        "not received)",
@@ -270,16 +272,16 @@ void Array::collision_seen(std::uint16_t positioner, const protocol::PositionerS
 
 void Array::stop_in_background() {
   ++background_;
-  asio::co_spawn(executor_, stop_everyone(lock_.reason), [this](std::exception_ptr, StopReport) {
+  asio::co_spawn(executor_, stop_everyone(lock_->state().reason), [this](std::exception_ptr, StopReport) {
     --background_;
     for (auto* w : background_waiters_) w->notify();
   });
 }
 
 void Array::lock_for(std::string reason) {
-  lock_.locked = true;
-  lock_.reason = std::move(reason);
-  spdlog::error("fps array locked: {}; stopping every robot", lock_.reason);
+  if (lock_->lock(std::move(reason))) {
+    spdlog::error("fps array locked: {}; stopping every robot", lock_->state().reason);
+  }
 }
 
 asio::awaitable<StopReport> Array::stop_everyone(std::string reason) {
@@ -310,20 +312,20 @@ asio::awaitable<StopReport> Array::stop_everyone(std::string reason) {
     report.buses[i].error = r.error().message();
     const auto msg = fmt::format("bus {}: TRAJECTORY_ABORT not sent: {}", bus_name(i), r.error().message());
     spdlog::error("fps array: {}", msg);
-    lock_.stop_errors.push_back(msg);
+    lock_->record_stop_error(msg);
   });
   last_stop_ = report;
   co_return report;
 }
 
 asio::awaitable<StopReport> Array::emergency_stop(std::string reason) {
-  if (!lock_.locked) lock_for(reason);
+  lock_for(reason);
   auto report = co_await stop_everyone(std::move(reason));
   co_return report;
 }
 
 void Array::request_stop(std::string reason) {
-  if (!lock_.locked) lock_for(std::move(reason));
+  lock_for(std::move(reason));
   stop_in_background();
 }
 
@@ -360,7 +362,7 @@ std::string StopReport::to_text() const {
 }
 
 asio::awaitable<Result<UnlockReport>> Array::unlock() {
-  const std::size_t collisions_before = lock_.collisions.size();
+  const std::size_t collisions_before = lock_->state().collisions.size();
   auto results = co_await broadcast_on(all_buses(), CommandId::stop_trajectory);
   UnlockReport report;
   std::vector<std::string> failures;
@@ -382,14 +384,14 @@ asio::awaitable<Result<UnlockReport>> Array::unlock() {
     co_return Error(HostErrc::locked, fmt::format("STOP_TRAJECTORY could not be sent ({}); the array stays locked",
                                                   fmt::join(failures, "; ")));
   }
-  if (lock_.collisions.size() != collisions_before) {
+  if (lock_->state().collisions.size() != collisions_before) {
     co_return Error(HostErrc::locked, "a collision was reported while unlocking; the array stays locked");
   }
-  if (lock_.locked) {
+  if (lock_->locked()) {
     spdlog::info("fps array unlocked ({} robots acknowledged STOP_TRAJECTORY)", report.acknowledged.size());
     ++counters_.unlocks;
   }
-  lock_ = LockState{};
+  lock_->clear();
   co_return report;
 }
 
@@ -445,13 +447,14 @@ asio::awaitable<Result<Array::MoveResults>> Array::goto_relative(std::map<std::u
 asio::awaitable<Result<Array::MoveResults>> Array::move_many(std::map<std::uint16_t, ArmAngles> values,
                                                              bool relative) {
   std::vector<std::pair<std::uint16_t, ArmAngles>> list(values.begin(), values.end());
+  std::vector<std::uint16_t> ids;
   for (const auto& [id, t] : list) {
     if (!find(id)) co_return Error(HostErrc::unknown_positioner, fmt::format("positioner {}", id));
-    if (auto g = may_move(id); !g) co_return g.error();
+    ids.push_back(id);
   }
+  const auto move = relative ? CommandId::go_to_relative_position : CommandId::go_to_absolute_position;
+  if (auto a = admit_all(move, ids); !a) co_return a.error();
   std::vector<Result<MoveResult>> results(list.size(), Result<MoveResult>(Error(HostErrc::cancelled)));
-  std::vector<std::uint16_t> ids;
-  for (const auto& [id, t] : list) ids.push_back(id);
   const MovingMark mark(moving_, std::move(ids));
   co_await for_each_concurrently(list.size(), [&](std::size_t i) -> asio::awaitable<void> {
     Positioner* p = find(list[i].first);
@@ -488,6 +491,7 @@ ClientCounters Array::client_totals() const {
     t.bad_replies += c.bad_replies;
     t.uid_waits += c.uid_waits;
     t.slot_waits += c.slot_waits;
+    t.refused += c.refused;
     for (std::size_t i = 0; i < t.by_code.size(); ++i) t.by_code[i] += c.by_code[i];
   }
   return t;

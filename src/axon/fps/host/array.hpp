@@ -8,8 +8,10 @@
 //
 // Safety. A collision report (command 18, uid 0) from any robot on any bus locks the array at
 // once and sends TRAJECTORY_ABORT as a broadcast on every bus (abort, not stop: the collision flags
-// stay for diagnosis). While locked, everything that moves a robot fails with HostErrc::locked,
-// including steps already waiting (their next poll sees the lock). More collision reports after
+// stay for diagnosis). While locked, every command that moves a robot is refused with
+// HostErrc::locked by the command client it would go through (motion_lock.hpp: one lock shared by
+// every bus's client, one rule from the command table), whichever handle sends it; steps already
+// waiting end at their next poll. More collision reports after
 // the stop are expected (neighbours hit by the stop, robots noticing late): they are recorded, not
 // treated as new. unlock() sends STOP_TRAJECTORY on every bus, which clears the flags, and only then
 // unlocks. A robot that does not acknowledge a trajectory start makes the array stop every robot
@@ -28,6 +30,7 @@
 #include "axon/core/error.hpp"
 #include "axon/fps/host/command_client.hpp"
 #include "axon/fps/host/firmware_upgrade.hpp"
+#include "axon/fps/host/motion_lock.hpp"
 #include "axon/fps/host/positioner.hpp"
 #include "axon/fps/host/status_table.hpp"
 #include "axon/fps/host/trajectory_report.hpp"
@@ -58,21 +61,6 @@ struct DiscoveryReport {
   StatusTable table;                  // every robot found, with firmware and status
   std::vector<std::string> problems;  // buses that failed, ids that answered on two buses, ...
   std::vector<std::size_t> failed_buses;  // buses whose GET_ID broadcast failed (their robots are unknown)
-};
-
-struct Collision {
-  std::uint16_t positioner = 0;
-  std::size_t bus = 0;
-  protocol::ResponseCode code = protocol::ResponseCode::accepted;  // alpha_collision or beta_collision
-  core::WallTime when{0};
-  bool caused_lock = false;  // false: reported after the array was already locked (expected)
-};
-
-struct LockState {
-  bool locked = false;
-  std::string reason;                   // what locked the array
-  std::vector<Collision> collisions;    // the first caused the lock; the rest came after the stop
-  std::vector<std::string> stop_errors; // buses where the stop broadcast could not be sent
 };
 
 // One bus of an emergency stop: did the TRAJECTORY_ABORT broadcast go out, and to whom.
@@ -123,6 +111,7 @@ class Array final : public MotionGate {
 
   [[nodiscard]] const ArrayOptions& options() const noexcept { return options_; }
   [[nodiscard]] std::size_t bus_count() const noexcept { return buses_.size(); }
+  // The command client of a bus; it obeys the array's lock like every other path.
   [[nodiscard]] CommandClient& client(std::size_t bus) const { return *buses_.at(bus).client; }
   [[nodiscard]] const std::string& bus_name(std::size_t bus) const { return buses_.at(bus).bus->name(); }
 
@@ -145,12 +134,13 @@ class Array final : public MotionGate {
   asio::awaitable<StatusTable> status_table(bool positions = true);
 
   // --- safety --------------------------------------------------------------------------------
-  [[nodiscard]] Result<void> may_move(std::uint16_t positioner) const override;
   // A collision flag found while polling a robot during a step: locks and stops like a collision
   // frame (which may have been lost).
   void collision_seen(std::uint16_t positioner, const protocol::PositionerStatus& status) override;
-  [[nodiscard]] bool locked() const noexcept { return lock_.locked; }
-  [[nodiscard]] const LockState& lock_state() const noexcept { return lock_; }
+  [[nodiscard]] bool locked() const noexcept { return lock_->locked(); }
+  [[nodiscard]] const LockState& lock_state() const noexcept { return lock_->state(); }
+  // The lock every client of this array obeys (for a client made by hand on one of its buses).
+  [[nodiscard]] std::shared_ptr<const MotionLock> motion_lock() const noexcept { return lock_; }
   // Locks the array and stops every robot (TRAJECTORY_ABORT broadcast on every bus at once), as
   // a collision does; `reason` says why in the lock and in every robot's result. For operators and
   // supervisors. When the array was already locked, the first reason stays and the abort goes out
@@ -218,6 +208,8 @@ class Array final : public MotionGate {
   };
 
   asio::awaitable<Result<MoveResults>> move_many(std::map<std::uint16_t, ArmAngles> values, bool relative);
+  // The lock's rule asked up front for a whole sequence, so that a refused one does nothing at all.
+  [[nodiscard]] Result<void> admit_all(protocol::CommandId c, const std::vector<std::uint16_t>& ids) const;
   void on_unsolicited(std::size_t bus, const Unsolicited& u);
   void lock_for(std::string reason);
   void stop_in_background();
@@ -250,7 +242,7 @@ class Array final : public MotionGate {
   asio::any_io_executor executor_;
   std::vector<BusSlot> buses_;
   std::map<std::uint16_t, Robot> robots_;
-  LockState lock_;
+  std::shared_ptr<MotionLock> lock_ = std::make_shared<MotionLock>();  // shared with every client
   ArrayCounters counters_;
   std::set<std::uint16_t> moving_;
   std::optional<StopReport> last_stop_;

@@ -56,7 +56,9 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
     rep.robots.push_back(std::move(run));
     traj.push_back(&t);
   }
-  if (auto g = may_move(rep.robots.front().id); !g) co_return g.error();
+  std::vector<std::uint16_t> ids;
+  for (const auto& r : rep.robots) ids.push_back(r.id);
+  if (auto a = admit_all(CommandId::send_new_trajectory, ids); !a) co_return a.error();
   const std::size_t n = rep.robots.size();
   const auto involved = buses_of(rep);
   auto phase_start = core::steady_now();
@@ -146,9 +148,9 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
     }
     return ids;
   }();
-  const bool lock_now = lock_.locked;
+  const bool lock_now = lock_->locked();
   if (!failed.empty() || lock_now) {
-    rep.outcome = lock_now ? fmt::format("not started: the array is locked ({})", lock_.reason)
+    rep.outcome = lock_now ? fmt::format("not started: the array is locked ({})", lock_->state().reason)
                            : fmt::format("not started: {} of {} positioners failed the checks or the upload (each "
                                          "listed once below)",
                                          failed.size(), n);
@@ -258,7 +260,8 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
     auto st = co_await p->wait_for(done, duration + o.end_margin, "trajectory");
     if (!st) {
       const auto& e = st.error();
-      const bool reported = std::any_of(lock_.collisions.begin(), lock_.collisions.end(),
+      const auto& collisions = lock_->state().collisions;
+      const bool reported = std::any_of(collisions.begin(), collisions.end(),
                                         [&](const Collision& c) { return c.positioner == r.id; });
       if (e == HostErrc::collision || reported) {
         co_return fail(r, RobotState::collided, e.message());
@@ -290,8 +293,8 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
   rep.completed = rep.all(RobotState::completed);
   if (rep.completed) {
     rep.outcome = fmt::format("completed: {} robots at their targets", n);
-  } else if (lock_.locked) {
-    rep.outcome = fmt::format("stopped: {}", lock_.reason);
+  } else if (lock_->locked()) {
+    rep.outcome = fmt::format("stopped: {}", lock_->state().reason);
   } else {
     rep.outcome = "finished with problems";
   }

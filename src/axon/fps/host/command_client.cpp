@@ -32,32 +32,6 @@ long long as_ms(core::Duration d) { return std::chrono::duration_cast<std::chron
 
 }  // namespace
 
-bool is_read(CommandId c) noexcept {
-  switch (c) {
-    case CommandId::get_id:
-    case CommandId::get_firmware_version:
-    case CommandId::get_status:
-    case CommandId::get_datum_calibration_error:
-    case CommandId::get_current_position:
-    case CommandId::get_offsets:
-    case CommandId::get_hall_position:
-    case CommandId::get_motor_calibration_error:
-    case CommandId::get_position_and_current_alpha:
-    case CommandId::get_position_and_current_beta:
-    case CommandId::get_currents:
-    case CommandId::get_position_and_torque_alpha:
-    case CommandId::get_position_and_torque_beta:
-    case CommandId::get_torques:
-    case CommandId::get_cogging_vector_length:
-    case CommandId::get_cogging_positive:
-    case CommandId::get_cogging_negative:
-    case CommandId::get_cogging_angles:
-    case CommandId::get_holding_current:
-    case CommandId::get_raw_temperature: return true;
-    default: return false;
-  }
-}
-
 Error Reply::error() const {
   return Error(protocol::make_error_code(code),
                fmt::format("positioner {} {} uid {}", positioner, protocol::command_name(command), uid));
@@ -127,10 +101,12 @@ struct Turn {
 
 class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
  public:
-  Impl(can::Bus& b, ClientOptions o) : bus(b), options(std::move(o)), ex(b.get_executor()) {}
+  Impl(can::Bus& b, ClientOptions o, std::shared_ptr<const MotionLock> l)
+      : bus(b), options(std::move(o)), lock(std::move(l)), ex(b.get_executor()) {}
 
   can::Bus& bus;
   ClientOptions options;
+  std::shared_ptr<const MotionLock> lock;  // may be null: nothing is refused
   asio::any_io_executor ex;
   ClientCounters counters;
   bool stopping = false;
@@ -392,7 +368,8 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
     if (auto r = protocol::check_request(info, false, payload.size()); !r) {
       co_return Error(r.error().code, fmt::format("positioner {} {}: {}", pos, info.name, r.error().detail));
     }
-    const unsigned attempts = 1 + (is_read(cmd) ? ro.retries.value_or(options.read_retries) : 0);
+    if (auto a = admit(cmd, pos); !a) co_return a.error();  // at once, rather than after a wait for a uid
+    const unsigned attempts = 1 + (info.read_only ? ro.retries.value_or(options.read_retries) : 0);
     const auto timeout = ro.timeout.value_or(options.timeout_for(cmd));
     for (unsigned attempt = 0;; ++attempt) {
       if (attempt > 0) ++counters.retries;
@@ -430,9 +407,6 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
       ~SlotGuard() { self.release_slot(); }
     } slot_guard{*this};
 
-    auto frame = protocol::make_request(pos, cmd, uid, payload);
-    if (!frame) co_return frame.error();
-
     Pending p(ex);
     const auto key = pending_key(pos, n, uid);
     pending[key] = &p;
@@ -445,14 +419,9 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
       }
     } pending_guard{*this, key, &p};
 
-    ++counters.sent;
-    auto sent = co_await bus.send(frame.value());
-    turn.pass();  // the frame is with the bus: the next request of the run may go
-    if (!sent) {
-      ++counters.send_errors;
-      co_return Error(sent.error().code, fmt::format("positioner {} {} on bus {}: {}", pos,
-                                                     protocol::command_name(cmd), bus.name(), sent.error().detail));
-    }
+    auto sent = co_await send(pos, cmd, uid, payload);
+    turn.pass();  // the frame is with the bus (or never will be): the next request of the run may go
+    if (!sent) co_return sent.error();
     const auto deadline = core::steady_now() + timeout;
     while (!p.reply && !stopping && !closed) {
       if (!co_await p.wake.wait_until(deadline)) break;
@@ -476,6 +445,7 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
     if (auto r = protocol::check_request(info, true, payload.size()); !r) {
       co_return Error(r.error().code, fmt::format("broadcast {}: {}", info.name, r.error().detail));
     }
+    if (auto a = admit(cmd, protocol::kBroadcastId); !a) co_return a.error();  // at once, rather than after a wait
     const std::uint8_t n = info.number();
     while (collectors.contains(n)) {
       if (auto r = check_running(); !r) co_return r.error();
@@ -505,20 +475,15 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
     } collector_guard{*this, n};
 
     if (bo.trigger) {
+      // What the trigger starts (the sync line starts trajectories) passes the same check as a frame.
+      if (auto a = admit(cmd, protocol::kBroadcastId); !a) co_return a.error();
       auto t = co_await bo.trigger();
       if (!t) co_return t.error();
+      ++counters.broadcasts;
     } else {
-      auto frame = protocol::make_request(protocol::kBroadcastId, cmd, 0, payload);
-      if (!frame) co_return frame.error();
-      ++counters.sent;
-      auto sent = co_await bus.send(frame.value());
-      if (!sent) {
-        ++counters.send_errors;
-        co_return Error(sent.error().code, fmt::format("broadcast {} on bus {}: {}", info.name, bus.name(),
-                                                       sent.error().detail));
-      }
+      auto sent = co_await send(protocol::kBroadcastId, cmd, 0, payload);
+      if (!sent) co_return sent.error();
     }
-    ++counters.broadcasts;
     if ((bo.expected && c.result.replies.size() >= *bo.expected) || (c.waiting && c.waiting->empty()))
       c.result.complete = true;
     const auto deadline = core::steady_now() + bo.window.value_or(options.broadcast_window);
@@ -532,14 +497,35 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
 
   asio::awaitable<Result<void>> broadcast_now(CommandId cmd) {
     if (closed) co_return Error(HostErrc::closed, fmt::format("bus {}", bus.name()));
-    auto frame = protocol::make_request(protocol::kBroadcastId, cmd, 0, {});
+    co_return co_await send(protocol::kBroadcastId, cmd, 0, {});
+  }
+
+  // --- the way out ---------------------------------------------------------------------------
+
+  // The safety chokepoint (motion_lock.hpp): a command that moves a robot is refused while the
+  // lock is held. Every frame goes out through send(), which asks here first; so does a
+  // broadcast's trigger.
+  Result<void> admit(CommandId cmd, std::uint16_t pos) {
+    if (!lock) return ok();
+    auto a = lock->admit(cmd, pos);
+    if (!a) ++counters.refused;
+    return a;
+  }
+
+  // Every request frame this client puts on the bus, unicast (uid 1..63) or broadcast (positioner
+  // 0, uid 0).
+  asio::awaitable<Result<void>> send(std::uint16_t pos, CommandId cmd, std::uint8_t uid,
+                                     const protocol::Payload& payload) {
+    if (auto a = admit(cmd, pos); !a) co_return a.error();
+    auto frame = protocol::make_request(pos, cmd, uid, payload);
     if (!frame) co_return frame.error();
     ++counters.sent;
-    ++counters.broadcasts;
+    if (pos == protocol::kBroadcastId) ++counters.broadcasts;
     auto sent = co_await bus.send(frame.value());
     if (!sent) {
       ++counters.send_errors;
-      co_return Error(sent.error().code, fmt::format("broadcast {} on bus {}: {}", protocol::command_name(cmd),
+      const auto to = pos == protocol::kBroadcastId ? std::string("broadcast") : fmt::format("positioner {}", pos);
+      co_return Error(sent.error().code, fmt::format("{} {} on bus {}: {}", to, protocol::command_name(cmd),
                                                      bus.name(), sent.error().detail));
     }
     co_return ok();
@@ -562,8 +548,8 @@ class CommandClient::Impl : public std::enable_shared_from_this<Impl> {
 
 // ---------------------------------------------------------------------------------------------
 
-CommandClient::CommandClient(can::Bus& bus, ClientOptions options)
-    : impl_(std::make_shared<Impl>(bus, std::move(options))) {
+CommandClient::CommandClient(can::Bus& bus, ClientOptions options, std::shared_ptr<const MotionLock> lock)
+    : impl_(std::make_shared<Impl>(bus, std::move(options), std::move(lock))) {
   asio::co_spawn(impl_->ex, Impl::read_loop(impl_), [name = bus.name()](std::exception_ptr e) {
     if (!e) return;
     try {
@@ -582,6 +568,7 @@ CommandClient::~CommandClient() {
 can::Bus& CommandClient::bus() const noexcept { return impl_->bus; }
 const ClientOptions& CommandClient::options() const noexcept { return impl_->options; }
 const ClientCounters& CommandClient::counters() const noexcept { return impl_->counters; }
+const MotionLock* CommandClient::motion_lock() const noexcept { return impl_->lock.get(); }
 std::size_t CommandClient::in_flight() const noexcept { return impl_->pending.size(); }
 bool CommandClient::running() const noexcept { return !impl_->reader_done && !impl_->stopping; }
 

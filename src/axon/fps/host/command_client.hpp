@@ -12,10 +12,19 @@
 // Requests take a uid from the pool of their (positioner, command) pair (uid_pool.hpp); when all 63
 // are in flight the request waits for one to come back rather than fail. The client also bounds the
 // unicast requests in flight on its bus (ClientOptions::max_in_flight): a CAN@net gateway drops
-// frames beyond its 100-frame transmit FIFO. Each request has a timeout; only reads (commands that
-// change nothing, is_read()) are retried after a timeout. A reply with a non-zero response code
+// frames beyond its 100-frame transmit FIFO. Each request has a timeout; only reads (the command
+// table's `read_only` commands) are retried after a timeout. A reply with a non-zero response code
 // comes back as an Error whose code is the protocol's ResponseCode, so its message names the code
 // and carries the interface document's advice.
+//
+// Safety: this client is where the collision lock is enforced (motion_lock.hpp). Every frame it
+// sends, and every broadcast trigger (the sync line), first passes the lock it was given: while
+// that lock is held, a command the table marks `moves` is refused with HostErrc::locked, nothing
+// goes on the bus and ClientCounters::refused counts it. Reads, settings and stops always go out.
+// An Array gives the clients of all its buses its one lock, so whoever holds one of them
+// (Array::client(bus), a Positioner, a pipeline of trajectory points) cannot move a robot of a
+// locked array. A client made without a lock refuses nothing. Frames written to the can::Bus
+// directly bypass it.
 //
 // Threading: everything runs on the bus's executor (single-threaded). Lifetime: call `co_await
 // stop()` before destroying the client, and keep the bus alive until the reader has stopped (stop()
@@ -26,6 +35,7 @@
 #include "axon/core/clock.hpp"
 #include "axon/core/error.hpp"
 #include "axon/fps/host/error.hpp"
+#include "axon/fps/host/motion_lock.hpp"
 #include "axon/fps/protocol/commands.hpp"
 #include "axon/fps/protocol/message.hpp"
 #include "axon/fps/protocol/payload.hpp"
@@ -51,15 +61,12 @@ namespace axon::fps::host {
 namespace asio = boost::asio;
 using namespace std::chrono_literals;
 
-// Commands that only read: repeating them changes nothing, so they may be retried after a timeout.
-bool is_read(protocol::CommandId c) noexcept;
-
 struct ClientOptions {
   // How long a unicast request waits for its reply (per attempt).
   core::Duration timeout = 1s;
   // Per-command overrides of `timeout`.
   std::map<protocol::CommandId, core::Duration> command_timeouts;
-  // Extra attempts after a timeout, for reads only (is_read()).
+  // Extra attempts after a timeout, for reads only (the table's read_only commands).
   unsigned read_retries = 2;
   // How long a broadcast collects replies when it does not reach its expected count (hosts in
   // service wait a fixed 0.5 s).
@@ -159,6 +166,7 @@ struct ClientCounters {
   std::uint64_t bad_replies = 0;        // replies whose data did not decode for their command
   std::uint64_t uid_waits = 0;          // requests that had to wait for a free uid
   std::uint64_t slot_waits = 0;         // requests that had to wait for the bus in-flight bound
+  std::uint64_t refused = 0;            // moves refused by the motion lock (nothing sent)
   std::array<std::uint64_t, 16> by_code{};  // matched replies by response code (0 = accepted)
 
   [[nodiscard]] std::uint64_t errors() const noexcept;  // matched replies with a non-zero code
@@ -166,8 +174,9 @@ struct ClientCounters {
 
 class CommandClient {
  public:
-  // Starts the reader on the bus's executor.
-  explicit CommandClient(can::Bus& bus, ClientOptions options = {});
+  // Starts the reader on the bus's executor. `lock`: the lock whose holding refuses moves (an
+  // Array's; none: nothing is refused).
+  explicit CommandClient(can::Bus& bus, ClientOptions options = {}, std::shared_ptr<const MotionLock> lock = nullptr);
   CommandClient(const CommandClient&) = delete;
   CommandClient& operator=(const CommandClient&) = delete;
   ~CommandClient();
@@ -175,14 +184,16 @@ class CommandClient {
   [[nodiscard]] can::Bus& bus() const noexcept;
   [[nodiscard]] const ClientOptions& options() const noexcept;
   [[nodiscard]] const ClientCounters& counters() const noexcept;
+  // The lock this client obeys (nullptr: none).
+  [[nodiscard]] const MotionLock* motion_lock() const noexcept;
   // Unicast requests waiting for their reply right now.
   [[nodiscard]] std::size_t in_flight() const noexcept;
   [[nodiscard]] bool running() const noexcept;
 
   // Sends one request to positioner 1..2047 and waits for its reply. Errors: the command table's
-  // (ProtocolErrc: broadcast-only addressing, wrong payload size, host cannot send it), a
-  // ResponseCode when the positioner refused, HostErrc::timeout, cancelled, closed, or the bus's
-  // send error.
+  // (ProtocolErrc: broadcast-only addressing, wrong payload size, host cannot send it),
+  // HostErrc::locked (a move while the lock is held: not sent), a ResponseCode when the positioner
+  // refused, HostErrc::timeout, cancelled, closed, or the bus's send error.
   asio::awaitable<Result<Reply>> request(std::uint16_t positioner, protocol::CommandId command,
                                          protocol::Payload payload = {}, RequestOptions options = {});
 
@@ -215,10 +226,12 @@ class CommandClient {
   // Sends a broadcast (positioner 0, uid 0) and collects the replies until `expected` positioners
   // answered or the window closed. Replies with a non-zero code are collected too (check each).
   // Only one broadcast of a given command is collected at a time on a bus: a second one waits.
+  // A move (START_TRAJECTORY) while the lock is held is HostErrc::locked: neither sent nor triggered.
   asio::awaitable<Result<BroadcastResult>> broadcast(protocol::CommandId command, protocol::Payload payload = {},
                                                      BroadcastOptions options = {});
   // Sends a broadcast at once and does not collect replies (they go to a running collection of
-  // the same command, or to the subscribers): for emergency stops, which must never wait.
+  // the same command, or to the subscribers): for emergency stops, which must never wait. A move
+  // while the lock is held is HostErrc::locked.
   asio::awaitable<Result<void>> broadcast_now(protocol::CommandId command);
 
   // Subscribers see every Unsolicited frame, synchronously from the reader (keep handlers short;

@@ -174,7 +174,7 @@ asio::awaitable<void> FocalPlaneArray::stop_behind(GatewayLink link, std::vector
       failures.push_back(bus.error().message());
       continue;
     }
-    CommandClient client(*bus.value());
+    CommandClient client(*bus.value(), {}, array_->motion_lock());  // the array's lock, as on every bus
     BroadcastOptions bo;
     bo.expected_ids = expected;
     bo.window = options_.reconnect_window;

@@ -82,7 +82,11 @@ std::string UploadResult::describe() const {
 Positioner::Positioner(CommandClient& client, std::uint16_t id, PositionerOptions options, MotionGate* gate)
     : client_(&client), id_(id), options_(std::move(options)), gate_(gate) {}
 
-Result<void> Positioner::check_gate() const { return gate_ ? gate_->may_move(id_) : ok(); }
+Result<void> Positioner::still_free() const {
+  const MotionLock* lock = client_->motion_lock();
+  if (lock == nullptr || !lock->locked()) return ok();
+  return lock->interrupted(id_);
+}
 
 asio::awaitable<Result<void>> Positioner::simple(CommandId c) {
   auto r = co_await client_->request(id_, c);
@@ -293,7 +297,6 @@ asio::awaitable<Result<void>> Positioner::abort() { co_return co_await simple(Co
 asio::awaitable<Result<void>> Positioner::stop() { co_return co_await simple(CommandId::stop_trajectory); }
 
 asio::awaitable<Result<protocol::ArmTimes>> Positioner::start_goto(ArmAngles position, bool relative) {
-  if (auto g = check_gate(); !g) co_return g.error();
   auto p = to_wire(position, id_, relative ? "relative move" : "absolute move");
   if (!p) co_return p.error();
   if (relative) co_return co_await client_->call<CommandId::go_to_relative_position>(id_, p.value());
@@ -304,7 +307,6 @@ asio::awaitable<Result<MoveResult>> Positioner::goto_absolute(ArmAngles target) 
 asio::awaitable<Result<MoveResult>> Positioner::goto_relative(ArmAngles delta) { return move(delta, true); }
 
 asio::awaitable<Result<MoveResult>> Positioner::move(ArmAngles value, bool relative) {
-  if (auto g = check_gate(); !g) co_return g.error();
   MoveResult out;
   out.target = value;
   if (relative) {
@@ -353,7 +355,7 @@ asio::awaitable<Result<PositionerStatus>> Positioner::wait_for(std::function<boo
   const auto deadline = core::steady_now() + timeout;
   for (;;) {
     if (motion) {
-      if (auto g = check_gate(); !g) co_return g.error();
+      if (auto g = still_free(); !g) co_return g.error();
     }
     auto st = co_await read_status();
     if (!st) co_return st.error();
@@ -375,7 +377,6 @@ asio::awaitable<Result<PositionerStatus>> Positioner::wait_for(std::function<boo
 asio::awaitable<Result<PositionerStatus>> Positioner::run_step(CommandId c, core::Duration timeout,
                                                                std::function<bool(const PositionerStatus&)> done,
                                                                std::string what) {
-  if (auto g = check_gate(); !g) co_return g.error();
   if (auto r = co_await simple(c); !r) co_return r.error();
   co_return co_await watch_motion(std::move(done), timeout, std::move(what));
 }
@@ -471,13 +472,10 @@ asio::awaitable<Result<CalibrationReport>> Positioner::calibrate(CalibrationPlan
 
 asio::awaitable<UploadResult> Positioner::upload_trajectory(const protocol::Trajectory& trajectory) {
   UploadResult out;
-  if (auto g = check_gate(); !g) {
-    out.error = g.error();
-    co_return out;
-  }
   const std::vector<protocol::Request> reqs = trajectory.requests();  // new, points..., end
   out.stage = UploadResult::Stage::new_trajectory;
   if (auto r = co_await client_->request(id_, reqs.front().command, reqs.front().payload); !r) {
+    if (r.error() == HostErrc::locked) out.stage = UploadResult::Stage::not_sent;  // refused before sending
     out.error = r.error();
     co_return out;
   }

@@ -3,13 +3,14 @@
 // Every call is a coroutine on the bus's executor. Reads return decoded values in physical units
 // (degrees), settings take physical units and check them before sending (a value that does not fit
 // its field is ProtocolErrc::value_out_of_range, nothing is sent). Motion commands (moves, datum
-// search, calibrations, trajectories) first ask the MotionGate, if one was given (the Array's
-// collision lock), and fail with its error when motion is not allowed.
+// search, calibrations, trajectory upload) are refused with HostErrc::locked while the lock of the
+// client's array is held: the command client refuses them (motion_lock.hpp), whichever handle
+// sends them.
 //
 // Waiting: after a move or calibration is accepted, the robot's status is polled every
 // PositionerOptions::poll_interval until the flags the interface document names show the step
-// finished (DISPLACEMENT_COMPLETED plus the step's own flags), a collision flag appears, the gate
-// closes, or the step's timeout passes. Moves then read the position back and check it against the
+// finished (DISPLACEMENT_COMPLETED plus the step's own flags), a collision flag appears, the lock
+// is taken, or the step's timeout passes. Moves then read the position back and check it against the
 // target within PositionerOptions::position_tolerance (0.1 deg, as hosts in service do). A move,
 // datum search or calibration the host gives up on (timeout, no status replies, bus lost) gets a
 // TRAJECTORY_ABORT, so that no robot keeps moving unwatched; the error says whether it went out.
@@ -55,14 +56,13 @@ struct PositionerOptions {
   std::size_t trajectory_window = 8;          // trajectory points in flight to one robot
 };
 
-// Decides whether a robot may move now (the Array's collision lock implements it), and hears
-// about collision flags a positioner finds while polling a robot (the backup for a lost collision
-// frame).
+// Hears about collision flags a positioner finds while polling a robot (the backup for a lost
+// collision frame): the Array locks and stops every robot. Whether a robot may move is not asked
+// here: the command client decides that (motion_lock.hpp).
 class MotionGate {
  public:
   virtual ~MotionGate() = default;
-  [[nodiscard]] virtual Result<void> may_move(std::uint16_t positioner) const = 0;
-  virtual void collision_seen(std::uint16_t /*positioner*/, const protocol::PositionerStatus& /*status*/) {}
+  virtual void collision_seen(std::uint16_t positioner, const protocol::PositionerStatus& status) = 0;
 };
 
 struct MoveResult {
@@ -157,7 +157,7 @@ class Positioner {
   asio::awaitable<Result<void>> set_hall(bool on);
 
   // --- motion ----------------------------------------------------------------------------------
-  // Stops whatever runs. abort keeps collision flags, stop clears them. Never gated.
+  // Stops whatever runs. abort keeps collision flags, stop clears them. Never refused.
   asio::awaitable<Result<void>> abort();
   asio::awaitable<Result<void>> stop();
   // Sends the move and returns the robot's ETA without waiting.
@@ -181,17 +181,20 @@ class Positioner {
   asio::awaitable<Result<CalibrationReport>> calibrate(CalibrationPlan plan);
 
   // Uploads a trajectory (SEND_NEW_TRAJECTORY, every point with its reply checked, at most
-  // trajectory_window in flight, TRAJECTORY_DATA_END). Does not start it.
+  // trajectory_window in flight, TRAJECTORY_DATA_END). Does not start it. Refused while locked
+  // (stage not_sent, error HostErrc::locked).
   asio::awaitable<UploadResult> upload_trajectory(const protocol::Trajectory& trajectory);
 
   // Waits until `done(status)` holds, polling; fails on a collision flag (and tells the gate), on
-  // a closed gate (when `motion`), or after `timeout`. `what` names the step in errors.
+  // the lock being held (when `motion`: HostErrc::locked), or after `timeout`. `what` names the
+  // step in errors.
   asio::awaitable<Result<protocol::PositionerStatus>> wait_for(
       std::function<bool(const protocol::PositionerStatus&)> done, core::Duration timeout, std::string what,
       bool motion = true);
 
  private:
-  Result<void> check_gate() const;
+  // HostErrc::locked while the client's lock is held (a motion step under way ends).
+  Result<void> still_free() const;
   asio::awaitable<Result<void>> simple(protocol::CommandId c);
   asio::awaitable<Result<MoveResult>> move(ArmAngles value, bool relative);
   // wait_for a step the robot runs; stops the robot when the host gives up on it.

@@ -35,6 +35,15 @@ constexpr bool layouts_consistent() {
 }
 static_assert(layouts_consistent(), "every fixed layout's fields must add up to its size");
 
+constexpr bool safety_classes_consistent() {
+  for (const auto& c : kCommands) {
+    if (c.moves && c.read_only) return false;
+    if (!c.host_sends && (c.moves || c.read_only)) return false;
+  }
+  return true;
+}
+static_assert(safety_classes_consistent(), "a command moves or only reads, not both; robot-sent frames have no class");
+
 }  // namespace
 
 Result<const CommandInfo*> lookup_command(std::uint8_t number) {
