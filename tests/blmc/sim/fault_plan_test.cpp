@@ -147,15 +147,16 @@ TEST(BlmcFaultPlan, LoadsOnePlanPerBoardFromAFile) {
     f << "- { board: 1, events: [ { at_s: 4.0, kind: encoder } ] }\n"
          "- { seed: 7, drops: [ { direction: tx, probability: 0.001 } ] }\n";
   }
-  auto plans = load_fault_plans(path.string(), 2);
-  ASSERT_TRUE(plans) << plans.error().message();
-  ASSERT_EQ(plans->size(), 2u);
-  EXPECT_TRUE((*plans)[0].events.empty());
-  ASSERT_EQ((*plans)[1].events.size(), 1u);
-  EXPECT_EQ((*plans)[1].events[0].kind, FaultKind::encoder);
-  EXPECT_EQ((*plans)[0].drops.size(), 1u);
-  EXPECT_EQ((*plans)[1].drops.size(), 1u);
-  EXPECT_EQ((*plans)[0].seed, 7u);
+  auto loaded = load_fault_plans(path.string(), 2);
+  ASSERT_TRUE(loaded) << loaded.error().message();
+  const auto& plans = loaded.value();
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_TRUE(plans[0].events.empty());
+  ASSERT_EQ(plans[1].events.size(), 1u);
+  EXPECT_EQ(plans[1].events[0].kind, FaultKind::encoder);
+  EXPECT_EQ(plans[0].drops.size(), 1u);
+  EXPECT_EQ(plans[1].drops.size(), 1u);
+  EXPECT_EQ(plans[0].seed, 7u);
   EXPECT_TRUE(load_fault_plans("", 3).value().size() == 3u);
   auto bad = load_fault_plans(path.string(), 1);  // board 1 of one
   EXPECT_FALSE(bad);
