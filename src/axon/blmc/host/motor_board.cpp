@@ -6,6 +6,7 @@
 #include "axon/blmc/host/loop_await.hpp"
 #include "axon/blmc/host/session_log.hpp"
 #include "axon/can/open.hpp"
+#include "axon/core/wakeup.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -87,10 +88,20 @@ struct MotorBoard::Impl {
 
   explicit Impl(MotorBoardOptions o) : options(std::move(o)) {}
 
+  // A call that overstays its time limit is interrupted (the board's waits end at once); the
+  // interrupt is then taken back so that later calls work.
   template <class T, class Make>
   T wait(Make make, core::Duration timeout, const char* what) {
+    bool interrupted = false;
+    const core::OnExit clear{[&] {
+      if (interrupted) boost::asio::post(loop.executor(), [b = board.get()] { b->clear_interrupt(); });
+    }};
     return detail::await_on<T>(
-        loop, std::move(make), timeout, [this] { interrupt(); },
+        loop, std::move(make), timeout,
+        [&] {
+          interrupted = true;
+          interrupt();
+        },
         Error(HostErrc::timeout, fmt::format("{}: {}: no result within {:.1f} s", options.name, what, seconds_of(timeout))));
   }
   void interrupt() {
@@ -277,6 +288,14 @@ void MotorBoard::enable() {
 }
 
 void MotorBoard::disable() { impl_->disable(); }
+
+void MotorBoard::recover() {
+  auto& i = *impl_;
+  if (i.run) throw Exception(Error(HostErrc::cyclic_active, fmt::format("{}: recover: stop_control first", i.options.name)));
+  i.enabled = true;  // the recovery enables: whatever happens next, the way out disables
+  const auto limit = i.options.ready_timeout + std::chrono::seconds(2);
+  i.wait<Result<void>>([b = i.board.get()] { return b->recover(); }, limit, "recover").value();
+}
 bool MotorBoard::enabled() const noexcept { return impl_->enabled; }
 
 protocol::Status MotorBoard::wait_status() {

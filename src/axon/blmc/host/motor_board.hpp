@@ -131,6 +131,10 @@ class MotorBoard {
   // Stops control if it runs, then IqRef = 0, ENABLE_MTR1/2 = 0, ENABLE_SYS = 0.
   void disable();
   [[nodiscard]] bool enabled() const noexcept;
+  // After the board disabled itself on an error (a safety stop naming a board error): the spec's
+  // recovery, ENABLE_SYS=1, IqRef=0, ENABLE_MTRx=1, then waits until ready. Throws
+  // HostErrc::board_error while the error's cause remains (the motors stay off), or not_ready.
+  void recover();
 
   // The next status frame (HostErrc::timeout after status_timeout).
   protocol::Status wait_status();
