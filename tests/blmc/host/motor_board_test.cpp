@@ -212,3 +212,23 @@ TEST(BlmcSimulatedBoard, ServesEachBoardOnItsOwnChannel) {
 
 }  // namespace
 }  // namespace axon::blmc
+
+namespace axon::blmc {
+namespace {
+
+TEST(BlmcSimulatedBoard, AnAddressInUseIsAnException) {
+  sim::SimulatedBoard first(sim_options());
+  auto o = sim_options();
+  o.socketcand = first.endpoint();
+  try {
+    sim::SimulatedBoard second(o);
+    FAIL() << "two simulators on " << first.endpoint();
+  } catch (const Exception& e) {
+    EXPECT_NE(std::string(e.what()).find("in use"), std::string::npos) << e.what();
+  }
+  o.config.alignment_time = -1s;
+  EXPECT_THROW(sim::SimulatedBoard{o}, Exception);
+}
+
+}  // namespace
+}  // namespace axon::blmc

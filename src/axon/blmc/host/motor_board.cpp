@@ -87,6 +87,9 @@ struct MotorBoard::Impl {
   std::shared_ptr<ControlRun> run;
 
   explicit Impl(MotorBoardOptions o) : options(std::move(o)) {}
+  // The loop's thread ends before the bus and the board go (close() ran first, unless the
+  // constructor failed).
+  ~Impl() { loop.stop(); }
 
   // A call that overstays its time limit is interrupted (the board's waits end at once); the
   // interrupt is then taken back so that later calls work.

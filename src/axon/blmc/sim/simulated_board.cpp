@@ -22,6 +22,20 @@ struct SimulatedBoard::Impl {
   std::string endpoint;
   bool stopped = false;
 
+  ~Impl() {
+    // Everything that lives on the loop goes on the loop's thread, then the thread stops.
+    try {
+      loop.call([this] {
+        if (server) server->stop();
+        server.reset();
+        runner.reset();
+        registry.reset();
+      });
+    } catch (...) {
+    }
+    loop.stop();
+  }
+
   void start(const SimulatedBoardOptions& o);
   void check(unsigned board) const {
     if (board >= channels.size())
@@ -49,26 +63,10 @@ void SimulatedBoard::Impl::start(const SimulatedBoardOptions& o) {
 }
 
 SimulatedBoard::SimulatedBoard(SimulatedBoardOptions options) : impl_(std::make_unique<Impl>()) {
-  try {
-    impl_->loop.call([&] { impl_->start(options); });
-  } catch (...) {
-    stop();
-    throw;
-  }
+  impl_->loop.call([&] { impl_->start(options); });  // on failure ~Impl takes down what started
 }
 
-SimulatedBoard::~SimulatedBoard() {
-  stop();
-  try {
-    impl_->loop.call([i = impl_.get()] {
-      i->server.reset();
-      i->runner.reset();
-      i->registry.reset();
-    });
-  } catch (...) {
-  }
-  impl_->loop.stop();
-}
+SimulatedBoard::~SimulatedBoard() { stop(); }
 
 void SimulatedBoard::stop() {
   if (impl_->stopped) return;
