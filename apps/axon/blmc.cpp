@@ -44,6 +44,7 @@ struct BlmcOptions {
   std::string socketcand;
   std::string socketcan;
   std::string log;  // candump log of every frame of the session
+  std::string csv;  // motion commands: one line per control cycle
   std::string motors = "both";
   double max_current = 2.0;
   double max_velocity = 2.0;  // krpm
@@ -285,9 +286,14 @@ json stats_json(const bh::LoopStats& st) {
 
 // The table header now, then a row at each refresh of the library's control run (bh::run_control);
 // a row that cannot be written stops the run.
+// With --csv, every cycle's record goes to that file too.
 bh::ControlHooks table_hooks(Session& s) {
   s.out().table_header();
   bh::ControlHooks h;
+  if (!s.o().csv.empty()) {
+    auto csv = std::make_shared<bh::CycleCsv>(need(bh::CycleCsv::create(s.o().csv)));
+    h.record = [csv](const bh::CycleRecord& r) { csv->write(r); };
+  }
   h.refresh = [&s](double t, const bh::CycleRecord* last) {
     if (!s.out().ok()) return false;
     return last == nullptr || s.out().row(t, bh::measurements_of(*last));
@@ -554,6 +560,7 @@ void add_board_options(CLI::App* b, BlmcOptions& o) {
   b->add_option("--socketcand", o.socketcand, "socketcand server as HOST:PORT/CHANNEL");
   b->add_option("--socketcan", o.socketcan, "SocketCAN interface (default can0)");
   b->add_option("--log", o.log, "write every frame of the session to this candump log");
+  b->add_option("--csv", o.csv, "current, pd, home: write every control cycle to this CSV file (docs/library-blmc.md)");
   b->add_option("--motors", o.motors, "motors to use: 1, 2 or both (default both)");
   b->add_option("--max-current", o.max_current, "safety: current clamp, A (default 2)")->check(positive());
   b->add_option("--max-velocity", o.max_velocity, "safety: zero current above this speed, krpm (default 2)")->check(positive());
