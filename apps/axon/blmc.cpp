@@ -1,9 +1,11 @@
 // `axon blmc ...`: one motor driver board (two motors) on one CAN bus, through the host driver
-// (docs/blmc-host.md). Motion commands run the real-time ControlLoop with the safety limits given
-// by flags inside a blmc::host::MotorSession: on every way out (the end, a safety stop, a failed
-// start, an exception, a closed stdout, Ctrl-C/SIGTERM/SIGHUP) the board gets zero current and is
-// disabled, and the disable's result decides the exit code. Tables and results go to stdout (JSON
-// Lines with --json), logs to stderr.
+// (docs/blmc-host.md). This file parses options and prints; the work is the library's: motion
+// commands are blmc::host::with_motors_enabled around run_control / run_pd / run_homing
+// (control_run.hpp) with the safety limits given by flags, so on every way out (the end, a safety
+// stop, a failed start, an exception, a closed stdout, Ctrl-C/SIGTERM/SIGHUP) the board gets zero
+// current and is disabled, and the disable's result decides the exit code. Tables and results go
+// to stdout (JSON Lines with --json), logs to stderr. The options live in one Blmc object per
+// invocation, shared by the subcommands' callbacks.
 #include "axon/blmc/host/board.hpp"
 #include "axon/blmc/host/control_run.hpp"
 #include "axon/blmc/host/error.hpp"
@@ -19,7 +21,6 @@
 #include "axon/core/wakeup.hpp"
 #include "run.hpp"
 
-#include <boost/asio/detached.hpp>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
