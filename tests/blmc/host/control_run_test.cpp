@@ -15,12 +15,20 @@ namespace {
 
 using namespace testing;
 
+// With slack for a loaded machine (see test_limits()), here also for the board's receive timeout.
 ControlOptions options(core::Duration duration) {
   ControlOptions o;
   o.limits = test_limits();
+  o.limits.stale_after = 500ms;
   o.loop = loop_options();
   o.duration = duration;
   o.refresh = 20ms;
+  return o;
+}
+
+BoardOptions slack() {
+  BoardOptions o;
+  o.recv_timeout_ms = 500;
   return o;
 }
 
@@ -45,7 +53,7 @@ TEST(BlmcControlRun, ValidateRefusesAPeriodTheReceiveTimeoutWouldTrip) {
 TEST(BlmcControlRun, PdHoldsBothMotorsAndHandsTheBoardBackOutOfCyclicMode) {
   SimRig rig;
   rig.run([&]() -> asio::awaitable<void> {
-    Board board(*rig.host);
+    Board board(*rig.host, slack());
     std::uint64_t records = 0;
     int refreshes = 0;
     ControlHooks hooks;
@@ -79,7 +87,7 @@ TEST(BlmcControlRun, PdHoldsBothMotorsAndHandsTheBoardBackOutOfCyclicMode) {
 TEST(BlmcControlRun, AnInterruptEndsTheRunAsAStop) {
   SimRig rig;
   rig.run([&]() -> asio::awaitable<void> {
-    Board board(*rig.host);
+    Board board(*rig.host, slack());
     const std::function<asio::awaitable<Result<ControlOutcome>>()> body =
         [&]() -> asio::awaitable<Result<ControlOutcome>> {
       FunctionController ctl([](const ControlInput&, std::span<MotorPair>) {});
@@ -105,7 +113,7 @@ TEST(BlmcControlRun, HomingReportsTheIndexOfEachMotor) {
   cfg.motors[1].index_offset_rev = 0.1;
   SimRig rig(cfg);
   rig.run([&]() -> asio::awaitable<void> {
-    Board board(*rig.host);
+    Board board(*rig.host, slack());
     HomingOptions h;
     h.speed_rev_s = -1;  // downwards: from 0 the marks come at -0.6 and -0.9 rev
     const std::function<asio::awaitable<Result<HomingRun>>()> body = [&]() -> asio::awaitable<Result<HomingRun>> {

@@ -122,6 +122,7 @@ class MotorBoard {
   ~MotorBoard();
   MotorBoard(const MotorBoard&) = delete;
   MotorBoard& operator=(const MotorBoard&) = delete;
+  // A moved-from MotorBoard may only be destroyed or assigned to.
   MotorBoard(MotorBoard&&) noexcept;
   MotorBoard& operator=(MotorBoard&&) noexcept;
 
