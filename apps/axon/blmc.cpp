@@ -1,15 +1,16 @@
 // `axon blmc ...`: one motor driver board (two motors) on one CAN bus, through the host driver
-// (docs/blmc-host.md). Motion commands run the real-time ControlLoop with the safety limits given
-// by flags inside a blmc::host::MotorSession: on every way out (the end, a safety stop, a failed
-// start, an exception, a closed stdout, Ctrl-C/SIGTERM/SIGHUP) the board gets zero current and is
-// disabled, and the disable's result decides the exit code. Tables and results go to stdout (JSON
-// Lines with --json), logs to stderr.
+// (docs/blmc-host.md). This file parses options and prints; the work is the library's: motion
+// commands are blmc::host::with_motors_enabled around run_control / run_pd / run_homing
+// (control_run.hpp) with the safety limits given by flags, so on every way out (the end, a safety
+// stop, a failed start, an exception, a closed stdout, Ctrl-C/SIGTERM/SIGHUP) the board gets zero
+// current and is disabled, and the disable's result decides the exit code. Tables and results go
+// to stdout (JSON Lines with --json), logs to stderr. The options live in one Blmc object per
+// invocation, shared by the subcommands' callbacks.
 #include "axon/blmc/host/board.hpp"
-#include "axon/blmc/host/control_loop.hpp"
+#include "axon/blmc/host/control_run.hpp"
 #include "axon/blmc/host/error.hpp"
-#include "axon/blmc/host/homing.hpp"
 #include "axon/blmc/host/motor_session.hpp"
-#include "axon/blmc/host/pd_controller.hpp"
+#include "axon/blmc/host/session_log.hpp"
 #include "axon/blmc/protocol/command.hpp"
 #include "axon/blmc/protocol/frames.hpp"
 #include "axon/can/bus_spec.hpp"
@@ -20,7 +21,6 @@
 #include "axon/core/wakeup.hpp"
 #include "run.hpp"
 
-#include <boost/asio/detached.hpp>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
@@ -45,6 +45,7 @@ struct BlmcOptions {
   std::string socketcand;
   std::string socketcan;
   std::string log;  // candump log of every frame of the session
+  std::string csv;  // motion commands: one line per control cycle
   std::string motors = "both";
   double max_current = 2.0;
   double max_velocity = 2.0;  // krpm
@@ -58,12 +59,17 @@ struct BlmcOptions {
   std::vector<int> cpus;
   bool pace_measurements = false;
   bool json = false;
+  // The subcommands' own arguments.
+  int current_motor = 1;
+  double current_amps = 0;
+  double current_duration_s = 1;
+  bh::PdGains pd_gains;
+  double pd_amplitude = 0, pd_frequency = 0.5, pd_duration_s = 5;
+  bh::HomingOptions home;
+  double home_timeout_s = 20;
+  std::string raw_text;
+  std::string record_file;
 };
-
-BlmcOptions& opts() {
-  static BlmcOptions o;
-  return o;
-}
 
 std::string bus_text(const BlmcOptions& o) {
   int given = !o.bus.empty() + !o.socketcand.empty() + !o.socketcan.empty();
@@ -81,109 +87,117 @@ std::array<bool, 2> motor_set(const std::string& m) {
   throw Exception(usage(fmt::format("--motors {}: use 1, 2 or both", m)));
 }
 
-bh::SafetyLimits limits(const BlmcOptions& o) {
-  bh::SafetyLimits l;
-  l.motors = motor_set(o.motors);
-  l.max_current_a = o.max_current;
-  l.max_velocity_krpm = o.max_velocity;
-  l.stale_after = std::chrono::microseconds(static_cast<std::int64_t>(o.stale_ms * 1000));
-  return l;
-}
-
 core::Duration seconds(double s) { return std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(s)); }
 
-// The loop options that only make sense together, checked before anything is sent to the board
-// (each alone is checked by its validator).
-void check_loop_options(const BlmcOptions& o) {
-  constexpr double kMaxRate = 10000;
-  if (o.rate_hz > kMaxRate)
-    throw Exception(usage(fmt::format("--rate: must be at most {:g} Hz (the board runs at 1 kHz), got {:g}", kMaxRate, o.rate_hz)));
-  const double period_ms = 1000.0 / o.rate_hz;
-  if (o.recv_timeout_ms > 0 && period_ms >= o.recv_timeout_ms)
-    throw Exception(usage(fmt::format("--rate {:g}: one current reference every {:g} ms, not within the board's receive "
-                                      "timeout of {} ms (--recv-timeout-ms): the board would trip",
-                                      o.rate_hz, period_ms, o.recv_timeout_ms)));
-  if (auto v = limits(o).validate(); !v) throw Exception(usage(v.error().detail));
+// The loop and safety settings the flags give (the motion commands' duration set by each).
+bh::ControlOptions control_options(const BlmcOptions& o, double duration_s) {
+  bh::ControlOptions c;
+  c.limits.motors = motor_set(o.motors);
+  c.limits.max_current_a = o.max_current;
+  c.limits.max_velocity_krpm = o.max_velocity;
+  c.limits.stale_after = std::chrono::microseconds(static_cast<std::int64_t>(o.stale_ms * 1000));
+  c.loop.period = seconds(1.0 / o.rate_hz);
+  c.loop.realtime = o.realtime;
+  c.loop.cpus = o.cpus;
+  c.loop.pacing = o.pace_measurements ? bh::Pacing::measurements : bh::Pacing::clock;
+  c.duration = seconds(duration_s);
+  c.refresh = seconds(1.0 / o.refresh_hz);
+  return c;
 }
 
 // ---- output -------------------------------------------------------------------------------------
 
 // stdout, with the failure noticed: SIGPIPE is ignored, so a reader that went away (`| head`)
 // shows as EPIPE here and the command stops (its devices made safe) instead of running blind.
-bool g_output_ok = true;
+class Output {
+ public:
+  explicit Output(const bool& json) : json_(&json) {}
+  [[nodiscard]] bool is_json() const noexcept { return *json_; }
+  [[nodiscard]] bool ok() const noexcept { return ok_; }
 
-bool emit(const std::string& line) {
-  if (!g_output_ok) return false;
-  if (std::fputs(line.c_str(), stdout) < 0 || std::fputc('\n', stdout) == EOF || std::fflush(stdout) != 0) {
-    g_output_ok = false;
-    spdlog::error("blmc: cannot write to stdout ({}): stopping", std::strerror(errno));
+  bool emit(const std::string& line) {
+    if (!ok_) return false;
+    if (std::fputs(line.c_str(), stdout) < 0 || std::fputc('\n', stdout) == EOF || std::fflush(stdout) != 0) {
+      ok_ = false;
+      spdlog::error("blmc: cannot write to stdout ({}): stopping", std::strerror(errno));
+    }
+    return ok_;
   }
-  return g_output_ok;
-}
-bool emit(const json& j) { return emit(j.dump()); }
+  bool emit(const json& j) { return emit(j.dump()); }
 
-json pair_json(const bh::MotorPair& p) { return json::array({p.motor1, p.motor2}); }
-
-json status_json(const bp::Status& s) {
-  return json{{"system_enabled", s.system_enabled}, {"motor1_enabled", s.motor1_enabled},
-              {"motor1_ready", s.motor1_ready}, {"motor2_enabled", s.motor2_enabled}, {"motor2_ready", s.motor2_ready},
-              {"error", std::string(bp::name(s.error))}, {"byte", s.to_byte()}};
-}
-
-bool print_status(const bp::Status& s) {
-  if (opts().json) {
+  bool status(const bp::Status& s) {
+    if (!is_json()) return emit(fmt::format("{}  (byte 0x{:02X})", s.to_string(), s.to_byte()));
     auto j = status_json(s);
     j["type"] = "status";
     return emit(j);
   }
-  return emit(fmt::format("{}  (byte 0x{:02X})", s.to_string(), s.to_byte()));
-}
 
-bool print_table_header() {
-  if (opts().json) return true;
-  return emit(fmt::format("{:>8} | {:>8} {:>8} | {:>9} {:>9} | {:>8} {:>8} | {:>6} {:>6} | {}", "t[s]", "I1[A]", "I2[A]",
-                          "pos1[rev]", "pos2[rev]", "v1[krpm]", "v2[krpm]", "adcA", "adcB", "status"));
-}
-
-bool print_row(double t, const bh::Measurements& m) {
-  const auto& st = m.status;
-  if (opts().json) {
-    return emit(json{{"type", "sample"},
-                     {"t", t},
-                     {"current", pair_json(m.current.value)},
-                     {"position", pair_json(m.position.value)},
-                     {"velocity", pair_json(m.velocity.value)},
-                     {"adc", pair_json(m.adc.value)},
-                     {"status", st.received() ? status_json(st.value) : json(nullptr)}});
+  bool table_header() {
+    if (is_json()) return true;
+    return emit(fmt::format("{:>8} | {:>8} {:>8} | {:>9} {:>9} | {:>8} {:>8} | {:>6} {:>6} | {}", "t[s]", "I1[A]", "I2[A]",
+                            "pos1[rev]", "pos2[rev]", "v1[krpm]", "v2[krpm]", "adcA", "adcB", "status"));
   }
-  return emit(fmt::format("{:8.3f} | {:8.3f} {:8.3f} | {:9.4f} {:9.4f} | {:8.4f} {:8.4f} | {:6.3f} {:6.3f} | {}", t,
-                          m.current.value.motor1, m.current.value.motor2, m.position.value.motor1,
-                          m.position.value.motor2, m.velocity.value.motor1, m.velocity.value.motor2, m.adc.value.motor1,
-                          m.adc.value.motor2, st.received() ? st.value.to_string() : "(no status yet)"));
-}
+
+  bool row(double t, const bh::Measurements& m) {
+    const auto& st = m.status;
+    if (is_json()) {
+      return emit(json{{"type", "sample"},
+                       {"t", t},
+                       {"current", pair_json(m.current.value)},
+                       {"position", pair_json(m.position.value)},
+                       {"velocity", pair_json(m.velocity.value)},
+                       {"adc", pair_json(m.adc.value)},
+                       {"status", st.received() ? status_json(st.value) : json(nullptr)}});
+    }
+    return emit(fmt::format("{:8.3f} | {:8.3f} {:8.3f} | {:9.4f} {:9.4f} | {:8.4f} {:8.4f} | {:6.3f} {:6.3f} | {}", t,
+                            m.current.value.motor1, m.current.value.motor2, m.position.value.motor1,
+                            m.position.value.motor2, m.velocity.value.motor1, m.velocity.value.motor2, m.adc.value.motor1,
+                            m.adc.value.motor2, st.received() ? st.value.to_string() : "(no status yet)"));
+  }
+
+  static json pair_json(const bh::MotorPair& p) { return json::array({p.motor1, p.motor2}); }
+  static json status_json(const bp::Status& s) {
+    return json{{"system_enabled", s.system_enabled}, {"motor1_enabled", s.motor1_enabled},
+                {"motor1_ready", s.motor1_ready}, {"motor2_enabled", s.motor2_enabled}, {"motor2_ready", s.motor2_ready},
+                {"error", std::string(bp::name(s.error))}, {"byte", s.to_byte()}};
+  }
+
+ private:
+  const bool* json_;
+  bool ok_ = true;
+};
+
+// One `axon blmc` invocation: its options (filled by the parser), its stdout, and whether the
+// motors may be on: true from the moment a command enables them until their disable was sent.
+// Still true after run_command only when the command was abandoned (a second signal stops the
+// event loop at once): then the board is disabled over a new connection.
+struct Blmc {
+  BlmcOptions o;
+  Output out{o.json};
+  bool motors_may_be_on = false;
+};
 
 // ---- session ------------------------------------------------------------------------------------
 
 // One session: bus, board, optional candump log, stop requests.
 struct Session {
+  Blmc* cli = nullptr;
   std::unique_ptr<can::Bus> bus;
   std::unique_ptr<bh::Board> board;
   std::optional<can::CandumpWriter> log;
   std::string iface;
   bool stop = false;
   bool signal_ends_normally = false;  // monitor/record until Ctrl-C: a signal is their end
+  [[nodiscard]] const BlmcOptions& o() const { return cli->o; }
+  [[nodiscard]] Output& out() const { return cli->out; }
 };
 
-// True from the moment a command enables the motors until their disable was sent. Still true
-// after run_command only when the command was abandoned (a second signal stops the event loop
-// at once): then the board is disabled over a new connection.
-bool g_motors_may_be_on = false;
-
-asio::awaitable<std::unique_ptr<Session>> open_session(asio::io_context& io,
+asio::awaitable<std::unique_ptr<Session>> open_session(Blmc& cli, asio::io_context& io,
                                                        const std::function<void(std::function<void()>)>& on_signal,
                                                        bool signal_ends_normally) {
-  const auto& o = opts();
+  const auto& o = cli.o;
   auto s = std::make_unique<Session>();
+  s->cli = &cli;
   s->signal_ends_normally = signal_ends_normally;
   const auto spec = need(can::parse_bus_spec(bus_text(o)));
   const asio::any_io_executor ex = io.get_executor();
@@ -198,12 +212,7 @@ asio::awaitable<std::unique_ptr<Session>> open_session(asio::io_context& io,
   s->board = std::make_unique<bh::Board>(*s->bus, bo);
   if (!o.log.empty()) {
     s->log.emplace(need(can::CandumpWriter::create(o.log, can::CandumpWriter::Flush::on_request)));
-    Session* raw = s.get();
-    s->board->set_tap([raw](const can::Frame& f, bool) {
-      can::Frame g = f;
-      if (g.timestamp().count() == 0) g.set_timestamp(core::SteadyClock::instance().wall());
-      (void)raw->log->write(g, raw->iface);
-    });
+    s->board->set_tap(bh::candump_tap(*s->log, s->iface));
   }
   Session* raw = s.get();
   // A stop request ends the waits on the board at once (an enable waiting for the alignment).
@@ -224,42 +233,23 @@ asio::awaitable<void> close_session(Session& s) {
   s.bus->close();
 }
 
-// A command abandoned with the motors on (see g_motors_may_be_on): IqRef=0 and the disables over
-// a new connection, on a new event loop. Returns false when that failed too.
-bool disable_over_new_connection() {
+// A command abandoned with the motors on (Blmc::motors_may_be_on). Returns false when that failed too.
+bool disable_over_new_connection(const BlmcOptions& o) {
   spdlog::warn("blmc: stopped before the motors were disabled: disabling the board over a new connection");
-  asio::io_context io;
-  Result<void> result = Error(bh::HostErrc::timeout, "no answer from the bus within 3 s");
-  asio::co_spawn(
-      io,
-      [&]() -> asio::awaitable<void> {
-        const auto spec = need(can::parse_bus_spec(bus_text(opts())));
-        auto b = co_await can::open_bus(io.get_executor(), spec);
-        if (!b) {
-          result = b.error();
-          co_return;
-        }
-        auto bus = std::move(b).value();
-        {
-          bh::Board board(*bus);
-          result = co_await board.disable();
-        }
-        auto f = co_await bus->flush(1s);
-        (void)f;
-        bus->close();
-      },
-      [](std::exception_ptr) {});
-  io.run_for(3s);
+  const auto spec = can::parse_bus_spec(bus_text(o));
+  const Result<void> result = spec ? bh::disable_over_new_connection(spec.value()) : Result<void>(spec.error());
   if (result) spdlog::info("blmc: board disabled, currents zero");
   else spdlog::error("blmc: could not disable the board: {}", result.error().message());
   return static_cast<bool>(result);
 }
 
-int run_blmc(bool signal_ends_normally, const std::function<asio::awaitable<int>(Session&)>& body) {
+using Body = std::function<asio::awaitable<int>(Session&)>;
+
+int run_blmc(Blmc& cli, bool signal_ends_normally, const Body& body) {
   int rc = 0;
   try {
     rc = run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
-      auto s = co_await open_session(io, set_on_signal, signal_ends_normally);
+      auto s = co_await open_session(cli, io, set_on_signal, signal_ends_normally);
       int code = 0;
       std::exception_ptr failure;
       try {
@@ -272,10 +262,10 @@ int run_blmc(bool signal_ends_normally, const std::function<asio::awaitable<int>
       co_return code;
     });
   } catch (...) {
-    if (g_motors_may_be_on) disable_over_new_connection();
+    if (cli.motors_may_be_on) disable_over_new_connection(cli.o);
     throw;
   }
-  if (g_motors_may_be_on && !disable_over_new_connection() && rc == exit_code_value::ok) rc = exit_code_value::failed;
+  if (cli.motors_may_be_on && !disable_over_new_connection(cli.o) && rc == exit_code_value::ok) rc = exit_code_value::failed;
   return rc;
 }
 
@@ -295,48 +285,26 @@ json stats_json(const bh::LoopStats& st) {
               {"overruns", st.overruns},      {"missed", st.missed}};
 }
 
-// Runs `controller` in the real-time loop until `duration` (0: until the controller says done or
-// a stop request), printing a row at the refresh rate. The loop is stopped and destroyed before
-// this returns or throws; the caller's MotorSession then leaves cyclic mode and disables.
-asio::awaitable<Outcome> run_loop(Session& s, bh::Controller& controller, double duration_s,
-                                  const std::function<bool()>& done = {}) {
-  const auto& o = opts();
-  auto r0 = co_await s.board->start_cyclic();
-  need(std::move(r0));
-  bh::LoopOptions lo;
-  lo.period = seconds(1.0 / o.rate_hz);
-  lo.realtime = o.realtime;
-  lo.cpus = o.cpus;
-  lo.pacing = o.pace_measurements ? bh::Pacing::measurements : bh::Pacing::clock;
-  bh::ControlLoop loop({&s.board->port()}, controller, {limits(o)}, lo);
-  need(loop.start());
-  const auto t0 = core::SteadyClock::instance().now();
-  const auto refresh = seconds(1.0 / o.refresh_hz);
-  bool writing = print_table_header();
-  bh::CycleRecord rec{}, last{};
-  bool have = false;
-  while (loop.running() && !s.stop && writing) {
-    co_await core::sleep_for(refresh);
-    while (loop.pop_record(rec)) {
-      last = rec;
-      have = true;
-    }
-    const double t = std::chrono::duration<double>(core::SteadyClock::instance().now() - t0).count();
-    if (have) {
-      bh::Measurements m;
-      const auto& b = last.board[0];
-      m.current.value = b.current;
-      m.position.value = b.position;
-      m.velocity.value = b.velocity;
-      m.adc.value = b.adc;
-      if (auto st = bp::Status::from_byte(b.status)) m.status = {st.value(), {}, 1};
-      writing = print_row(t, m);
-    }
-    if (duration_s > 0 && t >= duration_s) break;
-    if (done && done()) break;
+// The table header now, then a row at each refresh of the library's control run (bh::run_control);
+// a row that cannot be written stops the run.
+// With --csv, every cycle's record goes to that file too.
+bh::ControlHooks table_hooks(Session& s) {
+  s.out().table_header();
+  bh::ControlHooks h;
+  if (!s.o().csv.empty()) {
+    auto csv = std::make_shared<bh::CycleCsv>(need(bh::CycleCsv::create(s.o().csv)));
+    h.record = [csv](const bh::CycleRecord& r) { csv->write(r); };
   }
-  loop.stop();
-  const auto st = loop.stats();
+  h.refresh = [&s](double t, const bh::CycleRecord* last) {
+    if (!s.out().ok()) return false;
+    return last == nullptr || s.out().row(t, bh::measurements_of(*last));
+  };
+  return h;
+}
+
+// The loop's figures and how it ended, for the report and the exit code.
+Outcome outcome_of(const Session& s, const bh::ControlOutcome& c) {
+  const auto& st = c.stats;
   spdlog::info("blmc: {} cycles, period {:.1f} us mean, jitter p99 {} us max {} us, {} overruns, {} missed",
                st.cycles, std::chrono::duration<double, std::micro>(st.period_mean).count(),
                std::chrono::duration_cast<std::chrono::microseconds>(st.jitter_p99).count(),
@@ -344,19 +312,19 @@ asio::awaitable<Outcome> run_loop(Session& s, bh::Controller& controller, double
   Outcome out;
   out.report["loop"] = stats_json(st);
   out.report["fault"] = nullptr;
-  if (auto f = loop.fault()) {
-    spdlog::error("blmc: safety stop: {}", f->fault.describe());
-    out.report["fault"] = json{{"kind", bh::to_string(f->fault.kind)}, {"text", f->fault.describe()}};
+  if (c.fault) {
+    spdlog::error("blmc: safety stop: {}", c.fault->fault.describe());
+    out.report["fault"] = json{{"kind", bh::to_string(c.fault->fault.kind)}, {"text", c.fault->fault.describe()}};
     out.rc = exit_code_value::safety_stop;
-  } else if (!writing) {
+  } else if (!s.out().ok()) {
     out.rc = exit_code_value::failed;
   }
-  co_return out;
+  return out;
 }
 
 // The end of a motion command: its figures (a JSON report line, or text lines), and its exit code
 // from the work and the disable.
-int report(const char* command, const bh::EnabledRun<Outcome>& run) {
+int report(Output& output, const char* command, const bh::EnabledRun<Outcome>& run) {
   int rc = exit_code_value::failed;
   json j{{"type", "report"}, {"command", command}, {"enabled", static_cast<bool>(run.enable)}};
   if (!run.enable) {
@@ -371,41 +339,36 @@ int report(const char* command, const bh::EnabledRun<Outcome>& run) {
   j["disabled"] = static_cast<bool>(run.disable);
   if (run.disable) spdlog::info("blmc: board disabled, currents zero");
   else if (rc == exit_code_value::ok) rc = exit_code_value::failed;  // the library logged why
-  if (opts().json) {
+  if (output.is_json()) {
     j["exit_code"] = signo ? signal_exit_code(signo) : rc;
-    emit(j);
+    output.emit(j);
   } else if (run.value) {
     for (const auto& line : run.value->lines)
-      if (!emit(line)) break;
+      if (!output.emit(line)) break;
   }
   return rc;
 }
 
-// Enables the motors, runs `work`, and disables them on every way out (MotorSession).
-asio::awaitable<int> with_motors(Session& s, const char* command,
-                                 const std::function<asio::awaitable<Outcome>(Session&)>& work) {
-  g_motors_may_be_on = true;
+using Work = asio::awaitable<Outcome> (*)(Session&);
+
+// Enables the motors, runs `work`, and disables them on every way out (the library's MotorSession).
+// An exception leaves motors_may_be_on set: whether the session's disable went through is not
+// known then, so the disable over a new connection runs too (a second disable is harmless).
+asio::awaitable<int> with_motors(Session& s, const char* command, Work work) {
+  s.cli->motors_may_be_on = true;
   const std::function<asio::awaitable<Outcome>()> body = [&]() -> asio::awaitable<Outcome> {
     auto out = co_await work(s);
     co_return out;
   };
-  std::optional<bh::EnabledRun<Outcome>> run;
-  try {
-    auto r = co_await bh::with_motors_enabled<Outcome>(*s.board, body);
-    run = std::move(r);
-  } catch (...) {
-    // The session sent its disable, but whether it went through is not known here: the flag stays,
-    // so the disable over a new connection runs too (a second disable is harmless).
-    throw;
-  }
-  g_motors_may_be_on = !run->disable;  // a failed disable: try again over a new connection
-  co_return report(command, *run);
+  auto run = co_await bh::with_motors_enabled<Outcome>(*s.board, body);
+  s.cli->motors_may_be_on = !run.disable;  // a failed disable: try again over a new connection
+  co_return report(s.out(), command, run);
 }
 
 // ---- subcommands ------------------------------------------------------------------------------
 
 asio::awaitable<int> cmd_status(Session& s) {
-  const auto& o = opts();
+  const auto& o = s.o();
   const auto t0 = core::SteadyClock::instance().now();
   int printed = 0;
   while (!s.stop) {
@@ -415,7 +378,7 @@ asio::awaitable<int> cmd_status(Session& s) {
       spdlog::error("blmc: {}", st.error().message());
       co_return exit_code_value::failed;
     }
-    if (!print_status(st.value())) co_return exit_code_value::failed;
+    if (!s.out().status(st.value())) co_return exit_code_value::failed;
     ++printed;
     if (o.duration_s <= 0 && printed >= 1) break;
     if (o.duration_s > 0 && core::SteadyClock::instance().now() - t0 >= seconds(o.duration_s)) break;
@@ -424,13 +387,13 @@ asio::awaitable<int> cmd_status(Session& s) {
 }
 
 asio::awaitable<int> cmd_monitor(Session& s) {
-  const auto& o = opts();
+  const auto& o = s.o();
   const auto t0 = core::SteadyClock::instance().now();
-  bool writing = print_table_header();
+  bool writing = s.out().table_header();
   while (!s.stop && !s.board->closed() && writing) {
     co_await core::sleep_for(seconds(1.0 / o.refresh_hz));
     const double t = std::chrono::duration<double>(core::SteadyClock::instance().now() - t0).count();
-    writing = print_row(t, s.board->latest());
+    writing = s.out().row(t, s.board->latest());
     if (o.duration_s > 0 && t >= o.duration_s) break;
   }
   const auto& m = s.board->latest();
@@ -441,19 +404,19 @@ asio::awaitable<int> cmd_monitor(Session& s) {
 // `enable` hands the board on enabled (that is what it is for); a failed or interrupted enable is
 // disabled again.
 asio::awaitable<int> cmd_enable(Session& s) {
-  g_motors_may_be_on = true;  // until handed on or disabled
+  s.cli->motors_may_be_on = true;  // until handed on or disabled
   auto r = co_await s.board->enable();
   if (!r) {
     if (r.error() != bh::HostErrc::interrupted) spdlog::error("blmc: enable: {}", r.error().message());
     auto d = co_await s.board->disable();
     if (d) spdlog::info("blmc: board disabled, currents zero");
     else spdlog::error("blmc: could not disable the board: {}", d.error().message());
-    g_motors_may_be_on = false;
+    s.cli->motors_may_be_on = false;
     co_return exit_code_value::failed;
   }
   s.board->leave_enabled();
-  g_motors_may_be_on = false;
-  co_return print_status(s.board->latest().status.value) ? exit_code_value::ok : exit_code_value::failed;
+  s.cli->motors_may_be_on = false;
+  co_return s.out().status(s.board->latest().status.value) ? exit_code_value::ok : exit_code_value::failed;
 }
 
 asio::awaitable<int> cmd_disable(Session& s) {
@@ -462,41 +425,33 @@ asio::awaitable<int> cmd_disable(Session& s) {
   co_return exit_code_value::ok;
 }
 
-struct CurrentArgs {
-  int motor = 1;
-  double amps = 0;
-  double duration_s = 1;
-} current_args;
-
-struct PdArgs {
-  double kp = 5, kd = 0.05, amplitude = 0, frequency = 0.5, duration_s = 5;
-} pd_args;
-
-bh::HomingOptions home_args;
-double home_timeout_s = 20;
-
-std::string raw_text;
-std::string record_file;
-
 asio::awaitable<Outcome> current_work(Session& s) {
-  const auto a = current_args;
-  bh::FunctionController ctl([a](const bh::ControlInput&, std::span<bh::MotorPair> out) {
-    out[0] = a.motor == 1 ? bh::MotorPair{a.amps, 0} : bh::MotorPair{0, a.amps};
+  const auto& o = s.o();
+  const int motor = o.current_motor;
+  const double amps = o.current_amps;
+  bh::FunctionController ctl([motor, amps](const bh::ControlInput&, std::span<bh::MotorPair> out) {
+    out[0] = motor == 1 ? bh::MotorPair{amps, 0} : bh::MotorPair{0, amps};
   });
-  auto out = co_await run_loop(s, ctl, a.duration_s);
-  co_return out;
+  const auto options = control_options(o, o.current_duration_s);
+  auto hooks = table_hooks(s);
+  auto r = co_await bh::run_control(*s.board, ctl, options, std::move(hooks));
+  co_return outcome_of(s, need(std::move(r)));
 }
 
 asio::awaitable<Outcome> pd_work(Session& s) {
-  const auto m = motor_set(opts().motors);
+  const auto& o = s.o();
+  const auto m = motor_set(o.motors);
   std::array<bh::PdTarget, 2> t;
-  for (std::size_t i = 0; i < 2; ++i) t[i] = {m[i], pd_args.amplitude, pd_args.frequency, 0};
-  bh::PdController ctl(1, {pd_args.kp, pd_args.kd}, t);
-  auto out = co_await run_loop(s, ctl, pd_args.duration_s);
+  for (std::size_t i = 0; i < 2; ++i) t[i] = {m[i], o.pd_amplitude, o.pd_frequency, 0};
+  const auto options = control_options(o, o.pd_duration_s);
+  auto hooks = table_hooks(s);
+  auto r = co_await bh::run_pd(*s.board, o.pd_gains, t, options, std::move(hooks));
+  const auto pd = need(std::move(r));
+  auto out = outcome_of(s, pd.control);
   out.report["tracking"] = json::array();
   for (int k = 0; k < 2; ++k) {
     if (!m[static_cast<std::size_t>(k)]) continue;
-    const auto& ts = ctl.tracking(0, k);
+    const auto& ts = pd.tracking[static_cast<std::size_t>(k)];
     out.report["tracking"].push_back(
         json{{"motor", k + 1}, {"rms_rev", ts.rms_rev()}, {"max_rev", ts.max_abs_error_rev}, {"samples", ts.samples}});
     out.lines.push_back(fmt::format("motor {}: tracking error rms {:.5f} rev, max {:.5f} rev ({} samples)", k + 1,
@@ -506,81 +461,83 @@ asio::awaitable<Outcome> pd_work(Session& s) {
 }
 
 asio::awaitable<Outcome> home_work(Session& s) {
-  auto ho = home_args;
-  ho.motors = motor_set(opts().motors);
-  bh::HomingController ctl(1, ho);
-  const std::function<bool()> done = [&] { return ctl.done(); };
-  auto out = co_await run_loop(s, ctl, home_timeout_s, done);
+  const auto& o = s.o();
+  auto ho = o.home;
+  ho.motors = motor_set(o.motors);
+  const auto options = control_options(o, o.home_timeout_s);
+  auto hooks = table_hooks(s);
+  auto r = co_await bh::run_homing(*s.board, ho, options, std::move(hooks));
+  const auto home = need(std::move(r));
+  auto out = outcome_of(s, home.control);
   out.report["homing"] = json::array();
   for (int k = 0; k < 2; ++k) {
-    const auto& r = ctl.result(0, k);
-    if (r.state == bh::MotorHoming::State::idle) continue;
-    const bool found = r.state == bh::MotorHoming::State::found;
-    out.report["homing"].push_back(json{{"motor", k + 1}, {"state", bh::to_string(r.state)},
-                                        {"index_rev", found ? json(r.index_rev) : json(nullptr)}, {"start_rev", r.start_rev}});
-    out.lines.push_back(found ? fmt::format("motor {}: index at {:.6f} rev (started at {:.6f})", k + 1, r.index_rev, r.start_rev)
-                              : fmt::format("motor {}: {} (no index within {:.2f} rev)", k + 1, bh::to_string(r.state),
+    const auto& h = home.motors[static_cast<std::size_t>(k)];
+    if (h.state == bh::MotorHoming::State::idle) continue;
+    const bool found = h.state == bh::MotorHoming::State::found;
+    out.report["homing"].push_back(json{{"motor", k + 1}, {"state", bh::to_string(h.state)},
+                                        {"index_rev", found ? json(h.index_rev) : json(nullptr)}, {"start_rev", h.start_rev}});
+    out.lines.push_back(found ? fmt::format("motor {}: index at {:.6f} rev (started at {:.6f})", k + 1, h.index_rev, h.start_rev)
+                              : fmt::format("motor {}: {} (no index within {:.2f} rev)", k + 1, bh::to_string(h.state),
                                             ho.max_travel_rev));
   }
-  if (out.rc == exit_code_value::ok && !ctl.all_found()) out.rc = exit_code_value::failed;
+  if (out.rc == exit_code_value::ok && !home.all_found) out.rc = exit_code_value::failed;
   co_return out;
 }
 
 asio::awaitable<int> cmd_record(Session& s) {
-  const auto& oo = opts();
-  auto w = need(can::CandumpWriter::create(record_file));
+  const auto& o = s.o();
+  auto w = need(can::CandumpWriter::create(o.record_file));
   std::uint64_t n = 0;
-  s.board->set_tap([&](const can::Frame& f, bool) {
-    can::Frame g = f;
-    if (g.timestamp().count() == 0) g.set_timestamp(core::SteadyClock::instance().wall());
-    if (w.write(g, s.iface)) ++n;
-  });
+  s.board->set_tap(bh::candump_tap(w, s.iface, &n));
   const auto t0 = core::SteadyClock::instance().now();
   while (!s.stop && !s.board->closed()) {
     co_await core::sleep_for(100ms);
-    if (oo.duration_s > 0 && core::SteadyClock::instance().now() - t0 >= seconds(oo.duration_s)) break;
+    if (o.duration_s > 0 && core::SteadyClock::instance().now() - t0 >= seconds(o.duration_s)) break;
   }
   s.board->set_tap({});
   (void)w.flush();
-  spdlog::info("blmc: {} frames to {}", n, record_file);
+  spdlog::info("blmc: {} frames to {}", n, o.record_file);
   co_return exit_code_value::ok;
 }
 
 asio::awaitable<int> cmd_raw(Session& s) {
+  const auto& text = s.o().raw_text;
   can::Frame f;
-  if (raw_text.find('#') != std::string::npos) f = need(can::Frame::parse(raw_text));
-  else f = need(bp::encode(need(bp::Command::parse(raw_text))));
+  if (text.find('#') != std::string::npos) f = need(can::Frame::parse(text));
+  else f = need(bp::encode(need(bp::Command::parse(text))));
   auto r = co_await s.board->send_frame(f);
   need(std::move(r));
   auto m = bp::decode_to_board(f);
   const std::string decoded = m ? bp::to_string(m.value()) : std::string();
-  if (opts().json)
-    co_return emit(json{{"type", "sent"}, {"frame", f.to_string()}, {"decoded", m ? json(decoded) : json(nullptr)}})
-        ? exit_code_value::ok
-        : exit_code_value::failed;
-  co_return emit(fmt::format("sent {}{}", f.to_string(), m ? " (" + decoded + ")" : "")) ? exit_code_value::ok
-                                                                                         : exit_code_value::failed;
+  const bool written = s.out().is_json()
+                           ? s.out().emit(json{{"type", "sent"}, {"frame", f.to_string()}, {"decoded", m ? json(decoded) : json(nullptr)}})
+                           : s.out().emit(fmt::format("sent {}{}", f.to_string(), m ? " (" + decoded + ")" : ""));
+  co_return written ? exit_code_value::ok : exit_code_value::failed;
 }
 
 // How a subcommand ends on SIGINT/SIGTERM/SIGHUP: observers (monitor, record) end normally (exit 0),
 // motion commands check the loop options first; every other command exits 128+N.
 enum class Kind { plain, observe, motion };
 
-CLI::App* add(CLI::App* parent, const char* name, const char* help, Kind kind,
-              std::function<asio::awaitable<int>(Session&)> body) {
+// The loop options that only make sense together, checked before anything is sent to the board
+// (each alone is checked by its validator).
+void check_loop_options(const BlmcOptions& o) {
+  if (auto v = bh::validate(control_options(o, 1), o.recv_timeout_ms); !v)
+    throw Exception(usage(fmt::format("--rate {:g} / --recv-timeout-ms {}: {}", o.rate_hz, o.recv_timeout_ms, v.error().detail)));
+}
+
+CLI::App* add(CLI::App* parent, const std::shared_ptr<Blmc>& cli, const char* name, const char* help, Kind kind, Body body) {
   auto* c = parent->add_subcommand(name, help);
-  c->callback([body, kind] {
-    if (kind == Kind::motion) check_loop_options(opts());
-    exit_code() = run_blmc(kind == Kind::observe, body);
+  c->callback([cli, body = std::move(body), kind] {
+    if (kind == Kind::motion) check_loop_options(cli->o);
+    exit_code() = run_blmc(*cli, kind == Kind::observe, body);
   });
   return c;
 }
 
-CLI::App* add_motion(CLI::App* parent, const char* name, const char* help,
-                     asio::awaitable<Outcome> (*work)(Session&)) {
-  return add(parent, name, help, Kind::motion, [name, work](Session& s) -> asio::awaitable<int> {
-    const std::function<asio::awaitable<Outcome>(Session&)> w = work;
-    const int rc = co_await with_motors(s, name, w);
+CLI::App* add_motion(CLI::App* parent, const std::shared_ptr<Blmc>& cli, const char* name, const char* help, Work work) {
+  return add(parent, cli, name, help, Kind::motion, [name, work](Session& s) -> asio::awaitable<int> {
+    const int rc = co_await with_motors(s, name, work);
     co_return rc;
   });
 }
@@ -604,6 +561,7 @@ void add_board_options(CLI::App* b, BlmcOptions& o) {
   b->add_option("--socketcand", o.socketcand, "socketcand server as HOST:PORT/CHANNEL");
   b->add_option("--socketcan", o.socketcan, "SocketCAN interface (default can0)");
   b->add_option("--log", o.log, "write every frame of the session to this candump log");
+  b->add_option("--csv", o.csv, "current, pd, home: write every control cycle to this CSV file (docs/library-blmc.md)");
   b->add_option("--motors", o.motors, "motors to use: 1, 2 or both (default both)");
   b->add_option("--max-current", o.max_current, "safety: current clamp, A (default 2)")->check(positive());
   b->add_option("--max-velocity", o.max_velocity, "safety: zero current above this speed, krpm (default 2)")->check(positive());
@@ -619,53 +577,58 @@ void add_board_options(CLI::App* b, BlmcOptions& o) {
   b->add_flag("--json", o.json, "stdout: JSON Lines (one object per line: status, sample, report, sent)");
 }
 
+void add_motion_commands(CLI::App* b, const std::shared_ptr<Blmc>& cli) {
+  auto& o = cli->o;
+  auto* cur = add_motion(b, cli, "current", "apply a constant current to one motor for a while (safety limits apply)",
+                         current_work);
+  cur->add_option("motor", o.current_motor, "1 or 2")->required()->check(CLI::Range(1, 2));
+  cur->add_option("amperes", o.current_amps, "current, A (clamped to --max-current)")->required()->check(amperes());
+  cur->add_option("--duration", o.current_duration_s, "seconds (default 1)")->check(positive());
+
+  auto* pd = add_motion(b, cli, "pd", "host-side PD: hold the start position, or track a sine around it", pd_work);
+  pd->add_option("--kp", o.pd_gains.kp, "A per motor revolution (default 5)")->check(non_negative());
+  pd->add_option("--kd", o.pd_gains.kd, "A per rev/s (default 0.05)")->check(non_negative());
+  pd->add_option("--amplitude", o.pd_amplitude, "sine amplitude, motor rev (default 0: hold)")->check(non_negative());
+  pd->add_option("--frequency", o.pd_frequency, "sine frequency, Hz (default 0.5)")->check(non_negative());
+  pd->add_option("--duration", o.pd_duration_s, "seconds (default 5)")->check(positive());
+
+  auto* home = add_motion(b, cli, "home", "find the encoder index of each motor and report its position (the offset)",
+                          home_work);
+  home->add_option("--speed", o.home.speed_rev_s, "motor rev/s, sign gives the direction (default 0.5)")->check(nonzero());
+  home->add_option("--kp", o.home.kp, "A per rev (default 2)")->check(positive());
+  home->add_option("--kd", o.home.kd, "A per rev/s (default 0.02)")->check(non_negative());
+  home->add_option("--current", o.home.max_current_a, "current limit while homing, A (default 0.5)")->check(positive());
+  home->add_option("--travel", o.home.max_travel_rev, "give up after this many motor rev (default 2)")->check(positive());
+  home->add_option("--timeout", o.home_timeout_s, "seconds (default 20)")->check(positive());
+}
+
 }  // namespace
 
 void add_blmc_commands(CLI::App& app, GlobalOptions& /*global*/) {
-  auto& o = opts();
+  auto cli = std::make_shared<Blmc>();
+  auto& o = cli->o;
   auto* b = app.add_subcommand("blmc", "motor driver board: status, monitor, enable, current, PD, homing, record, raw");
   b->require_subcommand(1);
   add_board_options(b, o);
 
-  add(b, "status", "decoded status frames (one, or live with --duration)", Kind::plain, cmd_status)
+  add(b, cli, "status", "decoded status frames (one, or live with --duration)", Kind::plain, cmd_status)
       ->add_option("--duration", o.duration_s, "seconds to keep printing (default 0: one)")
       ->check(non_negative());
-  add(b, "monitor", "live table of currents, positions, velocities, ADC", Kind::observe, cmd_monitor)
+  add(b, cli, "monitor", "live table of currents, positions, velocities, ADC", Kind::observe, cmd_monitor)
       ->add_option("--duration", o.duration_s, "seconds (default 0: until Ctrl-C)")
       ->check(non_negative());
-  add(b, "enable", "enable the system and motors, wait until they are aligned, and leave them enabled", Kind::plain,
+  add(b, cli, "enable", "enable the system and motors, wait until they are aligned, and leave them enabled", Kind::plain,
       cmd_enable);
-  add(b, "disable", "zero currents, disable the motors and the system", Kind::plain, cmd_disable);
+  add(b, cli, "disable", "zero currents, disable the motors and the system", Kind::plain, cmd_disable);
+  add_motion_commands(b, cli);
 
-  auto* cur = add_motion(b, "current", "apply a constant current to one motor for a while (safety limits apply)",
-                         current_work);
-  cur->add_option("motor", current_args.motor, "1 or 2")->required()->check(CLI::Range(1, 2));
-  cur->add_option("amperes", current_args.amps, "current, A (clamped to --max-current)")->required()->check(amperes());
-  cur->add_option("--duration", current_args.duration_s, "seconds (default 1)")->check(positive());
-
-  auto* pd = add_motion(b, "pd", "host-side PD: hold the start position, or track a sine around it", pd_work);
-  pd->add_option("--kp", pd_args.kp, "A per motor revolution (default 5)")->check(non_negative());
-  pd->add_option("--kd", pd_args.kd, "A per rev/s (default 0.05)")->check(non_negative());
-  pd->add_option("--amplitude", pd_args.amplitude, "sine amplitude, motor rev (default 0: hold)")->check(non_negative());
-  pd->add_option("--frequency", pd_args.frequency, "sine frequency, Hz (default 0.5)")->check(non_negative());
-  pd->add_option("--duration", pd_args.duration_s, "seconds (default 5)")->check(positive());
-
-  auto* home = add_motion(b, "home", "find the encoder index of each motor and report its position (the offset)",
-                          home_work);
-  home->add_option("--speed", home_args.speed_rev_s, "motor rev/s, sign gives the direction (default 0.5)")->check(nonzero());
-  home->add_option("--kp", home_args.kp, "A per rev (default 2)")->check(positive());
-  home->add_option("--kd", home_args.kd, "A per rev/s (default 0.02)")->check(non_negative());
-  home->add_option("--current", home_args.max_current_a, "current limit while homing, A (default 0.5)")->check(positive());
-  home->add_option("--travel", home_args.max_travel_rev, "give up after this many motor rev (default 2)")->check(positive());
-  home->add_option("--timeout", home_timeout_s, "seconds (default 20)")->check(positive());
-
-  auto* rec = add(b, "record", "write a candump log of the bus (everything the board sends and receives)", Kind::observe,
-                  cmd_record);
-  rec->add_option("file", record_file, "candump log file")->required();
+  auto* rec = add(b, cli, "record", "write a candump log of the bus (everything the board sends and receives)",
+                  Kind::observe, cmd_record);
+  rec->add_option("file", o.record_file, "candump log file")->required();
   rec->add_option("--duration", o.duration_s, "seconds (default 0: until Ctrl-C)")->check(non_negative());
 
-  add(b, "raw", "send one frame (ID#DATA) or command (NAME=value)", Kind::plain, cmd_raw)
-      ->add_option("frame", raw_text, "e.g. 000#0000000100000001 or ENABLE_SYS=1")
+  add(b, cli, "raw", "send one frame (ID#DATA) or command (NAME=value)", Kind::plain, cmd_raw)
+      ->add_option("frame", o.raw_text, "e.g. 000#0000000100000001 or ENABLE_SYS=1")
       ->required();
 }
 

@@ -15,6 +15,8 @@ void add_demo_command(CLI::App& app, GlobalOptions& global);
 void add_sim_commands(CLI::App& app, GlobalOptions& global);
 // `axon sim c4g`, registered by add_sim_commands under `sim` (apps/axon/sim_c4g.cpp).
 void add_sim_c4g_command(CLI::App& sim_cmd);
+// `axon sim blmc`, registered by add_sim_commands under `sim` (apps/axon/sim_blmc.cpp).
+void add_sim_blmc_command(CLI::App& sim_cmd);
 void add_fps_commands(CLI::App& app, GlobalOptions& global);
 void add_c4g_commands(CLI::App& app, GlobalOptions& global);
 // These add to the groups above (call after them): `fps layout`, `fps plc`, `sim plc`.

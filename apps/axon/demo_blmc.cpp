@@ -2,9 +2,8 @@
 // motors under PD control at 1 kHz in the real-time ControlLoop following a sine; then the
 // tracking error, the loop's timing and the board's state after the motors were disabled.
 #include "axon/blmc/host/board.hpp"
-#include "axon/blmc/host/control_loop.hpp"
+#include "axon/blmc/host/control_run.hpp"
 #include "axon/blmc/host/motor_session.hpp"
-#include "axon/blmc/host/pd_controller.hpp"
 #include "axon/blmc/sim/runner.hpp"
 #include "axon/can/virtual_bus.hpp"
 #include "axon/core/wakeup.hpp"
@@ -24,33 +23,15 @@ constexpr double kAmplitudeRev = 0.5, kFrequencyHz = 1.0, kRunS = 3.0;
 
 double blmc_us(core::Duration d) { return std::chrono::duration<double, std::micro>(d).count(); }
 
-// The PD loop for kRunS; the loop's fault if the safety supervisor stopped it.
-asio::awaitable<std::optional<bh::LoopFault>> run_pd(bh::Board& board, bh::PdController& pd, bh::LoopStats& stats,
-                                                     const bool& stop) {
-  auto c = co_await board.start_cyclic();
-  need(std::move(c));
-  std::optional<bh::LoopFault> fault;
-  {
-    // The simulated board ticks on this process's event-loop thread, which a busy machine can hold
-    // for longer than the 10 ms a real board's data may age; a hardware loop keeps the default.
-    bh::SafetyLimits limits;
-    limits.stale_after = 100ms;
-    bh::ControlLoop loop({&board.port()}, pd, {limits}, bh::LoopOptions{});
-    need(loop.start());
-    const auto t0 = std::chrono::steady_clock::now();
-    bh::CycleRecord rec;
-    while (loop.running() && !stop && std::chrono::steady_clock::now() - t0 < std::chrono::duration<double>(kRunS)) {
-      co_await core::sleep_for(20ms);
-      while (loop.pop_record(rec)) {
-      }
-    }
-    loop.stop();
-    fault = loop.fault();
-    stats = loop.stats();
-  }
-  auto s = co_await board.stop_cyclic();
-  need(std::move(s));
-  co_return fault;
+// The run's options: the library's defaults, except the stale-data limit. The simulated board
+// ticks on this process's event-loop thread, which a busy machine can hold for longer than the
+// 10 ms a real board's data may age; a hardware loop keeps the default.
+bh::ControlOptions demo_options() {
+  bh::ControlOptions o;
+  o.limits.stale_after = 100ms;
+  o.duration = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(kRunS));
+  o.refresh = 20ms;
+  return o;
 }
 
 }  // namespace
@@ -68,18 +49,23 @@ asio::awaitable<int> demo_blmc(asio::any_io_executor ex, std::function<void(std:
 
   fmt::print("2. enable and align, then PD control of both motors (kp 10 A/rev, kd 0.1 A/(rev/s)), a {:g} rev {:g} Hz sine, {:g} s\n",
              kAmplitudeRev, kFrequencyHz, kRunS);
-  bh::PdTarget sine{true, kAmplitudeRev, kFrequencyHz, 0.0};
-  bh::PdController pd(1, {10.0, 0.1}, {sine, sine}, 300ms);
-  bh::LoopStats st;
+  const bh::PdGains gains{10.0, 0.1};
+  const bh::PdTarget sine{true, kAmplitudeRev, kFrequencyHz, 0.0};
+  const std::array<bh::PdTarget, 2> targets{sine, sine};
   bool stop = false;
   set_on_signal([&stop, &board] {
     stop = true;
-    board.interrupt();  // ends a wait for the alignment at once
+    board.interrupt();  // ends a wait for the alignment at once, and the run
   });
   // Every way out of the body (its end, a fault, an exception, a failed enable) leaves the motors
   // with zero current and disabled: the library's MotorSession.
-  auto run = co_await bh::with_motors_enabled<std::optional<bh::LoopFault>>(
-      board, [&]() -> asio::awaitable<std::optional<bh::LoopFault>> { co_return co_await run_pd(board, pd, st, stop); });
+  const bh::ControlOptions options = demo_options();
+  const std::function<asio::awaitable<Result<bh::PdRun>>()> body = [&]() -> asio::awaitable<Result<bh::PdRun>> {
+    bh::ControlHooks none;
+    auto r = co_await bh::run_pd(board, gains, targets, options, std::move(none), 300ms);
+    co_return r;
+  };
+  auto run = co_await bh::with_motors_enabled<Result<bh::PdRun>>(board, body);
   set_on_signal([] {});
   co_await core::sleep_for(50ms);
   const auto status = board_sim->status();
@@ -87,11 +73,13 @@ asio::awaitable<int> demo_blmc(asio::any_io_executor ex, std::function<void(std:
   bus->close();
   need(std::move(run.enable));
   need(std::move(run.disable));
-  const std::optional<bh::LoopFault> fault = run.value ? *run.value : std::nullopt;
+  const auto pd = need(std::move(*run.value));
+  const auto& st = pd.control.stats;
+  const auto& fault = pd.control.fault;
 
   fmt::print("\n3. result\n");
   for (int k = 0; k < 2; ++k) {
-    const auto& t = pd.tracking(0, k);
+    const auto& t = pd.tracking[static_cast<std::size_t>(k)];
     fmt::print("   motor {}: tracking error rms {:.4f} rev, max {:.4f} rev ({} samples)\n", k + 1, t.rms_rev(),
                t.max_abs_error_rev, t.samples);
   }

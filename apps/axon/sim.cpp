@@ -1,11 +1,7 @@
 // `axon sim fps`: simulated fiber positioners served on virtual buses in this process, exposed as a
 // CAN@net gateway emulator and/or a socketcand server so that other processes (axon fps, python-can,
 // the host software in service) can drive them.
-// `axon sim blmc`: simulated motor driver boards, one per virtual bus (can0, can1 ...), served the
-// same way over socketcand.
-#include "axon/blmc/sim/board_config.hpp"
-#include "axon/blmc/sim/fault_plan.hpp"
-#include "axon/blmc/sim/runner.hpp"
+// `axon sim blmc` (apps/axon/sim_blmc.cpp) and `axon sim c4g` (sim_c4g.cpp) register under `sim` here.
 #include "axon/can/bus_spec.hpp"
 #include "axon/can/cannet_server.hpp"
 #include "axon/can/socketcand_server.hpp"
@@ -224,82 +220,6 @@ int run_sim_fps(const SimFpsOptions& o) {
   });
 }
 
-struct SimBlmcOptions {
-  unsigned boards = 1;
-  std::string socketcand = "127.0.0.1:29536";  // loopback, socketcand's usual port
-  std::string config;
-  std::string fault_plan;
-  double duration_s = 0;
-};
-
-// The fault plan of each board from --fault-plan: one plan (a map) or a list of plans; a plan with
-// `board: N` applies to board N (can<N>) only, one without applies to every board. Several plans
-// for one board add up (the last seed given wins).
-std::vector<blmc::sim::BoardFaultPlan> load_blmc_fault_plans(const std::string& file, unsigned boards) {
-  std::vector<blmc::sim::BoardFaultPlan> plans(boards);
-  if (file.empty()) return plans;
-  const auto root = need(core::ConfigNode::load_file(file));
-  std::vector<core::ConfigNode> items;
-  if (root.is_sequence()) items = need(root.items());
-  else items.push_back(root);
-  for (const auto& item : items) {
-    const auto plan = need(blmc::sim::BoardFaultPlan::from_config(item, {"board"}));
-    const bool one = item.has("board");
-    const unsigned which = one ? need(item.get_in<unsigned>("board", 0u, boards - 1)) : 0u;
-    for (unsigned b = 0; b < boards; ++b) {
-      if (one && b != which) continue;
-      auto& p = plans[b];
-      p.events.insert(p.events.end(), plan.events.begin(), plan.events.end());
-      p.stalls.insert(p.stalls.end(), plan.stalls.begin(), plan.stalls.end());
-      p.drops.insert(p.drops.end(), plan.drops.begin(), plan.drops.end());
-      if (item.has("seed")) p.seed = plan.seed;
-    }
-  }
-  return plans;
-}
-
-int run_sim_blmc(const SimBlmcOptions& o) {
-  blmc::sim::BoardConfig config;
-  if (!o.config.empty()) config = need(blmc::sim::BoardConfig::from_config(need(core::ConfigNode::load_file(o.config))));
-  const auto plans = load_blmc_fault_plans(o.fault_plan, o.boards);
-  return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
-    const asio::any_io_executor ex = io.get_executor();
-    can::VirtualBusRegistry registry(ex);
-    blmc::sim::Runner runner(ex);
-    std::vector<std::string> channels;
-    for (unsigned i = 0; i < o.boards; ++i) {
-      channels.push_back(fmt::format("can{}", i));
-      can::WireModel wire;
-      wire.enabled = true;  // bus load figures
-      need(registry.add(channels.back(), wire));
-      need(runner.add(config, plans[i], registry, channels.back()));
-    }
-    runner.start();
-    const auto ep = need(net::parse_endpoint(o.socketcand, can::kSocketcandPort));
-    auto scd = need(can::SocketcandServer::create(ex, registry, ep));
-    std::printf("listening socketcand %s\n", scd->local_endpoint().to_string().c_str());
-    std::fflush(stdout);
-    spdlog::info("sim: {} blmc board{} on {} (Ctrl-C to stop)", o.boards, o.boards == 1 ? "" : "s",
-                 fmt::join(channels, ", "));
-
-    co_await wait_for_stop(io, o.duration_s, set_on_signal);
-
-    scd->stop();
-    for (std::size_t i = 0; i < runner.size(); ++i) {
-      const auto& b = runner.board(i);
-      const auto& s = b.stats();
-      spdlog::info("sim: {}: status {}; IqRef {:g} {:g} A; {} frames in ({} malformed, {} ignored), {} out; bus load {:.1f} %",
-                   channels[i], b.status().to_string(), b.motor_state(0).iq_ref_a, b.motor_state(1).iq_ref_a,
-                   s.frames_received, s.malformed, s.ignored, s.frames_sent,
-                   100.0 * registry.find(channels[i])->load(std::chrono::steady_clock::now()));
-    }
-    const auto& rs = runner.stats();
-    spdlog::info("sim: {} ticks, {} schedule restarts, {} send errors", rs.ticks, rs.schedule_restarts, rs.send_errors);
-    runner.stop();
-    co_return 0;
-  });
-}
-
 }  // namespace
 
 void add_sim_commands(CLI::App& app, GlobalOptions&) {
@@ -342,15 +262,7 @@ void add_sim_commands(CLI::App& app, GlobalOptions&) {
   f->get_option("--layout")->excludes("--robots")->excludes("--buses")->excludes("--config")->excludes("--gateway")->excludes("--socketcand");
   f->callback([] { exit_code() = run_sim_fps(fps); });
 
-  static SimBlmcOptions blmc;
-  auto* b = sim_cmd->add_subcommand("blmc", "simulated blmc motor driver boards, one per bus (can0, can1 ...)");
-  b->add_option("--boards", blmc.boards, "number of boards (default 1)")->check(CLI::Range(1u, 64u));
-  b->add_option("--socketcand", blmc.socketcand, "serve socketcand on HOST:PORT (default 127.0.0.1:29536; port 0: any)");
-  b->add_option("--config", blmc.config, "board/motor parameters YAML (docs/blmc-simulator.md)");
-  b->add_option("--fault-plan", blmc.fault_plan, "fault plan YAML (docs/blmc-simulator.md)");
-  b->add_option("--duration", blmc.duration_s, "stop after this many seconds (default: until Ctrl-C)")->check(non_negative());
-  b->callback([] { exit_code() = run_sim_blmc(blmc); });
-
+  add_sim_blmc_command(*sim_cmd);
   add_sim_c4g_command(*sim_cmd);
 }
 

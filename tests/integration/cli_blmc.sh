@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # `axon blmc` against `axon sim blmc` in another process, over socketcand: the live status decodes;
-# host-side PD tracks a sine within a stated error and writes a candump log of the session; homing
-# finds the encoder index; raw commands go out in the spec's notation; `disable` leaves the board
-# with the system off.
+# host-side PD tracks a sine within a stated error and writes a candump log of the session; --csv
+# logs every control cycle; homing finds the encoder index; raw commands go out in the spec's
+# notation; `disable` leaves the board with the system off.
 source "$(dirname "$0")/lib.sh"
 "$AXON" sim blmc --boards 1 --socketcand 127.0.0.1:0 >"$TMP/sim.out" 2>"$TMP/sim.err" &
 PIDS+=($!)
@@ -24,6 +24,11 @@ head -1 "$TMP/session.log" | grep -Eq '^\([0-9]+\.[0-9]{6}\) can0 [0-9A-F]{3}#[0
 grep -q ' can0 000#0000000100000001$' "$TMP/session.log" || fail "no ENABLE_SYS=1 in the log"
 iqref=$(grep -c ' can0 005#' "$TMP/session.log")
 [ "$iqref" -gt 2000 ] || fail "only $iqref current references logged in 3 s"
+
+# --csv: one line per control cycle (a header, then about 1000 lines a second).
+blmc --csv "$TMP/cycles.csv" pd --duration 1 >/dev/null 2>"$TMP/csv.err" || fail "pd --csv failed: $(cat "$TMP/csv.err")"
+head -1 "$TMP/cycles.csv" | grep -q '^cycle,t_s,current1_a,current2_a,position1_rev' || fail "csv header: $(head -1 "$TMP/cycles.csv")"
+[ "$(wc -l <"$TMP/cycles.csv")" -gt 500 ] || fail "only $(wc -l <"$TMP/cycles.csv") csv lines in 1 s"
 
 blmc home >"$TMP/home.out" 2>"$TMP/home.err" || fail "home failed"
 grep -Eq '^motor 1: index at -?[0-9.]+ rev' "$TMP/home.out" || fail "home: $(cat "$TMP/home.out")"

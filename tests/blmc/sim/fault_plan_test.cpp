@@ -5,6 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
 using namespace axon;
 using namespace axon::blmc;
 using namespace axon::blmc::sim;
@@ -131,4 +137,28 @@ TEST(BlmcFaultPlan, SeededDropsAreReproducible) {
   EXPECT_EQ(times[0], times[1]);
   EXPECT_GT(counts[0], 400u);
   EXPECT_LT(counts[0], 600u);
+}
+
+// `axon sim blmc --fault-plan`: a list of plans, some for one board (`board: N`), some for all.
+TEST(BlmcFaultPlan, LoadsOnePlanPerBoardFromAFile) {
+  const auto path = std::filesystem::temp_directory_path() / ("axon_blmc_plans_" + std::to_string(::getpid()) + ".yaml");
+  {
+    std::ofstream f(path);
+    f << "- { board: 1, events: [ { at_s: 4.0, kind: encoder } ] }\n"
+         "- { seed: 7, drops: [ { direction: tx, probability: 0.001 } ] }\n";
+  }
+  auto loaded = load_fault_plans(path.string(), 2);
+  ASSERT_TRUE(loaded) << loaded.error().message();
+  const auto& plans = loaded.value();
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_TRUE(plans[0].events.empty());
+  ASSERT_EQ(plans[1].events.size(), 1u);
+  EXPECT_EQ(plans[1].events[0].kind, FaultKind::encoder);
+  EXPECT_EQ(plans[0].drops.size(), 1u);
+  EXPECT_EQ(plans[1].drops.size(), 1u);
+  EXPECT_EQ(plans[0].seed, 7u);
+  EXPECT_TRUE(load_fault_plans("", 3).value().size() == 3u);
+  auto bad = load_fault_plans(path.string(), 1);  // board 1 of one
+  EXPECT_FALSE(bad);
+  std::filesystem::remove(path);
 }

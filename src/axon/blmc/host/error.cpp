@@ -21,6 +21,7 @@ class HostCategory final : public std::error_category {
       case HostErrc::invalid_argument: return "invalid argument";
       case HostErrc::homing_failed: return "homing found no encoder index; check the encoder and the homing range";
       case HostErrc::interrupted: return "stopped on request while waiting for the board";
+      case HostErrc::not_enabled: return "the motors are not enabled; call enable() first";
     }
     return "unknown blmc host error";
   }

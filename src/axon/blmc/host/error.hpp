@@ -19,6 +19,7 @@ enum class HostErrc {
   invalid_argument,  // a bad option or input from the caller
   homing_failed,     // no encoder index found within the homing range or time
   interrupted,       // a stop was requested (Board::interrupt) while waiting for the board
+  not_enabled,       // the call needs the motors enabled (MotorBoard::start_control, home)
 };
 
 const std::error_category& host_category() noexcept;

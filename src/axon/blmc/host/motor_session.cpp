@@ -1,5 +1,12 @@
 #include "axon/blmc/host/motor_session.hpp"
 
+#include "axon/blmc/host/error.hpp"
+#include "axon/can/open.hpp"
+
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/io_context.hpp>
+#include <fmt/format.h>
+
 #include <spdlog/spdlog.h>
 
 namespace axon::blmc::host {
@@ -29,6 +36,32 @@ asio::awaitable<Result<void>> MotorSession::end() {
   if (!r) spdlog::error("{}: could not disable the board (the motors may still be on): {}", board_->options().name,
                         r.error().message());
   co_return end_result_;
+}
+
+Result<void> disable_over_new_connection(const can::BusSpec& spec, core::Duration timeout) {
+  Result<void> result = Error(HostErrc::timeout, fmt::format("{}: no way to the board within {:.1f} s", spec.to_string(),
+                                                             std::chrono::duration<double>(timeout).count()));
+  asio::io_context io;  // after `result`: the coroutine's frame goes first
+  asio::co_spawn(
+      io,
+      [&]() -> asio::awaitable<void> {
+        auto b = co_await can::open_bus(io.get_executor(), spec);
+        if (!b) {
+          result = b.error();
+          co_return;
+        }
+        auto bus = std::move(b).value();
+        {
+          Board board(*bus);
+          result = co_await board.disable();
+        }
+        auto f = co_await bus->flush(std::chrono::seconds(1));
+        (void)f;
+        bus->close();
+      },
+      [](std::exception_ptr) {});
+  io.run_for(timeout);
+  return result;
 }
 
 }  // namespace axon::blmc::host

@@ -24,6 +24,7 @@
 #pragma once
 
 #include "axon/blmc/host/board.hpp"
+#include "axon/can/bus_spec.hpp"
 
 #include <exception>
 #include <functional>
@@ -86,5 +87,11 @@ asio::awaitable<EnabledRun<T>> with_motors_enabled(Board& board, std::function<a
   if (failure) std::rethrow_exception(failure);
   co_return run;
 }
+
+// The way out when the program's own event loop is gone with the motors possibly on (a second
+// Ctrl-C stopped it mid-session): opens `spec` anew on an event loop of its own and sends IqRef = 0,
+// ENABLE_MTR1/2 = 0, ENABLE_SYS = 0. Blocks for at most `timeout`; HostErrc::timeout when the bus
+// did not let the frames out by then, the bus's error when it did not open.
+Result<void> disable_over_new_connection(const can::BusSpec& spec, core::Duration timeout = std::chrono::seconds(3));
 
 }  // namespace axon::blmc::host

@@ -134,4 +134,40 @@ Result<BoardFaultPlan> BoardFaultPlan::from_config(const core::ConfigNode& node,
   return plan;
 }
 
+namespace {
+
+void add_to(BoardFaultPlan& p, const BoardFaultPlan& plan, bool seed_given) {
+  p.events.insert(p.events.end(), plan.events.begin(), plan.events.end());
+  p.stalls.insert(p.stalls.end(), plan.stalls.begin(), plan.stalls.end());
+  p.drops.insert(p.drops.end(), plan.drops.begin(), plan.drops.end());
+  if (seed_given) p.seed = plan.seed;
+}
+
+}  // namespace
+
+Result<std::vector<BoardFaultPlan>> load_fault_plans(const std::string& path, unsigned boards) {
+  std::vector<BoardFaultPlan> plans(boards);
+  if (path.empty() || boards == 0) return plans;
+  AXON_TRY(root, core::ConfigNode::load_file(path));
+  std::vector<core::ConfigNode> items;
+  if (root.is_sequence()) {
+    AXON_TRY(list, root.items());
+    items = std::move(list);
+  } else {
+    items.push_back(root);
+  }
+  for (const auto& item : items) {
+    AXON_TRY(plan, BoardFaultPlan::from_config(item, {"board"}));
+    const bool one = item.has("board");
+    unsigned which = 0;
+    if (one) {
+      AXON_TRY(n, item.get_in<unsigned>("board", 0u, boards - 1));
+      which = n;
+    }
+    for (unsigned b = 0; b < boards; ++b)
+      if (!one || b == which) add_to(plans[b], plan, item.has("seed"));
+  }
+  return plans;
+}
+
 }  // namespace axon::blmc::sim

@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <initializer_list>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -71,5 +72,11 @@ struct BoardFaultPlan {
   static Result<BoardFaultPlan> from_config(const core::ConfigNode& node,
                                             std::initializer_list<std::string_view> extra_keys = {});
 };
+
+// The fault plan of each of `boards` boards (board i on bus can<i>) from a file: one plan (a map)
+// or a list of plans; a plan with `board: N` applies to board N only, one without to every board.
+// Several plans for one board add up (the last seed given wins). An empty path gives empty plans.
+// Errors: the file's (CoreErrc::io, config_*), a board number outside 0..boards-1.
+Result<std::vector<BoardFaultPlan>> load_fault_plans(const std::string& path, unsigned boards);
 
 }  // namespace axon::blmc::sim

@@ -16,6 +16,7 @@
 #pragma once
 
 #include "axon/blmc/sim/board.hpp"
+#include "axon/blmc/sim/runner_stats.hpp"
 #include "axon/can/bus.hpp"
 #include "axon/can/provider.hpp"
 #include "axon/can/virtual_bus.hpp"
@@ -36,13 +37,6 @@ struct RunnerOptions {
   core::Duration tick = kCycle;  // real time between steps; 0: no timer, the caller calls step()
   core::Duration max_catch_up = std::chrono::milliseconds(2);
   const core::Clock* clock = nullptr;  // default: core::SteadyClock::instance()
-};
-
-struct RunnerStats {
-  std::uint64_t ticks = 0;              // steps run by the timer
-  std::uint64_t schedule_restarts = 0;  // the tick fell more than max_catch_up behind
-  std::uint64_t send_errors = 0;        // a bus refused a frame (closed, overflow)
-  std::uint64_t receive_errors = 0;     // frames the boards did not take (malformed or foreign)
 };
 
 class Runner {

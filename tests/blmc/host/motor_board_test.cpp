@@ -1,0 +1,242 @@
+// The blocking MotorBoard against the in-process SimulatedBoard (socketcand over loopback, each on
+// its own event-loop thread): what a plain main() relies on. Enable, the user's control law at
+// 1 kHz, homing, a safety stop reported as a value, refusals in words, and a board left with the
+// system and both motors off and zero current on every way out (destructor included).
+#include "axon/blmc/host/error.hpp"
+#include "axon/blmc/host/motor_board.hpp"
+#include "axon/blmc/host/motor_session.hpp"
+#include "axon/blmc/sim/simulated_board.hpp"
+#include "axon/can/bus_spec.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include <unistd.h>
+
+namespace axon::blmc {
+namespace {
+
+using host::HostErrc;
+
+sim::SimulatedBoardOptions sim_options() {
+  sim::SimulatedBoardOptions o;
+  o.config.alignment_time = 200ms;
+  return o;
+}
+
+// Loaded machines (two cores for several builds) hold threads for longer than a real board's
+// timing allows (10 ms stale data, a 50 ms receive timeout): the tests that are not about those
+// limits give them slack.
+ControlSettings settings() {
+  ControlSettings s;
+  s.realtime = false;
+  s.limits.stale_after = 500ms;
+  return s;
+}
+
+MotorBoardOptions board_options() {
+  MotorBoardOptions o;
+  o.recv_timeout_ms = 500;
+  return o;
+}
+
+// The disable travels over socketcand: the board applies it a moment after the host sent it.
+void expect_board_off(const sim::SimulatedBoard& sim) {
+  for (int i = 0; i < 300 && sim.report().status.system_enabled; ++i) std::this_thread::sleep_for(10ms);
+  const auto r = sim.report();
+  EXPECT_FALSE(r.status.system_enabled);
+  EXPECT_FALSE(r.motors[0].enabled);
+  EXPECT_FALSE(r.motors[1].enabled);
+  EXPECT_EQ(r.motors[0].iq_ref_a, 0.0);
+  EXPECT_EQ(r.motors[1].iq_ref_a, 0.0);
+}
+
+// Both motors to a target 0.5 rev and -0.3 rev away from where they start.
+ControlLaw move_by(std::array<double, 2> delta, std::array<std::atomic<double>, 2>& start) {
+  return [delta, &start, first = true](const ControlState& s) mutable {
+    if (first) {
+      start[0] = s.position_rev[0];
+      start[1] = s.position_rev[1];
+      first = false;
+    }
+    return Command{MotorCommand::pd(start[0] + delta[0], 0, 8, 0.1), MotorCommand::pd(start[1] + delta[1], 0, 8, 0.1)};
+  };
+}
+
+TEST(BlmcMotorBoard, RunsAPdLawOnBothMotorsAndTheDestructorDisables) {
+  sim::SimulatedBoard sim(sim_options());
+  std::array<std::atomic<double>, 2> start{};
+  {
+    MotorBoard board(sim.bus_spec(), board_options());
+    board.enable();
+    EXPECT_TRUE(board.enabled());
+    const auto report = board.run_control(move_by({0.5, -0.3}, start), 1500ms, settings());
+    EXPECT_FALSE(report.fault) << report.fault_text;
+    EXPECT_GT(report.stats.cycles, 500u);
+    const auto m = board.measurements();
+    EXPECT_NEAR(m.position.value.motor1, start[0] + 0.5, 0.02);
+    EXPECT_NEAR(m.position.value.motor2, start[1] - 0.3, 0.02);
+    const auto r = sim.report();
+    EXPECT_TRUE(r.motors[0].enabled);  // control ended, the motors stay on until disabled
+  }
+  expect_board_off(sim);
+}
+
+TEST(BlmcMotorBoard, ABoardFaultIsAReportedSafetyStopNotAnException) {
+  sim::SimulatedBoard sim(sim_options());
+  MotorBoard board(sim.bus_spec(), board_options());
+  board.enable();
+  board.start_control([](const ControlState&) { return Command{MotorCommand::current(0.1), MotorCommand::current(0)}; },
+                      settings());
+  EXPECT_TRUE(board.control_running());
+  sim.inject(sim::FaultKind::encoder);
+  for (int i = 0; i < 300 && board.control_running(); ++i) std::this_thread::sleep_for(10ms);
+  EXPECT_FALSE(board.control_running());
+  const auto report = board.stop_control();
+  ASSERT_TRUE(report.fault);
+  EXPECT_EQ(report.fault->board_error, protocol::ErrorCode::encoder) << report.fault_text;
+  EXPECT_NE(report.fault_text.find("ENCODER"), std::string::npos) << report.fault_text;
+  // A glitch (no lasting cause): the documented recovery brings the motors back.
+  board.recover();
+  EXPECT_EQ(board.wait_status().error, protocol::ErrorCode::none);
+  EXPECT_TRUE(sim.report().status.system_enabled);
+  board.disable();
+  expect_board_off(sim);
+}
+
+TEST(BlmcMotorBoard, HomingFindsEachMotorsIndexOffset) {
+  auto o = sim_options();
+  o.config.motors[0].index_offset_rev = 0.25;
+  o.config.motors[1].index_offset_rev = 0.6;
+  sim::SimulatedBoard sim(o);
+  MotorBoard board(sim.bus_spec(), board_options());
+  board.enable();
+  host::HomingOptions h;
+  h.speed_rev_s = 1.0;
+  const auto report = board.home(h, settings(), 10s);
+  EXPECT_FALSE(report.control.fault) << report.control.fault_text;
+  ASSERT_TRUE(report.all_found);
+  // 20000 counts per revolution: the index reads within a count or two of the mark.
+  EXPECT_NEAR(report.motors[0].index_rev, 0.25, 2e-4);
+  EXPECT_NEAR(report.motors[1].index_rev, 0.6, 2e-4);
+}
+
+TEST(BlmcMotorBoard, RefusesControlBeforeEnableAndImpossibleSettingsInWords) {
+  sim::SimulatedBoard sim(sim_options());
+  MotorBoard board(sim.bus_spec(), board_options());
+  const ControlLaw zero = [](const ControlState&) { return Command{}; };
+  try {
+    board.start_control(zero, settings());
+    FAIL() << "control started with the motors off";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), HostErrc::not_enabled);
+  }
+  board.enable();
+  auto slow = settings();
+  slow.period = 1s;  // one reference per second: the board's 500 ms receive timeout would trip
+  try {
+    board.start_control(zero, slow);
+    FAIL() << "a period beyond the receive timeout was taken";
+  } catch (const Exception& e) {
+    EXPECT_TRUE(e.code() == std::errc::invalid_argument) << e.what();
+    EXPECT_NE(std::string(e.what()).find("receive timeout"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(board.control_running());
+}
+
+TEST(BlmcMotorBoard, InterruptEndsAnEnableWaitingForTheAlignmentAndLeavesTheBoardOff) {
+  auto o = sim_options();
+  o.config.alignment_time = 6s;
+  sim::SimulatedBoard sim(o);
+  MotorBoard board(sim.bus_spec(), board_options());
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(300ms);
+    board.interrupt();
+  });
+  try {
+    board.enable();
+    ADD_FAILURE() << "the enable waited for the alignment";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), HostErrc::interrupted) << e.what();
+  }
+  stopper.join();
+  EXPECT_FALSE(board.enabled());
+  expect_board_off(sim);
+}
+
+TEST(BlmcMotorBoard, WritesOneCsvLinePerCycle) {
+  sim::SimulatedBoard sim(sim_options());
+  const auto path = std::filesystem::temp_directory_path() / ("axon_blmc_cycles_" + std::to_string(::getpid()) + ".csv");
+  MotorBoard board(sim.bus_spec(), board_options());
+  board.enable();
+  auto s = settings();
+  s.csv = path.string();
+  const auto report = board.run_control([](const ControlState&) { return Command{}; }, 500ms, s);
+  EXPECT_GT(report.csv_lines, 100u);
+  std::ifstream in(path);
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_EQ(header.rfind("cycle,t_s,current1_a", 0), 0u) << header;
+  std::uint64_t lines = 0;
+  while (std::getline(in, line)) ++lines;
+  EXPECT_EQ(lines, report.csv_lines);
+  std::filesystem::remove(path);
+}
+
+TEST(BlmcMotorBoard, OpeningABusNobodyServesThrowsTheBusError) {
+  EXPECT_THROW(MotorBoard("socketcand://127.0.0.1:1/can0", MotorBoardOptions{.connect_timeout = 2s}), Exception);
+  EXPECT_THROW(MotorBoard("nonsense://x"), Exception);
+}
+
+TEST(BlmcMotorBoard, DisableOverANewConnectionTurnsAnEnabledBoardOff) {
+  sim::SimulatedBoard sim(sim_options());
+  MotorBoard board(sim.bus_spec(), board_options());
+  board.enable();
+  EXPECT_TRUE(sim.report().status.system_enabled);
+  auto r = host::disable_over_new_connection(can::parse_bus_spec(sim.bus_spec()).value());
+  EXPECT_TRUE(r) << (r ? "" : r.error().message());
+  expect_board_off(sim);
+}
+
+TEST(BlmcSimulatedBoard, ServesEachBoardOnItsOwnChannel) {
+  auto o = sim_options();
+  o.boards = 2;
+  sim::SimulatedBoard sim(o);
+  EXPECT_EQ(sim.boards(), 2u);
+  EXPECT_EQ(sim.bus_spec(1), "socketcand://" + sim.endpoint() + "/can1");
+  EXPECT_THROW((void)sim.bus_spec(2), std::out_of_range);
+  MotorBoard board(sim.bus_spec(1), board_options());
+  EXPECT_FALSE(board.wait_status().system_enabled);
+  board.enable();
+  EXPECT_TRUE(sim.report(1).status.system_enabled);
+  EXPECT_FALSE(sim.report(0).status.system_enabled);
+}
+
+}  // namespace
+}  // namespace axon::blmc
+
+namespace axon::blmc {
+namespace {
+
+TEST(BlmcSimulatedBoard, AnAddressInUseIsAnException) {
+  sim::SimulatedBoard first(sim_options());
+  auto o = sim_options();
+  o.socketcand = first.endpoint();
+  try {
+    sim::SimulatedBoard second(o);
+    FAIL() << "two simulators on " << first.endpoint();
+  } catch (const Exception& e) {
+    EXPECT_NE(std::string(e.what()).find("in use"), std::string::npos) << e.what();
+  }
+  o.config.alignment_time = -1s;
+  EXPECT_THROW(sim::SimulatedBoard{o}, Exception);
+}
+
+}  // namespace
+}  // namespace axon::blmc
