@@ -13,6 +13,7 @@
 #include "checks.hpp"
 #include "commands.hpp"
 #include "axon/core/config.hpp"
+#include "axon/fps/layout/layout_file.hpp"
 #include "axon/fps/sim/focal_plane_sim.hpp"
 #include "axon/fps/sim/simulator_config.hpp"
 #include "id_list.hpp"

@@ -1,26 +1,17 @@
 // The buses a host opens: given options win over the bus file, the file over the defaults.
 #include "axon/fps/host/bus_selection.hpp"
 
+#include "temp_file.hpp"
+
 #include <gtest/gtest.h>
 
-#include <unistd.h>
 
-#include <filesystem>
-#include <fstream>
 #include <string>
 
 namespace axon::fps::host {
 namespace {
 
-class BusFile : public ::testing::Test {
- protected:
-  std::string write(const std::string& text) {
-    std::ofstream(path_) << text;
-    return path_;
-  }
-  void TearDown() override { std::filesystem::remove(path_); }
-  std::string path_ = (std::filesystem::temp_directory_path() / ("axon-buses-" + std::to_string(::getpid()) + ".yaml")).string();
-};
+using BusFile = testing::TempFileTest;
 
 std::vector<std::string> texts(const BusSelection& s) {
   std::vector<std::string> out;

@@ -3,11 +3,10 @@
 #include "axon/fps/layout/layout_name.hpp"
 #include "axon/fps/plan/layout_model.hpp"
 
+#include "temp_file.hpp"
+
 #include <gtest/gtest.h>
 
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <string>
 
 namespace axon::fps::host {
@@ -64,15 +63,7 @@ TEST(PlanTrajectories, DropsTheStartPointAndRobotsThatStay) {
   EXPECT_TRUE(t.at(id5).beta().empty());
 }
 
-class TrajectoryFile : public ::testing::Test {
- protected:
-  std::string write(const std::string& text) {
-    std::ofstream(path_) << text;
-    return path_;
-  }
-  void TearDown() override { std::filesystem::remove(path_); }
-  std::string path_ = (std::filesystem::temp_directory_path() / ("axon-traj-" + std::to_string(::getpid()) + ".yaml")).string();
-};
+using TrajectoryFile = testing::TempFileTest;
 
 TEST_F(TrajectoryFile, LoadsEveryRobotWithEitherArm) {
   const auto t = load_trajectory_file(write("1: {alpha: [[10, 1], [20, 2]], beta: [[170, 2]]}\n7: {beta: [[160, 3]]}\n")).value();
