@@ -14,8 +14,9 @@ namespace {
 using BusFile = testing::TempFileTest;
 
 std::vector<std::string> texts(const BusSelection& s) {
+  const auto specs = s.specs().value();
   std::vector<std::string> out;
-  for (const auto& spec : s.specs().value()) out.push_back(spec.to_string());
+  for (const auto& spec : specs) out.push_back(spec.to_string());
   return out;
 }
 
