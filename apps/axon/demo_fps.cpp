@@ -84,6 +84,32 @@ struct Phase {
   double floor = 0;  // wire time of the busiest bus; 0: not a bus-bound phase
 };
 
+// The largest distance of one arm from its planned end, over the robots' final readings.
+double worst_reading(const host::TrajectoryReport& run, const std::map<std::uint16_t, host::ArmAngles>& ends) {
+  double worst = 0;
+  for (const auto& rr : run.robots)
+    if (rr.reached) {
+      const auto& end = ends.at(rr.id);
+      worst = std::max({worst, std::abs(rr.reached->alpha - end.alpha), std::abs(rr.reached->beta - end.beta)});
+    }
+  return worst;
+}
+
+// Step 7: each phase against its floor (or, for the move, the trajectory's real-time duration).
+void print_timings(const std::vector<Phase>& phases, double move_wall_s) {
+  fmt::print("7. timings (floor: wire time of the busiest bus for the frames the phase put on it, 1 Mbit/s):\n");
+  for (const auto& p : phases) {
+    if (p.floor > 0) {
+      fmt::print("   {:<12} {:7.3f} s   floor {:7.4f} s   ratio {:5.2f}\n", p.name, p.seconds, p.floor, p.seconds / p.floor);
+    } else if (p.name == "move") {
+      fmt::print("   {:<12} {:7.3f} s   trajectory {:.3f} s (real time)   ratio {:5.2f}\n", p.name, p.seconds, move_wall_s,
+                 p.seconds / move_wall_s);
+    } else {
+      fmt::print("   {:<12} {:7.3f} s\n", p.name, p.seconds);
+    }
+  }
+}
+
 }  // namespace
 
 asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std::function<void()>)> set_on_signal) {
@@ -264,14 +290,9 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
   phases.push_back({"move", seconds(run.timings.move), 0});
 
   // 6. Verify: the host's final reading of every robot and the simulator's own arms.
-  double worst_host = 0, worst_sim = 0;
+  const double worst_host = worst_reading(run, ends);
+  double worst_sim = 0;
   std::size_t at_target = 0;
-  for (const auto& rr : run.robots) {
-    if (rr.reached) {
-      const auto& target = ends.at(rr.id);
-      worst_host = std::max({worst_host, std::abs(rr.reached->alpha - target.alpha), std::abs(rr.reached->beta - target.beta)});
-    }
-  }
   // The simulator's own arms, read on its thread.
   sim_thread.call([&] {
     for (const auto& rr : run.robots) {
@@ -291,17 +312,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
 
   if (st.neighbour_collisions + st.obstacle_collisions > 0)
     throw Exception(Error(host::HostErrc::collision, "the simulator saw collisions during the planned move"));
-  fmt::print("7. timings (floor: wire time of the busiest bus for the frames the phase put on it, 1 Mbit/s):\n");
-  for (const auto& p : phases) {
-    if (p.floor > 0) {
-      fmt::print("   {:<12} {:7.3f} s   floor {:7.4f} s   ratio {:5.2f}\n", p.name, p.seconds, p.floor, p.seconds / p.floor);
-    } else if (p.name == "move") {
-      fmt::print("   {:<12} {:7.3f} s   trajectory {:.3f} s (real time)   ratio {:5.2f}\n", p.name, p.seconds,
-                 move_s / kTimeScale, p.seconds / (move_s / kTimeScale));
-    } else {
-      fmt::print("   {:<12} {:7.3f} s\n", p.name, p.seconds);
-    }
-  }
+  print_timings(phases, move_s / kTimeScale);
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   const auto totals = array.client_totals();
