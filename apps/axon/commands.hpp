@@ -24,8 +24,6 @@ void add_fps_layout_commands(CLI::App& app, GlobalOptions& global);
 void add_fps_plc_commands(CLI::App& app, GlobalOptions& global);
 void add_sim_plc_command(CLI::App& app, GlobalOptions& global);
 void add_blmc_commands(CLI::App& app, GlobalOptions& global);
-// `fps plan`, `fps plot`, `fps goto-all` (after add_fps_commands).
-void add_fps_plan_commands(CLI::App& app, GlobalOptions& global);
 // `fps plane` (after add_fps_commands).
 void add_fps_plane_commands(CLI::App& app, GlobalOptions& global);
 

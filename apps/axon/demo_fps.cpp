@@ -9,6 +9,7 @@
 
 #include "axon/fps/host/cold_control.hpp"
 #include "axon/fps/host/focal_plane_array.hpp"
+#include "axon/fps/host/trajectory_build.hpp"
 #include "axon/fps/plan/layout_model.hpp"
 #include "axon/fps/plan/planner.hpp"
 #include "axon/fps/plan/problems.hpp"
@@ -35,7 +36,6 @@
 namespace axon::app {
 
 namespace host = fps::host;
-namespace protocol = fps::protocol;
 
 namespace {
 
@@ -78,22 +78,37 @@ double floor_s(const std::map<fps::BusRef, std::uint64_t>& before, const std::ma
   return static_cast<double>(most) / 1e6;
 }
 
-// A straight move of both arms from `from` to `to` in `points` points per arm over `duration_s`.
-protocol::Trajectory straight(host::ArmAngles from, host::ArmAngles to, int points, double duration_s) {
-  std::vector<protocol::ArmPoint> a, b;
-  for (int i = 1; i <= points; ++i) {
-    const double f = static_cast<double>(i) / points;
-    a.push_back({from.alpha + (to.alpha - from.alpha) * f, duration_s * f});
-    b.push_back({from.beta + (to.beta - from.beta) * f, duration_s * f});
-  }
-  return need(protocol::Trajectory::from_physical(a, b));
-}
-
 struct Phase {
   std::string name;
   double seconds = 0;
   double floor = 0;  // wire time of the busiest bus; 0: not a bus-bound phase
 };
+
+// The largest distance of one arm from its planned end, over the robots' final readings.
+double worst_reading(const host::TrajectoryReport& run, const std::map<std::uint16_t, host::ArmAngles>& ends) {
+  double worst = 0;
+  for (const auto& rr : run.robots)
+    if (rr.reached) {
+      const auto& end = ends.at(rr.id);
+      worst = std::max({worst, std::abs(rr.reached->alpha - end.alpha), std::abs(rr.reached->beta - end.beta)});
+    }
+  return worst;
+}
+
+// Step 7: each phase against its floor (or, for the move, the trajectory's real-time duration).
+void print_timings(const std::vector<Phase>& phases, double move_wall_s) {
+  fmt::print("7. timings (floor: wire time of the busiest bus for the frames the phase put on it, 1 Mbit/s):\n");
+  for (const auto& p : phases) {
+    if (p.floor > 0) {
+      fmt::print("   {:<12} {:7.3f} s   floor {:7.4f} s   ratio {:5.2f}\n", p.name, p.seconds, p.floor, p.seconds / p.floor);
+    } else if (p.name == "move") {
+      fmt::print("   {:<12} {:7.3f} s   trajectory {:.3f} s (real time)   ratio {:5.2f}\n", p.name, p.seconds, move_wall_s,
+                 p.seconds / move_wall_s);
+    } else {
+      fmt::print("   {:<12} {:7.3f} s\n", p.name, p.seconds);
+    }
+  }
+}
 
 }  // namespace
 
@@ -179,12 +194,8 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
   // 4. Fold every robot to alpha 0 (beta stays folded: the arms never leave their cells), then
   //    the coordinated move: every robot the same trajectory at the same instant, so neighbours
   //    stay translated copies of each other and never come closer than the pitch allows.
-  std::map<std::uint16_t, protocol::Trajectory> fold;
-  for (const auto& row : table.rows) {
-    if (!row.position) continue;
-    fold.emplace(row.id, straight(*row.position, {0, 180}, 20, 16.0));
-  }
-  auto r1 = co_await fpa->run_trajectories(std::move(fold), {}, true);
+  auto fold = need(host::straight_moves(table, {0, 180}, 20, 16.0));
+  auto r1 = co_await fpa->run_trajectories(std::move(fold.trajectories), {}, true);
   const auto folded = need(std::move(r1));
   fmt::print("4. fold (20 points per arm, 16 s simulated, started by the PLC's sync line): {}\n", folded.outcome);
   if (received_stop_signal().load() != 0) {  // stopped by a signal: every robot was stopped; end here
@@ -218,21 +229,10 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
   if (!plan.verified) throw Exception(Error(host::HostErrc::sequence_failed, "the planner's checker rejected the plan"));
   if (plan.not_reached > 0) fmt::print("{}", plan.summary(model));
   const double move_s = plan.stats.duration_s;
-  std::map<std::uint16_t, protocol::Trajectory> moves;
+  auto moves = need(host::plan_trajectories(model, plan));
   std::map<std::uint16_t, host::ArmAngles> ends;
-  for (std::size_t i = 0; i < model.size(); ++i) {
-    const auto id = static_cast<std::uint16_t>(model.robot(i).id());
-    const auto& t = plan.trajectories[i];
-    ends[id] = {plan.robots[i].end.alpha_deg, plan.robots[i].end.beta_deg};
-    if (t.alpha.size() <= 1 && t.beta.size() <= 1) continue;  // stays
-    std::vector<protocol::ArmPoint> a, b;
-    // The first point (0 s) is where the robot stands: the firmware adds it by itself.
-    for (std::size_t k = 1; k < t.alpha.size(); ++k) a.push_back({t.alpha[k].deg, t.alpha[k].t_s});
-    for (std::size_t k = 1; k < t.beta.size(); ++k) b.push_back({t.beta[k].deg, t.beta[k].t_s});
-    if (a.empty()) a.push_back({t.alpha.front().deg, 0.5});
-    if (b.empty()) b.push_back({t.beta.front().deg, 0.5});
-    moves.emplace(id, need(protocol::Trajectory::from_physical(a, b)));
-  }
+  for (std::size_t i = 0; i < model.size(); ++i)
+    ends[static_cast<std::uint16_t>(model.robot(i).id())] = {plan.robots[i].end.alpha_deg, plan.robots[i].end.beta_deg};
   std::map<std::string, std::map<fps::BusRef, std::uint64_t>> marks;
   std::map<std::string, Clock::time_point> marks_t;
   bool moving = false, finished = false, progress_done = false;
@@ -290,14 +290,9 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
   phases.push_back({"move", seconds(run.timings.move), 0});
 
   // 6. Verify: the host's final reading of every robot and the simulator's own arms.
-  double worst_host = 0, worst_sim = 0;
+  const double worst_host = worst_reading(run, ends);
+  double worst_sim = 0;
   std::size_t at_target = 0;
-  for (const auto& rr : run.robots) {
-    if (rr.reached) {
-      const auto& target = ends.at(rr.id);
-      worst_host = std::max({worst_host, std::abs(rr.reached->alpha - target.alpha), std::abs(rr.reached->beta - target.beta)});
-    }
-  }
   // The simulator's own arms, read on its thread.
   sim_thread.call([&] {
     for (const auto& rr : run.robots) {
@@ -317,17 +312,7 @@ asio::awaitable<void> demo_fps(asio::any_io_executor ex, std::function<void(std:
 
   if (st.neighbour_collisions + st.obstacle_collisions > 0)
     throw Exception(Error(host::HostErrc::collision, "the simulator saw collisions during the planned move"));
-  fmt::print("7. timings (floor: wire time of the busiest bus for the frames the phase put on it, 1 Mbit/s):\n");
-  for (const auto& p : phases) {
-    if (p.floor > 0) {
-      fmt::print("   {:<12} {:7.3f} s   floor {:7.4f} s   ratio {:5.2f}\n", p.name, p.seconds, p.floor, p.seconds / p.floor);
-    } else if (p.name == "move") {
-      fmt::print("   {:<12} {:7.3f} s   trajectory {:.3f} s (real time)   ratio {:5.2f}\n", p.name, p.seconds,
-                 move_s / kTimeScale, p.seconds / (move_s / kTimeScale));
-    } else {
-      fmt::print("   {:<12} {:7.3f} s\n", p.name, p.seconds);
-    }
-  }
+  print_timings(phases, move_s / kTimeScale);
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   const auto totals = array.client_totals();

@@ -8,8 +8,9 @@
 #include "fps_array.hpp"
 #include "fps_stop.hpp"
 #include "checks.hpp"
-#include "axon/core/config.hpp"
 #include "axon/fps/host/array.hpp"
+#include "axon/fps/host/bus_selection.hpp"
+#include "axon/fps/host/trajectory_build.hpp"
 #include "axon/fps/protocol/commands.hpp"
 #include "axon/fps/protocol/response.hpp"
 #include "axon/fps/protocol/trajectory.hpp"
@@ -21,7 +22,6 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
-#include <yaml-cpp/yaml.h>
 
 #include <unistd.h>
 
@@ -39,80 +39,13 @@ using json = nlohmann::json;
 namespace host = fps::host;
 namespace protocol = fps::protocol;
 
-// Empty lists and a negative timeout mean "not given": the --config file or the defaults fill them.
+// The group's options: the buses (given, or from the --config file), output style.
 struct FpsOptions {
   std::string config;
-  std::string gateway;
-  std::vector<int> channels;
-  std::string socketcand;
-  std::vector<std::string> scd_channels;
-  std::vector<std::string> buses;
+  host::BusSelection buses;
   bool json = false;
   bool no_color = false;
-  double timeout_s = -1;
 };
-
-// The bus selection of a --config file: fills what the command line left out (the command line
-// wins). Unknown keys and bad values are errors located by file:line.
-Result<void> apply_config_file(FpsOptions& o) {
-  AXON_TRY(root, core::ConfigNode::load_file(o.config));
-  if (!root.is_map()) return root.error(CoreErrc::config_bad_value, "expected a map of bus options");
-  AXON_TRY(root.reject_unknown({"gateway", "channels", "socketcand", "channel", "buses", "timeout_ms"}));
-  if (root.has("gateway")) {
-    AXON_TRY(v, root.get<std::string>("gateway"));
-    if (o.gateway.empty()) o.gateway = v;
-  }
-  if (root.has("socketcand")) {
-    AXON_TRY(v, root.get<std::string>("socketcand"));
-    if (o.socketcand.empty()) o.socketcand = v;
-  }
-  if (root.has("channels")) {
-    AXON_TRY(node, root.child("channels"));
-    AXON_TRY(items, node.items());
-    std::vector<int> v;
-    std::map<int, int> line_of;
-    for (const auto& item : items) {
-      AXON_TRY(c, item.as<int>());
-      if (c < 1 || c > 4) return item.error(CoreErrc::config_bad_value, "a gateway channel is 1..4");
-      if (auto [it, fresh] = line_of.emplace(c, item.line()); !fresh)
-        return item.error(CoreErrc::config_bad_value, fmt::format("channel {} listed twice (first at line {})", c, it->second));
-      v.push_back(c);
-    }
-    if (o.channels.empty()) o.channels = v;
-  }
-  for (const char* key : {"channel", "buses"}) {
-    if (!root.has(key)) continue;
-    AXON_TRY(node, root.child(key));
-    AXON_TRY(items, node.items());
-    std::vector<std::string> v;
-    std::map<std::string, int> line_of;
-    for (const auto& item : items) {
-      AXON_TRY(text, item.as<std::string>());
-      if (auto [it, fresh] = line_of.emplace(text, item.line()); !fresh)
-        return item.error(CoreErrc::config_bad_value, fmt::format("'{}' listed twice (first at line {})", text, it->second));
-      v.push_back(text);
-    }
-    auto& target = std::string_view(key) == "channel" ? o.scd_channels : o.buses;
-    if (target.empty()) target = v;
-  }
-  if (root.has("timeout_ms")) {
-    AXON_TRY(ms, root.get_in<int>("timeout_ms", 1, 600000));
-    if (o.timeout_s < 0) o.timeout_s = ms / 1000.0;
-  }
-  return ok();
-}
-
-// The options with the --config file and the defaults applied.
-FpsOptions resolved(FpsOptions o) {
-  if (!o.config.empty()) need(apply_config_file(o));
-  if (o.channels.empty()) o.channels = {1};
-  if (o.scd_channels.empty()) o.scd_channels = {"can0"};
-  if (o.timeout_s < 0) o.timeout_s = 1.0;
-  return o;
-}
-
-// The group's options once add_fps_commands ran (for with_fps_array).
-FpsOptions* g_options = nullptr;
 
 // What a subcommand does once the robots are known. Returns the exit code.
 using Job = std::function<asio::awaitable<int>(host::Array&, const host::DiscoveryReport&)>;
@@ -139,26 +72,6 @@ json row_json(const host::StatusRow& r) {
   return j;
 }
 
-// The bus specs the options select: --gateway with --channels, --socketcand with --channel, --bus.
-std::vector<can::BusSpec> selected_buses(const FpsOptions& o) {
-  std::vector<std::string> texts;
-  if (!o.gateway.empty()) {
-    const net::Endpoint ep = need(net::parse_endpoint(o.gateway, can::kCanNetPort));
-    for (int c : o.channels) texts.push_back(fmt::format("cannet://{}/{}", ep.to_string(), c));
-  }
-  if (!o.socketcand.empty())
-    for (const auto& c : o.scd_channels) texts.push_back(fmt::format("socketcand://{}/{}", o.socketcand, c));
-  texts.insert(texts.end(), o.buses.begin(), o.buses.end());
-  std::vector<can::BusSpec> specs;
-  for (const auto& t : texts) {
-    auto spec = can::parse_bus_spec(t);
-    if (!spec) throw Exception(usage(spec.error().message()));
-    specs.push_back(std::move(spec).value());
-  }
-  if (auto distinct = can::check_distinct(specs); !distinct) throw Exception(usage(distinct.error().detail));
-  return specs;
-}
-
 // Buses where the discovery broadcast failed: the command cannot vouch for those robots.
 std::size_t failed_buses(const host::DiscoveryReport& report) {
   return report.failed_buses.size();
@@ -168,13 +81,14 @@ std::size_t failed_buses(const host::DiscoveryReport& report) {
 // closes everything. With `moves`, a stop signal stops every robot (fps_stop.hpp). A bus whose
 // discovery failed makes the exit code at least 1.
 int with_array(const FpsOptions& given, const Job& job, bool moves = false) {
-  const FpsOptions o = resolved(given);
-  const int sources = (o.gateway.empty() ? 0 : 1) + (o.socketcand.empty() ? 0 : 1) + (o.buses.empty() ? 0 : 1);
-  if (sources == 0) throw Exception(usage("select the buses: --gateway HOST:PORT, --socketcand HOST:PORT or --bus SPEC"));
-  const auto specs = selected_buses(o);
+  host::BusSelection selection = given.buses;
+  if (!given.config.empty()) need(selection.apply_file(given.config));
+  selection.apply_defaults();
+  const auto specs = need(selection.specs());
+  const double timeout_s = selection.timeout_s;
   return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
     const asio::any_io_executor ex = io.get_executor();
-    const auto timeout = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(o.timeout_s));
+    const auto timeout = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(timeout_s));
     auto opened = co_await can::open_buses(ex, specs);
     auto buses = need(std::move(opened));
     std::vector<can::Bus*> raw;
@@ -336,47 +250,6 @@ asio::awaitable<int> job_goto(const FpsOptions& o, const GotoArgs& g, host::Arra
                   m.target.alpha, m.target.beta);
   std::fflush(stdout);
   co_return 0;
-}
-
-// {robot_id: {alpha: [[deg, s], ...], beta: [[deg, s], ...]}} in YAML or JSON.
-std::map<std::uint16_t, protocol::Trajectory> load_trajectories(const std::string& file) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(file);
-  } catch (const std::exception& e) {
-    throw Exception(usage(fmt::format("{}: {}", file, e.what())));
-  }
-  if (!root.IsMap() || root.size() == 0) throw Exception(usage(fmt::format("{}: expected a map of robot id -> {{alpha, beta}}", file)));
-  std::map<std::uint16_t, protocol::Trajectory> out;
-  std::map<std::uint16_t, int> line_of;  // where each robot's entry starts (1-based)
-  for (const auto& kv : root) {
-    const auto key = kv.first.as<std::string>();
-    const auto ids = need(parse_id_list(key));
-    if (ids.size() != 1) throw Exception(usage(fmt::format("{}: key '{}' must be one robot id", file, key)));
-    const int line = kv.first.Mark().line + 1;
-    if (auto [it, fresh] = line_of.emplace(ids.front(), line); !fresh)
-      throw Exception(usage(fmt::format("{}:{}: robot {} listed twice (first at line {})", file, line, ids.front(), it->second)));
-    std::vector<protocol::ArmPoint> arms[2];
-    const char* names[2] = {"alpha", "beta"};
-    for (int a = 0; a < 2; ++a) {
-      const auto list = kv.second[names[a]];
-      if (!list) continue;
-      if (!list.IsSequence()) throw Exception(usage(fmt::format("{}: robot {} {}: expected a list of [deg, s]", file, key, names[a])));
-      for (const auto& pt : list) {
-        if (!pt.IsSequence() || pt.size() != 2)
-          throw Exception(usage(fmt::format("{}: robot {} {}: each point is [deg, s]", file, key, names[a])));
-        try {
-          arms[a].push_back(protocol::ArmPoint{pt[0].as<double>(), pt[1].as<double>()});
-        } catch (const std::exception& e) {
-          throw Exception(usage(fmt::format("{}: robot {} {}: {}", file, key, names[a], e.what())));
-        }
-      }
-    }
-    auto t = protocol::Trajectory::from_physical(arms[0], arms[1]);
-    if (!t) throw Exception(Error(t.error().code, fmt::format("{}: robot {}{}{}", file, key, t.error().detail.empty() ? "" : ": ", t.error().detail)));
-    out.emplace(ids.front(), std::move(t).value());
-  }
-  return out;
 }
 
 asio::awaitable<int> job_move(const FpsOptions& o, const std::map<std::uint16_t, protocol::Trajectory>& trajectories,
@@ -560,112 +433,151 @@ asio::awaitable<int> job_raw(const FpsOptions& o, const RawArgs& a, host::Array&
   co_return 0;
 }
 
+// A subcommand's callback: runs `job` (a member of the shared options struct `Args`) on the array.
+template <class Args, class JobFn>
+std::function<void()> on_array(std::shared_ptr<FpsOptions> o, std::shared_ptr<Args> args, JobFn job, bool moves = false) {
+  return [o, args, job, moves] {
+    exit_code() = with_array(*o, [&](host::Array& a, const host::DiscoveryReport& r) { return job(*o, *args, a, r); }, moves);
+  };
+}
+
+struct NoArgs {};
+struct IdsArgs {
+  std::vector<std::string> ids;
+};
+struct MoveArgs {
+  std::string file;
+  bool load_only = false;
+  std::map<std::uint16_t, protocol::Trajectory> trajectories;  // loaded before the buses open
+};
+struct StopArgs {
+  bool clear_flags = false;
+};
+struct DatumArgs {
+  std::uint16_t id = 0;
+};
+struct UpgradeArgs {
+  std::string firmware;
+  std::vector<std::string> ids;
+};
+
+void add_bus_options(CLI::App& fps, FpsOptions& o) {
+  auto& b = o.buses;
+  fps.add_option("--config", o.config, "YAML bus selection: gateway, channels, socketcand, channel, buses, timeout_ms")
+      ->check(CLI::ExistingFile);
+  fps.add_option("--gateway", b.gateway, "CAN@net NT gateway (or `axon sim fps`) at HOST[:PORT]");
+  fps.add_option("--channels", b.channels, "gateway channels, e.g. 1,2,3,4 (default 1)")->delimiter(',')->check(CLI::Range(1, 4));
+  fps.add_option("--socketcand", b.socketcand, "socketcand server at HOST[:PORT]");
+  fps.add_option("--channel", b.scd_channels, "socketcand channel (repeatable; default can0)");
+  fps.add_option("--bus", b.buses, "any bus spec (repeatable): cannet://HOST/N, socketcand://HOST/CH, socketcan:IF");
+  fps.add_flag("--json", o.json, "machine-readable output");
+  fps.add_flag("--no-color", o.no_color, "no colours in the status table (colours only on a terminal anyway)");
+  fps.add_option("--timeout", b.timeout_s, "seconds to wait for each reply (default 1)")->check(non_negative());
+}
+
+void add_read_commands(CLI::App& fps, const std::shared_ptr<FpsOptions>& o) {
+  const auto none = std::make_shared<NoArgs>();
+  fps.add_subcommand("discover", "robots per bus and their firmware")
+      ->callback(on_array(o, none, [](const FpsOptions& f, NoArgs&, host::Array& a, const host::DiscoveryReport& r) {
+        return job_discover(f, a, r);
+      }));
+  fps.add_subcommand("status", "status table: state, flags, position")
+      ->callback(on_array(o, none, [](const FpsOptions& f, NoArgs&, host::Array& a, const host::DiscoveryReport& r) {
+        return job_status(f, a, r);
+      }));
+  const auto pos = std::make_shared<IdsArgs>();
+  auto* p = fps.add_subcommand("position", "arm angles of the listed robots (default all)");
+  p->add_option("ids", pos->ids, "robot ids: 3, 1-6, 1,4,9");
+  p->callback(on_array(o, pos, [](const FpsOptions& f, IdsArgs& x, host::Array& a, const host::DiscoveryReport& r) {
+    return job_position(f, x.ids, a, r);
+  }));
+}
+
+void add_motion_commands(CLI::App& fps, const std::shared_ptr<FpsOptions>& o) {
+  const auto go = std::make_shared<GotoArgs>();
+  auto* g = fps.add_subcommand("goto", "move one robot's arms (degrees) and wait");
+  g->add_option("id", go->id, "robot id")->required()->check(CLI::Range(1, 2047));
+  g->add_option("alpha", go->alpha, "alpha angle, degrees")->required();
+  g->add_option("beta", go->beta, "beta angle, degrees")->required();
+  g->add_flag("--relative", go->relative, "move by ALPHA and BETA instead of to them");
+  g->callback(on_array(o, go, job_goto, true));
+
+  const auto mv = std::make_shared<MoveArgs>();
+  auto* m = fps.add_subcommand("move", "run trajectories from a file on several robots at once");
+  m->add_option("-t,--trajectory", mv->file, "YAML/JSON: {ID: {alpha: [[deg, s], ...], beta: [...]}}")->required();
+  m->add_flag("--load-only", mv->load_only, "upload and validate, do not start");
+  const auto run_move = on_array(o, mv, [](const FpsOptions& f, MoveArgs& x, host::Array& a, const host::DiscoveryReport& r) {
+    return job_move(f, x.trajectories, x.load_only, a, r);
+  }, true);
+  m->callback([mv, run_move] {
+    mv->trajectories = need(host::load_trajectory_file(mv->file));
+    run_move();
+  });
+
+  const auto st = std::make_shared<StopArgs>();
+  auto* s = fps.add_subcommand("stop", "stop every robot on every bus (TRAJECTORY_ABORT broadcast)");
+  s->add_flag("--clear-flags", st->clear_flags, "send STOP_TRAJECTORY instead, which also clears collision flags");
+  s->callback(on_array(o, st, [](const FpsOptions& f, StopArgs& x, host::Array& a, const host::DiscoveryReport& r) {
+    return job_stop(f, x.clear_flags, a, r);
+  }));
+  fps.add_subcommand("unlock", "clear collision flags on every bus (STOP_TRAJECTORY) and report who answered")
+      ->callback(on_array(o, std::make_shared<NoArgs>(),
+                          [](const FpsOptions& f, NoArgs&, host::Array& a, const host::DiscoveryReport& r) {
+                            return job_unlock(f, a, r);
+                          }));
+}
+
+void add_robot_commands(CLI::App& fps, const std::shared_ptr<FpsOptions>& o) {
+  const auto cal = std::make_shared<CalibrateArgs>();
+  auto* c = fps.add_subcommand("calibrate", "calibration sequence (default: motors, datums, save)");
+  c->add_option("id", cal->id, "robot id")->required()->check(CLI::Range(1, 2047));
+  c->add_flag("--motor", cal->motor, "calibrate the motors");
+  c->add_flag("--datum", cal->datum, "calibrate the datums");
+  c->add_flag("--cogging", cal->cogging, "calibrate cogging (long: up to 40 min)");
+  c->add_flag("--save", cal->save, "save the calibration to flash");
+  c->callback(on_array(o, cal, job_calibrate, true));
+
+  const auto dt = std::make_shared<DatumArgs>();
+  auto* d = fps.add_subcommand("datum", "datum search: both arms into their hard stops");
+  d->add_option("id", dt->id, "robot id")->required()->check(CLI::Range(1, 2047));
+  d->callback(on_array(o, dt, [](const FpsOptions& f, DatumArgs& x, host::Array& a, const host::DiscoveryReport& r) {
+    return job_datum(f, x.id, a, r);
+  }, true));
+
+  const auto up = std::make_shared<UpgradeArgs>();
+  auto* u = fps.add_subcommand("upgrade", "firmware upgrade of robots running their bootloader");
+  u->add_option("--firmware", up->firmware, "firmware image file")->required()->check(CLI::ExistingFile);
+  u->add_option("ids", up->ids, "robot ids: 3, 1-6, 1,4,9")->required();
+  u->callback([o, up] {
+    const auto ids = need(parse_id_lists(up->ids));
+    std::ifstream in(up->firmware, std::ios::binary);
+    const std::vector<std::uint8_t> image((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in.good() && !in.eof()) throw Exception(usage(fmt::format("cannot read {}", up->firmware)));
+    exit_code() = with_array(*o, [&](host::Array& a, const host::DiscoveryReport& r) { return job_upgrade(*o, image, ids, a, r); });
+  });
+
+  const auto raw = std::make_shared<RawArgs>();
+  auto* rw = fps.add_subcommand("raw", "send one command and print the reply");
+  rw->add_option("id", raw->id, "robot id")->required()->check(CLI::Range(1, 2047));
+  rw->add_option("command", raw->command, "command number or name (GET_STATUS, 3, ...)")->required();
+  rw->add_option("data", raw->data, "payload in hex, e.g. 0000803F");
+  rw->callback(on_array(o, raw, job_raw));
+}
+
 }  // namespace
 
 void add_fps_commands(CLI::App& app, GlobalOptions&) {
-  static FpsOptions o;
-  g_options = &o;
+  const auto o = std::make_shared<FpsOptions>();  // shared with every subcommand's callback
   auto* fps = app.add_subcommand("fps", "fiber positioners: discover, status, moves, trajectories, calibration, firmware");
   fps->require_subcommand(1);
   fps->fallthrough();  // bus options and --json may also follow the subcommand
-  fps->add_option("--config", o.config, "YAML bus selection: gateway, channels, socketcand, channel, buses, timeout_ms")
-      ->check(CLI::ExistingFile);
-  fps->add_option("--gateway", o.gateway, "CAN@net NT gateway (or `axon sim fps`) at HOST[:PORT]");
-  fps->add_option("--channels", o.channels, "gateway channels, e.g. 1,2,3,4 (default 1)")->delimiter(',')->check(CLI::Range(1, 4));
-  fps->add_option("--socketcand", o.socketcand, "socketcand server at HOST[:PORT]");
-  fps->add_option("--channel", o.scd_channels, "socketcand channel (repeatable; default can0)");
-  fps->add_option("--bus", o.buses, "any bus spec (repeatable): cannet://HOST/N, socketcand://HOST/CH, socketcan:IF");
-  fps->add_flag("--json", o.json, "machine-readable output");
-  fps->add_flag("--no-color", o.no_color, "no colours in the status table (colours only on a terminal anyway)");
-  fps->add_option("--timeout", o.timeout_s, "seconds to wait for each reply (default 1)")->check(non_negative());
-
-  fps->add_subcommand("discover", "robots per bus and their firmware")->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_discover(o, a, r); });
+  add_bus_options(*fps, *o);
+  add_read_commands(*fps, o);
+  add_motion_commands(*fps, o);
+  add_robot_commands(*fps, o);
+  add_fps_plan_commands(*fps, [o](const FpsArrayJob& job, bool moves) {
+    return with_array(*o, [&job](host::Array& a, const host::DiscoveryReport&) { return job(a); }, moves);
   });
-  fps->add_subcommand("status", "status table: state, flags, position")->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_status(o, a, r); });
-  });
-
-  static std::vector<std::string> position_ids;
-  auto* pos = fps->add_subcommand("position", "arm angles of the listed robots (default all)");
-  pos->add_option("ids", position_ids, "robot ids: 3, 1-6, 1,4,9");
-  pos->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_position(o, position_ids, a, r); });
-  });
-
-  static GotoArgs go;
-  auto* g = fps->add_subcommand("goto", "move one robot's arms (degrees) and wait");
-  g->add_option("id", go.id, "robot id")->required()->check(CLI::Range(1, 2047));
-  g->add_option("alpha", go.alpha, "alpha angle, degrees")->required();
-  g->add_option("beta", go.beta, "beta angle, degrees")->required();
-  g->add_flag("--relative", go.relative, "move by ALPHA and BETA instead of to them");
-  g->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_goto(o, go, a, r); }, true);
-  });
-
-  static std::string trajectory_file;
-  static bool load_only = false;
-  auto* m = fps->add_subcommand("move", "run trajectories from a file on several robots at once");
-  m->add_option("-t,--trajectory", trajectory_file, "YAML/JSON: {ID: {alpha: [[deg, s], ...], beta: [...]}}")->required();
-  m->add_flag("--load-only", load_only, "upload and validate, do not start");
-  m->callback([] {
-    const auto trajectories = load_trajectories(trajectory_file);
-    exit_code() = with_array(o, [&](host::Array& a, const host::DiscoveryReport& r) { return job_move(o, trajectories, load_only, a, r); }, true);
-  });
-
-  static bool clear_flags = false;
-  auto* s = fps->add_subcommand("stop", "stop every robot on every bus (TRAJECTORY_ABORT broadcast)");
-  s->add_flag("--clear-flags", clear_flags, "send STOP_TRAJECTORY instead, which also clears collision flags");
-  s->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_stop(o, clear_flags, a, r); });
-  });
-  fps->add_subcommand("unlock", "clear collision flags on every bus (STOP_TRAJECTORY) and report who answered")->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_unlock(o, a, r); });
-  });
-
-  static CalibrateArgs cal;
-  auto* c = fps->add_subcommand("calibrate", "calibration sequence (default: motors, datums, save)");
-  c->add_option("id", cal.id, "robot id")->required()->check(CLI::Range(1, 2047));
-  c->add_flag("--motor", cal.motor, "calibrate the motors");
-  c->add_flag("--datum", cal.datum, "calibrate the datums");
-  c->add_flag("--cogging", cal.cogging, "calibrate cogging (long: up to 40 min)");
-  c->add_flag("--save", cal.save, "save the calibration to flash");
-  c->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_calibrate(o, cal, a, r); }, true);
-  });
-
-  static std::uint16_t datum_id = 0;
-  auto* d = fps->add_subcommand("datum", "datum search: both arms into their hard stops");
-  d->add_option("id", datum_id, "robot id")->required()->check(CLI::Range(1, 2047));
-  d->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_datum(o, datum_id, a, r); }, true);
-  });
-
-  static std::string firmware_file;
-  static std::vector<std::string> upgrade_ids;
-  auto* u = fps->add_subcommand("upgrade", "firmware upgrade of robots running their bootloader");
-  u->add_option("--firmware", firmware_file, "firmware image file")->required()->check(CLI::ExistingFile);
-  u->add_option("ids", upgrade_ids, "robot ids: 3, 1-6, 1,4,9")->required();
-  u->callback([] {
-    const auto ids = need(parse_id_lists(upgrade_ids));
-    std::ifstream in(firmware_file, std::ios::binary);
-    const std::vector<std::uint8_t> image((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (!in.good() && !in.eof()) throw Exception(usage(fmt::format("cannot read {}", firmware_file)));
-    exit_code() = with_array(o, [&](host::Array& a, const host::DiscoveryReport& r) { return job_upgrade(o, image, ids, a, r); });
-  });
-
-  static RawArgs raw;
-  auto* rw = fps->add_subcommand("raw", "send one command and print the reply");
-  rw->add_option("id", raw.id, "robot id")->required()->check(CLI::Range(1, 2047));
-  rw->add_option("command", raw.command, "command number or name (GET_STATUS, 3, ...)")->required();
-  rw->add_option("data", raw.data, "payload in hex, e.g. 0000803F");
-  rw->callback([] {
-    exit_code() = with_array(o, [](host::Array& a, const host::DiscoveryReport& r) { return job_raw(o, raw, a, r); });
-  });
-}
-
-int with_fps_array(const FpsArrayJob& job, bool moves) {
-  return with_array(*g_options, [&job](host::Array& a, const host::DiscoveryReport&) { return job(a); }, moves);
 }
 
 }  // namespace axon::app

@@ -4,6 +4,7 @@
 
 #include "axon/fps/host/array.hpp"
 
+#include <CLI/CLI.hpp>
 #include <boost/asio/awaitable.hpp>
 
 #include <functional>
@@ -13,6 +14,10 @@ namespace axon::app {
 using FpsArrayJob = std::function<boost::asio::awaitable<int>(fps::host::Array&)>;
 // Opens the buses, discovers, runs `job`, closes; returns the job's exit code. With `moves`, SIGINT,
 // SIGTERM and SIGHUP stop every robot (fps_stop.hpp).
-int with_fps_array(const FpsArrayJob& job, bool moves = false);
+using FpsArrayRunner = std::function<int(const FpsArrayJob& job, bool moves)>;
+
+// `fps plan`, `fps plot`, `fps goto-all` (fps_plan.cpp), under the `fps` group, whose options
+// `with_array` uses (add_fps_commands calls this).
+void add_fps_plan_commands(CLI::App& fps_cmd, FpsArrayRunner with_array);
 
 }  // namespace axon::app

@@ -206,7 +206,8 @@ int check(const LayoutArgs& a, CLI::App& fps_cmd) {
 
 void add_fps_layout_commands(CLI::App& app, GlobalOptions&) {
   CLI::App* fps_cmd = app.get_subcommand("fps");
-  static LayoutArgs a;
+  const auto args = std::make_shared<LayoutArgs>();  // shared with the callbacks
+  auto& a = *args;
   auto* layout = fps_cmd->add_subcommand("layout", "focal-plane layout files: generate, show, check against the buses");
   layout->require_subcommand(1);
   auto* gen = layout->add_subcommand("generate", "write the default layout (500 robots, 6 sextants, 24 buses)");
@@ -215,13 +216,13 @@ void add_fps_layout_commands(CLI::App& app, GlobalOptions&) {
   gen->add_option("--name", a.generator.name, "layout name (default 'default')");
   gen->add_option("--fiducials-per-sextant", a.generator.fiducials_per_sextant, "fiducials per sextant (default 10, plus the centre)");
   gen->add_option("--gateway-address", a.generator.gateway_address, "gateway address pattern, {} = sextant");
-  gen->callback([] { exit_code() = generate(a); });
+  gen->callback([args] { exit_code() = generate(*args); });
   auto* sh = layout->add_subcommand("show", "summary: robots per sextant, gateway and bus; fibres; neighbours");
   sh->add_option("file", a.file, "layout YAML")->required();
   sh->add_flag("--json", a.json, "machine-readable output");
-  sh->callback([fps_cmd] {
-    a.json = a.json || fps_cmd->get_option("--json")->as<bool>();
-    exit_code() = show(a);
+  sh->callback([fps_cmd, args] {
+    args->json = args->json || fps_cmd->get_option("--json")->as<bool>();
+    exit_code() = show(*args);
   });
   auto* ck = layout->add_subcommand(
       "check", "GET_ID broadcast on every bus of the layout; report missing, unexpected, wrong-bus robots (exit 1 if any)");
@@ -229,9 +230,9 @@ void add_fps_layout_commands(CLI::App& app, GlobalOptions&) {
   ck->add_option("--as-gateway", a.as_gateway, "the layout gateway that `axon fps --gateway` is (default: the only one)");
   ck->add_option("--window", a.window_s, "seconds each broadcast collects replies (default 0.5)");
   ck->add_flag("--json", a.json, "machine-readable output");
-  ck->callback([fps_cmd] {
-    a.json = a.json || fps_cmd->get_option("--json")->as<bool>();
-    exit_code() = check(a, *fps_cmd);
+  ck->callback([fps_cmd, args] {
+    args->json = args->json || fps_cmd->get_option("--json")->as<bool>();
+    exit_code() = check(*args, *fps_cmd);
   });
 }
 

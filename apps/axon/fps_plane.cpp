@@ -7,6 +7,7 @@
 #include "axon/fps/host/cold_control.hpp"
 #include "axon/fps/host/plane_correct.hpp"
 #include "axon/fps/host/plane_upgrade.hpp"
+#include "axon/fps/host/trajectory_build.hpp"
 #include "axon/fps/host/trajectory_speed.hpp"
 #include "checks.hpp"
 #include "fps_json.hpp"
@@ -31,6 +32,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <memory>
 
 namespace axon::app {
 namespace {
@@ -168,34 +170,19 @@ int plane_status(const host::FocalPlaneArray& fpa, const host::DiscoveryReport& 
   return rc;
 }
 
-// Every known robot from where it is straight to (alpha, beta) over `points` points per arm.
-std::map<std::uint16_t, protocol::Trajectory> straight_moves(const host::StatusTable& table, const PlaneArgs& a,
-                                                             double duration_s,
-                                                             std::map<std::uint16_t, host::ArmAngles>& starts) {
-  std::map<std::uint16_t, protocol::Trajectory> t;
-  for (const auto& row : table.rows) {
-    if (!row.position) {
-      std::fprintf(stderr, "positioner %u: no position (%s); left out\n", unsigned{row.id}, row.error.c_str());
-      continue;
-    }
-    starts[row.id] = *row.position;
-    std::vector<protocol::ArmPoint> al, be;
-    for (int i = 1; i <= a.points; ++i) {
-      const double f = static_cast<double>(i) / a.points;
-      al.push_back({row.position->alpha + (a.alpha - row.position->alpha) * f, duration_s * f});
-      be.push_back({row.position->beta + (a.beta - row.position->beta) * f, duration_s * f});
-    }
-    t.emplace(row.id, need(protocol::Trajectory::from_physical(al, be)));
-  }
-  return t;
+// Every known robot from where it is straight to (alpha, beta); robots without a position are told on stderr.
+host::StraightMoves straight_moves(const host::StatusTable& table, const PlaneArgs& a, double duration_s) {
+  auto moves = need(host::straight_moves(table, {a.alpha, a.beta}, a.points, duration_s));
+  for (const auto& line : moves.left_out) std::fprintf(stderr, "%s; left out\n", line.c_str());
+  return moves;
 }
 
 // The duration to use: --duration when every robot can make it, the slowest robot's with
 // --fit-duration; otherwise a usage error that says what would do.
 double move_duration(const host::StatusTable& table, const PlaneArgs& a, const fps::plan::SpeedLimits& limits) {
-  std::map<std::uint16_t, host::ArmAngles> starts;
-  const auto moves = straight_moves(table, a, a.duration_s, starts);
-  const auto slowest = host::slowest_robot(moves, starts, limits);
+  const auto straight = straight_moves(table, a, a.duration_s);
+  const auto& moves = straight.trajectories;
+  const auto slowest = host::slowest_robot(moves, straight.starts, limits);
   if (!slowest || slowest->too_fast == 0) return a.duration_s;
   const double needed = host::feasible_duration_s(slowest->needed_s);
   const auto what = fmt::format("{} of {} robots cannot make {:g} s at {:g} deg/s (alpha) and {:g} deg/s (beta): the "
@@ -235,8 +222,7 @@ asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) 
   const auto limits = fps::plan::SpeedLimits::from_motor(a.max_rpm, a.gear_ratio);
   const auto table = co_await fpa.array().status_table(true);
   const double duration_s = move_duration(table, a, limits);
-  std::map<std::uint16_t, host::ArmAngles> starts;
-  auto t = straight_moves(table, a, duration_s, starts);
+  auto t = straight_moves(table, a, duration_s).trajectories;
   if (t.empty()) throw Exception(Error(host::HostErrc::not_ready, "no robot reported its position: nothing to move"));
   host::TrajectoryOptions to;
   to.speed_limits = limits;
@@ -409,20 +395,21 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
 
 void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   CLI::App* fps_cmd = app.get_subcommand("fps");
-  static PlaneArgs a;
+  const auto args = std::make_shared<PlaneArgs>();  // shared with the callbacks
+  auto& a = *args;
   auto* p = fps_cmd->add_subcommand("plane", "the whole focal plane of a layout: every gateway and bus, and the PLC");
   p->require_subcommand(1);
   p->add_option("--layout", a.layout, "layout: default, benchtop or FILE (gateway addresses from it)")->required();
   p->add_option("--plc", a.plc, "the PLC at HOST[:PORT] (needed for --sync)");
   p->add_flag("--json", a.json, "check, status, move: one JSON document on stdout and nothing else");
   p->fallthrough();  // --json may also follow the action
-  p->add_subcommand("check", "GET_ID on every bus at once, compared with the layout")->callback([] {
-    exit_code() = run_plane(a, "check");
+  p->add_subcommand("check", "GET_ID on every bus at once, compared with the layout")->callback([args] {
+    exit_code() = run_plane(*args, "check");
   });
   auto* ck = p->get_subcommand("check");
   ck->add_option("--window", a.window_s, "seconds to collect GET_ID answers (default 0.5)")->check(positive());
-  p->add_subcommand("status", "discovery: firmware and status of every robot")->callback([] {
-    exit_code() = run_plane(a, "status");
+  p->add_subcommand("status", "discovery: firmware and status of every robot")->callback([args] {
+    exit_code() = run_plane(*args, "status");
   });
   auto* mv = p->add_subcommand("move", "every robot straight to one (alpha, beta) by a trajectory, all at once");
   mv->add_option("--alpha", a.alpha, "degrees (default 0)");
@@ -435,7 +422,7 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   mv->add_option("--gear-ratio", a.gear_ratio, "motor turns per arm turn (default 1000)")->check(positive());
   mv->add_option("--points", a.points, "points per arm (default 20)")->check(CLI::Range(1, 1000));
   mv->add_flag("--sync", a.sync, "start with the PLC's sync line instead of the START_TRAJECTORY broadcast");
-  mv->callback([] { exit_code() = run_plane(a, "move"); });
+  mv->callback([args] { exit_code() = run_plane(*args, "move"); });
   auto* up = p->add_subcommand("upgrade",
                                "firmware of every robot, sextant by sextant: power-cycled into the bootloader by the PLC, "
                                "upgraded (one retry), powered back, version checked (needs --plc)");
@@ -451,9 +438,9 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   cd->add_flag("--watch", a.watch, "keep going: read every --period, send only when the decision changes");
   cd->add_option("--period", a.period_s, "seconds between readings with --watch (default 60)")->check(CLI::Range(0.05, 86400.0));
   cd->add_option("--for", a.for_s, "with --watch: stop after this many seconds (default: at a signal)")->check(non_negative());
-  cd->callback([] {
-    if (a.plc.empty()) throw Exception(usage("fps plane cold needs --plc"));
-    exit_code() = run_plane(a, "cold");
+  cd->callback([args] {
+    if (args->plc.empty()) throw Exception(usage("fps plane cold needs --plc"));
+    exit_code() = run_plane(*args, "cold");
   });
   auto* cr = p->add_subcommand("correct",
                                "correction iterations: robots whose measured fibre is outside tolerance get a correction "
@@ -468,10 +455,10 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   cr->add_option("--iterations", a.iterations, "most rounds that send corrections (default 3)")->check(CLI::Range(1, 100));
   cr->add_option("--wait", a.wait_s, "seconds to wait for each later --measured file to appear (default 600)")
       ->check(CLI::Range(0.0, 86400.0));
-  cr->callback([] { exit_code() = run_plane(a, "correct"); });
-  up->callback([] {
-    if (a.plc.empty()) throw Exception(usage("fps plane upgrade needs --plc"));
-    exit_code() = run_plane(a, "upgrade");
+  cr->callback([args] { exit_code() = run_plane(*args, "correct"); });
+  up->callback([args] {
+    if (args->plc.empty()) throw Exception(usage("fps plane upgrade needs --plc"));
+    exit_code() = run_plane(*args, "upgrade");
   });
 }
 

@@ -43,7 +43,6 @@ int main(int argc, char** argv) {
   add_c4g_commands(app, global);
   add_fps_layout_commands(app, global);
   add_fps_plc_commands(app, global);
-  add_fps_plan_commands(app, global);
   add_sim_plc_command(app, global);
   add_blmc_commands(app, global);
   add_fps_plane_commands(app, global);

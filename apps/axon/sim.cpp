@@ -9,6 +9,7 @@
 #include "checks.hpp"
 #include "commands.hpp"
 #include "axon/core/config.hpp"
+#include "axon/fps/layout/layout_file.hpp"
 #include "axon/fps/sim/focal_plane_sim.hpp"
 #include "axon/fps/sim/simulator_config.hpp"
 #include "id_list.hpp"
@@ -91,16 +92,6 @@ sim::SimulatorConfig build_config(const SimFpsOptions& o) {
   return config;
 }
 
-// The layout with each gateway's address replaced by where its emulator listens.
-fps::FocalPlane with_addresses(const fps::FocalPlane& plane, const std::vector<sim::GatewayInfo>& gateways) {
-  auto spec = plane.spec();
-  for (auto& g : spec.gateways) {
-    for (const auto& info : gateways)
-      if (info.id == g.id) g.address = info.endpoint.to_string();
-  }
-  return need(fps::FocalPlane::build(std::move(spec)));
-}
-
 // `axon sim fps --layout ...`: every robot of a layout behind one CAN@net emulator per gateway,
 // plus the PLC emulator whose relays act on them.
 int run_sim_layout(const SimFpsOptions& o) {
@@ -136,7 +127,9 @@ int run_sim_layout(const SimFpsOptions& o) {
     if (auto* p = fp->plc()) std::printf("listening plc %s\n", p->endpoint().to_string().c_str());
     if (!o.write_layout.empty()) {
       std::ofstream out(o.write_layout);
-      out << fps::to_yaml(with_addresses(plane, fp->gateways()));
+      std::map<std::uint16_t, std::string> addresses;
+      for (const auto& g : fp->gateways()) addresses[g.id] = g.endpoint.to_string();
+      out << fps::to_yaml(need(fps::with_gateway_addresses(plane, addresses)));
       out.close();
       if (!out) throw Exception(Error(CoreErrc::io, fmt::format("cannot write '{}'", o.write_layout)));
       std::printf("wrote layout %s\n", o.write_layout.c_str());
@@ -225,7 +218,8 @@ int run_sim_fps(const SimFpsOptions& o) {
 void add_sim_commands(CLI::App& app, GlobalOptions&) {
   auto* sim_cmd = app.add_subcommand("sim", "device simulators served over CAN@net / socketcand");
   sim_cmd->require_subcommand(1);
-  static SimFpsOptions fps;
+  const auto fps_args = std::make_shared<SimFpsOptions>();  // shared with the callback
+  auto& fps = *fps_args;
   auto* f = sim_cmd->add_subcommand("fps", "simulated fiber positioners (calibrated, datums initialised, folded)");
   f->add_option("--robots", fps.robots, "robot ids: ranges and lists, e.g. 1-20 or 1,3,10-12 (default 1-20)");
   f->add_option("--config", fps.config, "simulator YAML (docs/fps-simulator.md) instead of --robots/--buses");
@@ -260,7 +254,7 @@ void add_sim_commands(CLI::App& app, GlobalOptions&) {
   f->get_option("--config")->excludes("--robots")->excludes("--buses");
   f->get_option("--port")->excludes("--base-port");
   f->get_option("--layout")->excludes("--robots")->excludes("--buses")->excludes("--config")->excludes("--gateway")->excludes("--socketcand");
-  f->callback([] { exit_code() = run_sim_fps(fps); });
+  f->callback([fps_args] { exit_code() = run_sim_fps(*fps_args); });
 
   add_sim_blmc_command(*sim_cmd);
   add_sim_c4g_command(*sim_cmd);

@@ -1,17 +1,28 @@
 // An io_context running on a thread of its own. The blocking APIs own one each (their event loop
 // runs there while the caller's thread waits for results), and a simulator that shares a process
 // with its host runs on one so each side's loop carries only its own work, as on two machines.
-// Whatever lives on the loop is touched through call() only.
+// Whatever lives on the loop is touched through call() and run() only, never from the loop's own
+// thread (both would wait for themselves).
 #pragma once
 
 #include <utility>  // before Asio (Boost 1.74's awaitable.hpp uses std::exchange)
 
+#include "axon/core/error.hpp"
+
+#include <boost/asio/awaitable.hpp>
+#include <boost/asio/co_spawn.hpp>
 #include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
 
+#include <chrono>
+#include <exception>
+#include <fmt/format.h>
+#include <functional>
 #include <future>
+#include <memory>
 #include <thread>
+#include <type_traits>
 
 namespace axon::core {
 
@@ -31,6 +42,35 @@ class LoopThread {
     auto result = task.get_future();
     boost::asio::post(io_, [&task] { task(); });
     return result.get();
+  }
+
+  // Runs the coroutine that make() returns on the loop and waits for its result (its exception is
+  // rethrown here). When it has not ended after `timeout`, on_timeout() runs on the loop: it must
+  // make the coroutine end soon (stop the devices, cancel, close), because run() then waits for
+  // that end before it throws axon::Exception (CoreErrc::timeout): the coroutine may refer to
+  // what the caller holds, so it never outlives the call.
+  template <class F>
+  auto run(F make, std::chrono::steady_clock::duration timeout, std::function<void()> on_timeout = {}) ->
+      typename std::invoke_result_t<F&>::value_type {
+    using T = typename std::invoke_result_t<F&>::value_type;
+    auto done = std::make_shared<std::promise<T>>();
+    auto result = done->get_future();
+    if constexpr (std::is_void_v<T>) {
+      boost::asio::co_spawn(io_, std::move(make), [done](std::exception_ptr e) {
+        if (e) done->set_exception(e);
+        else done->set_value();
+      });
+    } else {
+      boost::asio::co_spawn(io_, std::move(make), [done](std::exception_ptr e, T value) {
+        if (e) done->set_exception(e);
+        else done->set_value(std::move(value));
+      });
+    }
+    if (result.wait_for(timeout) == std::future_status::ready) return result.get();
+    if (on_timeout) boost::asio::post(io_, std::move(on_timeout));
+    result.wait();
+    throw Exception(Error(CoreErrc::timeout, fmt::format("not done after {:.3g} s",
+                                                         std::chrono::duration<double>(timeout).count())));
   }
 
   // Ends the loop (what is still queued is dropped) and joins the thread. Idempotent.

@@ -1,6 +1,7 @@
 #include "axon/fps/plan/targets.hpp"
 
 #include "axon/core/header_table.hpp"
+#include "axon/fps/plan/error.hpp"
 #include "axon/core/text.hpp"
 
 #include "axon/core/config.hpp"
@@ -335,6 +336,16 @@ TargetValidation validate_targets(const CollisionModel& model, std::span<const T
     if (!changed) break;
   }
   return v;
+}
+
+Result<std::vector<Pose>> target_poses(const CollisionModel& model, std::span<const Target> targets, TargetPolicy policy,
+                                       std::string* notes) {
+  ValidationOptions vo;
+  vo.policy = policy;
+  const auto v = validate_targets(model, targets, vo);
+  if (!v.errors.empty() || (!v.ok() && policy == TargetPolicy::reject)) return Error(PlanErrc::bad_target_file, v.summary());
+  if (notes) *notes = v.summary();
+  return v.poses();
 }
 
 }  // namespace axon::fps::plan

@@ -68,4 +68,11 @@ struct TargetValidation {
 TargetValidation validate_targets(const CollisionModel& model, std::span<const Target> targets,
                                   const ValidationOptions& options = {});
 
+// The poses of validated targets, in model order: what a planner takes. Errors
+// (PlanErrc::bad_target_file, the validation summary as detail): unknown robots or duplicates, and
+// under TargetPolicy::reject any bad target. `notes`, when given, receives what parking resolved
+// (empty when nothing).
+Result<std::vector<Pose>> target_poses(const CollisionModel& model, std::span<const Target> targets, TargetPolicy policy,
+                                       std::string* notes = nullptr);
+
 }  // namespace axon::fps::plan

@@ -1,0 +1,323 @@
+#include "axon/fps/host/client.hpp"
+
+#include "axon/can/open.hpp"
+#include "axon/core/loop_thread.hpp"
+#include "axon/fps/host/array.hpp"
+#include "axon/fps/host/focal_plane_array.hpp"
+#include "axon/fps/host/plan_and_move.hpp"
+#include "axon/fps/plan/layout_model.hpp"
+#include "axon/fps/plan/targets.hpp"
+#include "axon/net/endpoint.hpp"
+
+#include <boost/asio/this_coro.hpp>
+#include <fmt/format.h>
+
+namespace axon::fps {
+
+namespace asio = boost::asio;
+
+namespace {
+
+using Seconds = std::chrono::duration<double>;
+core::Duration duration_of(double s) { return std::chrono::duration_cast<core::Duration>(Seconds(s)); }
+
+template <class T>
+T need(Result<T>&& r) {
+  if (!r) throw Exception(r.error());
+  if constexpr (!std::is_void_v<T>) return std::move(r).value();
+}
+
+Angles angles(const host::ArmAngles& a) { return {a.alpha, a.beta}; }
+std::optional<Angles> angles(const std::optional<host::ArmAngles>& a) {
+  return a ? std::optional<Angles>(angles(*a)) : std::nullopt;
+}
+
+std::vector<RobotStatus> rows_of(const host::StatusTable& table) {
+  std::vector<RobotStatus> out;
+  for (const auto& r : table.rows) {
+    RobotStatus s{r.id, r.bus_name, r.state(), r.ready(), r.firmware ? r.firmware->to_string() : std::string(), {},
+                  angles(r.position), r.error};
+    if (r.status) s.flags = r.status->names();
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+MoveOutcome outcome_of(const host::TrajectoryReport& report) {
+  MoveOutcome out{report.completed, report.summary(), {}};
+  for (const auto& r : report.robots)
+    out.robots.push_back({r.id, r.state == host::RobotState::completed, host::to_string(r.state), angles(r.target),
+                          angles(r.reached), r.detail});
+  return out;
+}
+
+MoveOutcome outcome_of(const std::map<std::uint16_t, host::ArmAngles>& targets, const host::Array::MoveResults& results) {
+  MoveOutcome out{true, {}, {}};
+  for (const auto& [id, r] : results) {
+    RobotMove m{id, r.has_value(), r ? "completed" : "failed", angles(targets.at(id)), std::nullopt, {}};
+    if (r) m.reached = angles(r.value().reached);
+    else m.detail = r.error().message();
+    if (!m.ok) out.summary += fmt::format("robot {}: {}\n", id, m.detail);
+    out.completed = out.completed && m.ok;
+    out.robots.push_back(std::move(m));
+  }
+  return out;
+}
+
+PlanOutcome plan_outcome(const plan::CollisionModel& model, const plan::Plan& p, std::string notes) {
+  PlanOutcome out{p.verified, model.size(), p.not_reached, p.stats.duration_s, p.stats.plan_s, p.check.min_clearance_mm,
+                  {}, std::move(notes)};
+  for (std::size_t i = 0; i < model.size() && i < p.robots.size(); ++i)
+    out.ends[static_cast<std::uint16_t>(model.robot(i).id())] = {p.robots[i].end.alpha_deg, p.robots[i].end.beta_deg};
+  out.notes += p.summary(model);
+  return out;
+}
+
+}  // namespace
+
+const RobotMove* MoveOutcome::find(std::uint16_t id) const noexcept {
+  for (const auto& r : robots)
+    if (r.id == id) return &r;
+  return nullptr;
+}
+
+struct Client::Impl {
+  ClientConfig config;
+  core::LoopThread loop;  // first: it outlives what runs on it
+  std::vector<std::unique_ptr<can::Bus>> buses;
+  std::unique_ptr<host::Array> own_array;
+  std::unique_ptr<host::FocalPlaneArray> plane_array;
+  host::Array* array = nullptr;
+  std::optional<FocalPlane> layout;
+
+  // A blocking call: the coroutine on the loop, bounded by the call timeout (overrun: stop everyone).
+  template <class F>
+  auto run(F make) {
+    return loop.run(std::move(make), duration_of(config.call_timeout_s), [this] {
+      if (array) array->request_stop("a blocking call overran its timeout");
+    });
+  }
+
+  host::Array& open_array() const {
+    if (!array) throw Exception(Error(host::HostErrc::invalid_argument, "the client is not open: call open() first"));
+    return *array;
+  }
+
+  [[nodiscard]] host::ArrayOptions array_options() const {
+    host::ArrayOptions o;
+    o.client.timeout = duration_of(config.reply_timeout_s);
+    o.positioner.poll_interval = duration_of(config.poll_interval_s);
+    o.positioner.position_tolerance = config.position_tolerance_deg;
+    o.discover_window = duration_of(config.discover_window_s);
+    return o;
+  }
+
+  // On the loop: stop what moves, close the array and the buses.
+  asio::awaitable<void> shut() {
+    if (!array) co_return;
+    if (!array->moving().empty()) co_await array->emergency_stop("the client closed while robots moved");
+    if (plane_array) co_await plane_array->close();
+    else co_await array->close();
+    for (auto& b : buses) b->close();
+  }
+};
+
+Client::Client(ClientConfig config) : impl_(std::make_unique<Impl>()) { impl_->config = config; }
+
+Client::~Client() { close(); }
+
+void Client::close() noexcept {
+  if (!impl_ || !impl_->array) return;
+  auto* impl = impl_.get();
+  try {
+    impl->loop.run([impl] { return impl->shut(); }, std::chrono::seconds(10));
+  } catch (...) {  // a close that fails leaves nothing more to do than drop the handles
+  }
+  try {
+    impl->loop.call([impl] {
+      impl->plane_array.reset();
+      impl->own_array.reset();
+      impl->buses.clear();
+    });
+  } catch (...) {
+  }
+  impl->array = nullptr;
+}
+
+bool Client::is_open() const noexcept { return impl_->array != nullptr; }
+
+void Client::set_call_timeout(double seconds) {
+  if (!(seconds > 0)) throw Exception(Error(host::HostErrc::invalid_argument, fmt::format("call timeout {:g} s: must be > 0", seconds)));
+  impl_->config.call_timeout_s = seconds;
+}
+
+void Client::open(const std::vector<std::string>& bus_specs) {
+  close();
+  std::vector<can::BusSpec> specs;
+  for (const auto& text : bus_specs) specs.push_back(need(can::parse_bus_spec(text)));
+  if (specs.empty()) throw Exception(Error(host::HostErrc::invalid_argument, "open: no bus given"));
+  need(can::check_distinct(specs));
+  auto* impl = impl_.get();
+  impl->run([impl, specs]() -> asio::awaitable<void> {
+    auto opened = co_await can::open_buses(co_await asio::this_coro::executor, specs);
+    impl->buses = need(std::move(opened));
+    std::vector<can::Bus*> raw;
+    for (auto& b : impl->buses) raw.push_back(b.get());
+    impl->own_array = std::make_unique<host::Array>(raw, impl->array_options());
+    impl->array = impl->own_array.get();
+  });
+}
+
+void Client::open(const FocalPlane& plane, const std::map<std::uint16_t, std::string>& gateway_addresses) {
+  close();
+  host::FocalPlaneArrayOptions o;
+  o.array = impl_->array_options();
+  for (const auto& [id, text] : gateway_addresses) o.addresses[id] = need(net::parse_endpoint(text, can::kCanNetPort));
+  auto* impl = impl_.get();
+  impl->run([impl, plane, o]() -> asio::awaitable<void> {
+    auto connected = co_await host::FocalPlaneArray::connect(co_await asio::this_coro::executor, plane, o);
+    impl->plane_array = need(std::move(connected));
+    impl->array = &impl->plane_array->array();
+  });
+  impl->layout = plane;
+}
+
+void Client::set_layout(const FocalPlane& plane) { impl_->layout = plane; }
+
+std::vector<RobotStatus> Client::discover() {
+  auto* impl = impl_.get();
+  impl->open_array();
+  return impl->run([impl]() -> asio::awaitable<std::vector<RobotStatus>> {
+    Result<host::DiscoveryReport> r = Error(host::HostErrc::cancelled);
+    if (impl->plane_array) r = co_await impl->plane_array->discover();
+    else r = co_await impl->array->discover();
+    co_return rows_of(need(std::move(r)).table);
+  });
+}
+
+std::vector<RobotStatus> Client::status() {
+  auto& array = impl_->open_array();
+  return impl_->run([&array]() -> asio::awaitable<std::vector<RobotStatus>> {
+    const auto table = co_await array.status_table(true);
+    co_return rows_of(table);
+  });
+}
+
+std::vector<std::uint16_t> Client::robots() const {
+  auto& array = impl_->open_array();
+  return impl_->loop.call([&array] { return array.ids(); });
+}
+
+MoveOutcome Client::goto_absolute(const std::map<std::uint16_t, Angles>& targets) {
+  auto& array = impl_->open_array();
+  std::map<std::uint16_t, host::ArmAngles> t;
+  for (const auto& [id, a] : targets) t[id] = {a.alpha, a.beta};
+  return impl_->run([&array, t]() -> asio::awaitable<MoveOutcome> {
+    auto r = co_await array.goto_absolute(t);
+    co_return outcome_of(t, need(std::move(r)));
+  });
+}
+
+MoveOutcome Client::run_trajectories(const std::map<std::uint16_t, ArmPath>& paths) {
+  auto& array = impl_->open_array();
+  host::Trajectories uploads;
+  for (const auto& [id, path] : paths) {
+    std::vector<protocol::ArmPoint> alpha, beta;
+    for (const auto& [deg, s] : path.alpha) alpha.push_back({deg, s});
+    for (const auto& [deg, s] : path.beta) beta.push_back({deg, s});
+    auto t = protocol::Trajectory::from_physical(alpha, beta);
+    if (!t) throw Exception(Error(t.error().code, fmt::format("robot {}: {}", id, t.error().detail)));
+    uploads.emplace(id, std::move(t).value());
+  }
+  return impl_->run([&array, uploads]() -> asio::awaitable<MoveOutcome> {
+    auto r = co_await array.run_trajectories(uploads);
+    co_return outcome_of(need(std::move(r)));
+  });
+}
+
+namespace {
+
+PlanAndMoveOutcome plan_and_move_on(Client::Impl& impl, const std::vector<plan::Target>& targets, const PlanSettings& s);
+
+}  // namespace
+
+PlanAndMoveOutcome Client::plan_and_move(const std::map<std::uint16_t, Angles>& targets, const PlanSettings& settings) {
+  std::vector<plan::Target> t;
+  for (const auto& [id, a] : targets) {
+    plan::Target target;
+    target.robot = id;
+    target.pose = plan::Pose{a.alpha, a.beta};
+    t.push_back(std::move(target));
+  }
+  return plan_and_move_on(*impl_, t, settings);
+}
+
+PlanAndMoveOutcome Client::plan_and_move(const std::string& target_file, const PlanSettings& settings) {
+  return plan_and_move_on(*impl_, need(plan::load_targets(target_file)), settings);
+}
+
+namespace {
+
+PlanAndMoveOutcome plan_and_move_on(Client::Impl& impl, const std::vector<plan::Target>& targets, const PlanSettings& s) {
+  auto& array = impl.open_array();
+  if (!impl.layout)
+    throw Exception(Error(host::HostErrc::invalid_argument, "plan_and_move needs the layout: open(plane) or set_layout()"));
+  plan::LayoutModelOptions lo;
+  lo.buffer_mm = s.buffer_mm;
+  auto model = std::make_shared<plan::CollisionModel>(need(plan::model_from_layout(*impl.layout, lo)));
+  std::string notes;
+  auto poses = need(plan::target_poses(*model, targets, s.park_bad_targets ? plan::TargetPolicy::park : plan::TargetPolicy::reject,
+                                       &notes));
+  host::PlanAndMoveOptions o;
+  o.planner.speed = {s.speed_deg_s, s.speed_deg_s};
+  o.planner.seed = s.seed;
+  o.allow_partial = s.allow_partial;
+  const FocalPlane& plane = *impl.layout;
+  return impl.run([&array, &plane, model, poses, o, notes]() -> asio::awaitable<PlanAndMoveOutcome> {
+    auto r = co_await host::plan_and_move(array, plane, *model, poses, o);
+    const auto report = need(std::move(r));
+    PlanAndMoveOutcome out{plan_outcome(*model, report.plan, notes), report.run.has_value(), {}};
+    if (report.run) out.move = outcome_of(*report.run);
+    else out.move.completed = true;
+    co_return out;
+  });
+}
+
+}  // namespace
+
+StopOutcome Client::emergency_stop(const std::string& reason) {
+  auto& array = impl_->open_array();
+  return impl_->run([&array, reason]() -> asio::awaitable<StopOutcome> {
+    const auto rep = co_await array.emergency_stop(reason);
+    co_return StopOutcome{rep.reason, rep.robots_reached(), rep.buses_sent(), rep.buses.size(), rep.to_text()};
+  });
+}
+
+void Client::stop(bool clear_flags) {
+  auto& array = impl_->open_array();
+  impl_->run([&array, clear_flags]() -> asio::awaitable<void> {
+    auto r = co_await array.stop_all(clear_flags);
+    need(std::move(r));
+  });
+}
+
+UnlockOutcome Client::unlock() {
+  auto& array = impl_->open_array();
+  return impl_->run([&array]() -> asio::awaitable<UnlockOutcome> {
+    auto r = co_await array.unlock();
+    auto u = need(std::move(r));
+    co_return UnlockOutcome{u.acknowledged, u.silent};
+  });
+}
+
+bool Client::locked() const {
+  auto& array = impl_->open_array();
+  return impl_->loop.call([&array] { return array.locked(); });
+}
+
+std::string Client::lock_reason() const {
+  auto& array = impl_->open_array();
+  return impl_->loop.call([&array] { return array.locked() ? array.lock_state().reason : std::string(); });
+}
+
+}  // namespace axon::fps

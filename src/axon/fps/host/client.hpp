@@ -1,0 +1,180 @@
+// axon::fps::Client: the fiber positioners from a plain program, without Asio. Every call blocks
+// until it is done and returns plain values; the work runs on an event loop the client owns, on a
+// thread of its own (core::LoopThread), over the coroutine API (fps::host::Array,
+// FocalPlaneArray), which stays there for programs that want it.
+//
+//   axon::fps::Client fps;
+//   fps.open(axon::fps::resolve_layout("site.yaml").value());   // or open({"cannet://10.0.0.1/1", ...})
+//   for (const auto& r : fps.discover()) std::printf("%u %s\n", r.id, r.state.c_str());
+//   fps.plan_and_move({{12, {90, 150}}, {13, {200, 170}}});
+//
+// Errors: a call that cannot do its job throws axon::Exception, whose error() carries the code
+// (fps::host::HostErrc: locked, unknown_positioner, ...; fps::plan::PlanErrc for plans and targets;
+// can and net codes for the connection; CoreErrc::timeout) and a message. What happened to each
+// robot of a move that did run is in the returned outcome, not thrown.
+//
+// Timeouts: every reply has ClientConfig::reply_timeout_s; a whole call has call_timeout_s (a move
+// takes its trajectory's duration plus margins, so that bound is generous). A call that overruns it
+// stops every robot (as emergency_stop() does: TRAJECTORY_ABORT on every bus, the array locked),
+// waits for the call to end, then throws CoreErrc::timeout; unlock() lets the robots move again.
+//
+// Safety: the array locks on a collision report from any robot and aborts every robot on every
+// bus (Array); a locked client refuses moves (HostErrc::locked) until unlock(). The destructor (and
+// close()) stop robots this client set moving, close the connections and never throw.
+//
+// Threading: one thread at a time may call a client (calls are not queued against each other).
+#pragma once
+
+#include "axon/fps/layout/focal_plane.hpp"
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace axon::fps {
+
+struct Angles {
+  double alpha = 0;  // degrees
+  double beta = 0;
+};
+
+struct ClientConfig {
+  double reply_timeout_s = 1.0;    // each command's reply
+  double call_timeout_s = 600.0;   // each blocking call, start to end
+  double poll_interval_s = 0.25;   // status polling while robots move
+  double discover_window_s = 0.5;  // GET_ID answers collected by discovery
+  double position_tolerance_deg = 0.1;  // a move ends this close to its target, per arm
+};
+
+// One robot's row of status(): plain values.
+struct RobotStatus {
+  std::uint16_t id = 0;
+  std::string bus;                  // bus name (cannet://HOST:PORT/N)
+  std::string state;                // ready, moving, collision, calibrating, no-datum, bootloader, no-reply
+  bool ready = false;
+  std::string firmware;             // "04.01.13", empty when unknown
+  std::vector<std::string> flags;   // status flags set
+  std::optional<Angles> position;   // application robots that answered
+  std::string error;                // why it did not answer
+};
+
+// One robot of a move.
+struct RobotMove {
+  std::uint16_t id = 0;
+  bool ok = false;                 // reached its target
+  std::string state;               // completed, collided, timeout, not_ready, ...
+  std::optional<Angles> target;
+  std::optional<Angles> reached;
+  std::string detail;              // why not, when not ok
+};
+
+struct MoveOutcome {
+  bool completed = false;          // every robot reached its target
+  std::string summary;             // one line per robot that did not
+  std::vector<RobotMove> robots;   // in id order
+  [[nodiscard]] const RobotMove* find(std::uint16_t id) const noexcept;
+};
+
+// A firmware trajectory as points in degrees and seconds after the start (the robot adds where it
+// stands as the first point); an arm without points stays.
+struct ArmPath {
+  std::vector<std::pair<double, double>> alpha;  // (degrees, seconds)
+  std::vector<std::pair<double, double>> beta;
+};
+
+struct PlanSettings {
+  double speed_deg_s = 12.0;     // both arms (2000 rpm at the motor, 1000:1)
+  double buffer_mm = 2.0;        // collision buffer of every robot
+  std::uint64_t seed = 1;        // the planner's nudges
+  bool park_bad_targets = true;  // false: a bad target fails the call instead of parking that robot
+  bool allow_partial = false;    // move the others when some robots cannot reach their targets
+};
+
+struct PlanOutcome {
+  bool verified = false;           // the independent checker found no contact
+  std::size_t robots = 0;
+  std::size_t not_reached = 0;     // parked or held
+  double move_s = 0;               // duration of the move
+  double plan_s = 0;               // planning wall time
+  double min_clearance_mm = 0;
+  std::map<std::uint16_t, Angles> ends;  // where the plan leaves each robot
+  std::string notes;               // targets parked, robots held (one line each)
+};
+
+struct PlanAndMoveOutcome {
+  PlanOutcome plan;
+  bool moved = false;              // false: every robot already stood at its end
+  MoveOutcome move;
+};
+
+struct StopOutcome {
+  std::string reason;
+  std::size_t robots_reached = 0;  // robots on the buses where the abort went out
+  std::size_t buses_sent = 0;
+  std::size_t buses = 0;
+  std::string text;                // StopReport::to_text()
+};
+
+struct UnlockOutcome {
+  std::vector<std::uint16_t> acknowledged;
+  std::vector<std::uint16_t> silent;
+};
+
+class Client {
+ public:
+  explicit Client(ClientConfig config = {});
+  ~Client();  // close(), never throws
+  Client(const Client&) = delete;
+  Client& operator=(const Client&) = delete;
+
+  // Opens buses by spec ("cannet://HOST:PORT/N", "socketcand://HOST:PORT/can0", "socketcan:can0").
+  // plan_and_move() then needs a layout (set_layout).
+  void open(const std::vector<std::string>& bus_specs);
+  // Opens every gateway of a layout (one CAN@net connection each, the channels its robots use),
+  // each at its layout address or, when given, at gateway_addresses[id] ("HOST:PORT").
+  void open(const FocalPlane& plane, const std::map<std::uint16_t, std::string>& gateway_addresses = {});
+  // The layout plan_and_move() plans on (set by open(plane)).
+  void set_layout(const FocalPlane& plane);
+  [[nodiscard]] bool is_open() const noexcept;
+  // The bound of each later blocking call (ClientConfig::call_timeout_s).
+  void set_call_timeout(double seconds);
+
+  // GET_ID on every bus, then firmware and status of every robot found.
+  std::vector<RobotStatus> discover();
+  // Firmware, status and position of every known robot (discover() first).
+  std::vector<RobotStatus> status();
+  [[nodiscard]] std::vector<std::uint16_t> robots() const;
+
+  // Moves the listed robots at once (GO_TO_ABSOLUTE_POSITION) and waits for them.
+  MoveOutcome goto_absolute(const std::map<std::uint16_t, Angles>& targets);
+  // Uploads, starts together (broadcast) and follows trajectories, by robot id.
+  MoveOutcome run_trajectories(const std::map<std::uint16_t, ArmPath>& paths);
+  // Plans collision-free moves from where every robot of the layout is to the targets (robots not
+  // listed: folded), then runs them (docs/fps-plan.md). Throws when the plan cannot be used.
+  PlanAndMoveOutcome plan_and_move(const std::map<std::uint16_t, Angles>& targets, const PlanSettings& settings = {});
+  // The same with a target file (YAML or CSV: robot, alpha/beta or x/y and fibre).
+  PlanAndMoveOutcome plan_and_move(const std::string& target_file, const PlanSettings& settings = {});
+
+  // Locks the array and aborts every robot on every bus; moves are refused until unlock().
+  StopOutcome emergency_stop(const std::string& reason = "emergency stop");
+  // TRAJECTORY_ABORT on every bus, without locking (with clear_flags: STOP_TRAJECTORY, which also
+  // clears collision flags).
+  void stop(bool clear_flags = false);
+  // STOP_TRAJECTORY on every bus (clears collision flags), then unlocks.
+  UnlockOutcome unlock();
+  [[nodiscard]] bool locked() const;
+  [[nodiscard]] std::string lock_reason() const;  // empty when not locked
+
+  // Stops what this client set moving, closes the connections. Idempotent, never throws.
+  void close() noexcept;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace axon::fps

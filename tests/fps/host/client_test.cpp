@@ -1,0 +1,166 @@
+// The blocking fps::Client against an in-process simulated plane (fps::sim::SimulatedPlane), over
+// the real CAN@net TCP transport on loopback: discovery, status, moves, plan-and-move, the
+// collision lock, stops and the call timeout.
+#include "axon/fps/host/client.hpp"
+#include "axon/fps/host/error.hpp"
+#include "axon/fps/plan/error.hpp"
+#include "axon/fps/sim/simulated_plane.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+namespace axon::fps {
+namespace {
+
+sim::SimulatedPlaneOptions fast_plane() {
+  sim::SimulatedPlaneOptions o;
+  o.time_scale = 20;
+  o.plc = false;
+  return o;
+}
+
+ClientConfig fast_client() {
+  ClientConfig c;
+  c.poll_interval_s = 0.02;
+  c.discover_window_s = 0.3;
+  c.call_timeout_s = 60;
+  return c;
+}
+
+double error_deg(const Angles& a, const Angles& b) { return std::max(std::abs(a.alpha - b.alpha), std::abs(a.beta - b.beta)); }
+
+class ClientOnPlane : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    fps.open(plane.plane());
+    robots = fps.discover();
+  }
+  sim::SimulatedPlane plane{"benchtop", fast_plane()};
+  Client fps{fast_client()};
+  std::vector<RobotStatus> robots;
+};
+
+TEST_F(ClientOnPlane, DiscoversEveryRobotOfTheLayoutReady) {
+  ASSERT_EQ(robots.size(), 6u);
+  for (const auto& r : robots) {
+    EXPECT_TRUE(r.ready) << r.id << ": " << r.state;
+    EXPECT_FALSE(r.firmware.empty());
+  }
+  const auto table = fps.status();
+  ASSERT_EQ(table.size(), 6u);
+  ASSERT_TRUE(table[0].position.has_value());
+  EXPECT_NEAR(table[0].position->beta, 180.0, 0.5);
+}
+
+TEST_F(ClientOnPlane, GotoAbsoluteLeavesTheArmsAtTheTarget) {
+  const auto out = fps.goto_absolute({{3, {30, 150}}});
+  ASSERT_TRUE(out.completed) << out.summary;
+  ASSERT_NE(out.find(3), nullptr);
+  EXPECT_LT(error_deg(*out.find(3)->reached, {30, 150}), 0.1);
+  EXPECT_LT(error_deg(*plane.arms(3), {30, 150}), 0.1);
+}
+
+TEST_F(ClientOnPlane, RunTrajectoriesMovesEveryRobotTogether) {
+  std::map<std::uint16_t, ArmPath> paths;
+  for (std::uint16_t id : {1, 2}) paths[id] = ArmPath{{{20, 2.0}, {40, 4.0}}, {{170, 4.0}}};
+  const auto out = fps.run_trajectories(paths);
+  ASSERT_TRUE(out.completed) << out.summary;
+  for (std::uint16_t id : {1, 2}) EXPECT_LT(error_deg(*plane.arms(id), {40, 170}), 0.1);
+}
+
+TEST_F(ClientOnPlane, PlanAndMoveTakesEveryRobotToItsTargetWithoutCollisions) {
+  std::map<std::uint16_t, Angles> targets;
+  for (std::uint16_t id = 1; id <= 6; ++id) targets[id] = {60.0 + 10.0 * id, 160};
+  const auto out = fps.plan_and_move(targets);
+  EXPECT_TRUE(out.plan.verified);
+  EXPECT_EQ(out.plan.not_reached, 0u) << out.plan.notes;
+  ASSERT_TRUE(out.moved);
+  ASSERT_TRUE(out.move.completed) << out.move.summary;
+  for (const auto& [id, target] : targets) EXPECT_LT(error_deg(*plane.arms(id), target), 0.1) << id;
+  EXPECT_EQ(plane.collisions(), 0u);
+}
+
+TEST_F(ClientOnPlane, ACollisionLocksTheClientUntilUnlock) {
+  plane.inject_collision(4);
+  for (int i = 0; i < 200 && !fps.locked(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_TRUE(fps.locked());
+  EXPECT_NE(fps.lock_reason().find("4"), std::string::npos) << fps.lock_reason();
+  try {
+    fps.goto_absolute({{1, {10, 170}}});
+    FAIL() << "a move went out while the array was locked";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), host::HostErrc::locked) << e.what();
+  }
+  const auto u = fps.unlock();
+  EXPECT_FALSE(fps.locked());
+  EXPECT_EQ(u.acknowledged.size(), 6u);
+  EXPECT_TRUE(fps.goto_absolute({{1, {10, 170}}}).completed);
+}
+
+TEST_F(ClientOnPlane, EmergencyStopLocksAndReachesEveryBus) {
+  const auto stop = fps.emergency_stop("test");
+  EXPECT_EQ(stop.buses_sent, stop.buses);
+  EXPECT_EQ(stop.robots_reached, 6u);
+  EXPECT_TRUE(fps.locked());
+  fps.unlock();
+  EXPECT_FALSE(fps.locked());
+}
+
+TEST_F(ClientOnPlane, BadTargetsAreRefusedWhenNotParked) {
+  PlanSettings s;
+  s.park_bad_targets = false;
+  try {
+    fps.plan_and_move({{1, {30, 150}}, {99, {0, 180}}}, s);
+    FAIL() << "a target for a robot the layout lacks was accepted";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), plan::PlanErrc::bad_target_file) << e.what();
+  }
+}
+
+TEST(Client, ACallThatOverrunsItsTimeoutStopsEveryRobotAndThrows) {
+  auto slow = fast_plane();
+  slow.time_scale = 2;  // the move takes seconds of wall time
+  sim::SimulatedPlane plane("benchtop", slow);
+  Client fps(fast_client());
+  fps.open(plane.bus_specs());
+  ASSERT_EQ(fps.discover().size(), 6u);
+  fps.set_call_timeout(0.3);
+  try {
+    fps.goto_absolute({{2, {180, 90}}});
+    FAIL() << "the move finished within 0.2 s";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), CoreErrc::timeout) << e.what();
+  }
+  EXPECT_TRUE(fps.locked());
+  EXPECT_GT(error_deg(*plane.arms(2), {180, 90}), 1.0);  // stopped on the way
+}
+
+TEST(Client, OpenedFromBusSpecsPlansOnceGivenTheLayout) {
+  sim::SimulatedPlane plane("benchtop", fast_plane());
+  Client fps(fast_client());
+  fps.open(plane.bus_specs());
+  ASSERT_EQ(fps.discover().size(), 6u);
+  try {
+    fps.plan_and_move({{1, {30, 150}}});
+    FAIL() << "planned without a layout";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), host::HostErrc::invalid_argument);
+  }
+  fps.set_layout(plane.plane());
+  const auto out = fps.plan_and_move({{1, {30, 150}}});
+  EXPECT_TRUE(out.move.completed) << out.move.summary;
+  EXPECT_LT(error_deg(*plane.arms(1), {30, 150}), 0.1);
+}
+
+TEST(Client, CallsBeforeOpenAreErrors) {
+  Client fps;
+  EXPECT_FALSE(fps.is_open());
+  EXPECT_THROW(fps.discover(), Exception);
+}
+
+}  // namespace
+}  // namespace axon::fps
