@@ -54,7 +54,7 @@ double SineExcitation::value(std::size_t j, double t) const noexcept {
   return amplitude_[j] * std::sin(2.0 * std::numbers::pi * frequency_[j] * t);
 }
 
-OpenModeApp::OpenModeApp(Style style) : style_(style), envelope_(style.ramp_s) {}
+OpenModeApp::OpenModeApp(Style style) : style_(std::move(style)), envelope_(style_.ramp_s) {}
 
 OpenModeApp::Gate OpenModeApp::gate_for(const protocol::Packet& request, std::size_t first, std::size_t count,
                                         std::int32_t mode) noexcept {

@@ -97,7 +97,7 @@ class OpenModeApp : public App {
   [[nodiscard]] std::string_view phase_text() const noexcept;
 
   struct Style {
-    std::string_view app;           // prefixes messages: "correct"
+    std::string app;                // prefixes messages: "correct"
     std::string_view waiting;       // status while waiting: "waiting for mode 7"
     std::string_view running;       // status while running: "correcting"
     std::string_view mode;          // the mode in messages: "7", "1/2"
