@@ -36,31 +36,41 @@ sim::SimulatedControllerOptions program(const apps::ServeSession& session, std::
   return o;
 }
 
+// The program that opens `mode` on arm 1, waits for the PC and ends the exchange.
+std::string open_mode_program(int mode) {
+  return "steps:\n  - drive_on\n  - go_open: {type: A, mode: " + std::to_string(mode) +
+         ", arms: [1]}\n  - wait_for_pc: {timeout: 10}\n  - delay: 0.2\n  - exit_open\n";
+}
+
+struct Served {
+  apps::ServeReport served;
+  sim::SimulatedControllerReport seen;
+};
+
+// Serves `app` to a simulated controller playing `yaml` until both ended; every packet the
+// controller sent was answered (though not necessarily in time on a loaded machine: no timing).
+Served serve_program(apps::App& app, std::string yaml) {
+  apps::ServeSession session(app, loopback());
+  session.start();
+  auto controller = sim::SimulatedController::start(program(session, std::move(yaml)));
+  Served r{session.run(), controller.wait()};
+  EXPECT_EQ(r.seen.outcome, sim::SimulatedControllerReport::Outcome::completed) << r.seen.outcome_text;
+  EXPECT_EQ(r.seen.exit_code(), 0);
+  EXPECT_EQ(r.served.stats.packets, r.seen.stats.packets_sent);
+  EXPECT_TRUE(r.served.finished) << r.served.text();
+  EXPECT_EQ(r.served.stats.safety_fault, "none");
+  return r;
+}
+
 TEST(SimulatedController, PlaysAMode4TrajectoryAgainstAServeSession) {
   apps::StreamOptions so;
   so.trajectory = std::make_shared<apps::Trajectory>(
       apps::Trajectory::from_rows({0.0, 0.5}, {{0, 0, 0, 0, 0, 0}, {3 * kDeg, -2 * kDeg, 0, 0, 0, 0}}).value());
   so.relative = true;
   apps::StreamApp app(so);
-  apps::ServeSession session(app, loopback());
-  session.start();
-  auto controller = sim::SimulatedController::start(program(session, R"(steps:
-  - drive_on
-  - go_open: {type: A, mode: 4, arms: [1]}
-  - wait_for_pc: {timeout: 5}
-  - delay: 0.2
-  - exit_open)"));
-  const auto served = session.run();
-  const auto seen = controller.wait();
-
-  // Every packet answered, though not necessarily in time on a loaded machine: no timing here.
-  EXPECT_EQ(seen.outcome, sim::SimulatedControllerReport::Outcome::completed) << seen.outcome_text;
-  EXPECT_EQ(seen.exit_code(), 0);
-  EXPECT_EQ(served.stats.packets, seen.stats.packets_sent);
-  EXPECT_TRUE(served.finished) << served.text();
+  const auto [served, seen] = serve_program(app, open_mode_program(4));
   EXPECT_EQ(served.reason, "controller ended the exchange (504)");
   EXPECT_EQ(served.exit_code(), 0);
-  EXPECT_EQ(served.stats.safety_fault, "none");
   EXPECT_GE(served.stats.cyclic_packets, 250u);  // 0.5 s at 2 ms, plus the way in and out
   ASSERT_EQ(seen.joint_degrees[1].size(), 6u);
   // The relative trajectory moved the arm by its last row from where it started (0).
@@ -123,20 +133,7 @@ TEST(SimulatedController, ALawAppClosesTheLoopsInMode1) {
     }
     worst.store(w, std::memory_order_relaxed);
   });
-  apps::ServeSession session(app, loopback());
-  session.start();
-  auto controller = sim::SimulatedController::start(program(session, R"(steps:
-  - drive_on
-  - go_open: {type: A, mode: 1, arms: [1]}
-  - wait_for_pc: {timeout: 10}
-  - delay: 0.2
-  - exit_open)"));
-  const auto served = session.run();
-  const auto seen = controller.wait();
-  EXPECT_EQ(seen.outcome, sim::SimulatedControllerReport::Outcome::completed) << seen.outcome_text;
-  EXPECT_EQ(served.stats.packets, seen.stats.packets_sent);
-  EXPECT_TRUE(served.finished) << served.text();
-  EXPECT_EQ(served.stats.safety_fault, "none");
+  const auto [served, seen] = serve_program(app, open_mode_program(1));
   EXPECT_LT(worst.load(), 0.01);  // motor turns
   for (const auto& e : seen.events) EXPECT_NE(e.name, sim::event::kSoftSwitchMotion) << e.text;
 }
