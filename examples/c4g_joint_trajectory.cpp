@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   apps::ServeOptions serve;
   serve.server.listen = argc > 1 ? axon::net::parse_endpoint(argv[1], 1000).value() : axon::net::Endpoint{"127.0.0.1", 0};
   serve.until_controller_ends = true;  // answer the program to its end, not only our part of it
+  serve.duration_s = 60;               // a bound, should the controller never end
   apps::ServeSession session(app, serve);
   session.start();
   std::printf("serving mode 4 on %s\n", session.local_address().c_str());

@@ -58,6 +58,11 @@ void LawApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& ax
   view_ = std::move(v).value();
 }
 
+void LawApp::silence() noexcept {
+  const Phase p = phase();
+  if (p != Phase::waiting && p != Phase::done && p != Phase::refused) refuse("%s: packets stopped during the run", name_.c_str());
+}
+
 void LawApp::schedule() noexcept {
   const double period = view_->period_s;
   const double t = advance(period);

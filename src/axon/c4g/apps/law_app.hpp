@@ -14,6 +14,7 @@
 // cycle, also while the controller switches control over (T1..T3; LawCycle::switching tells,
 // CycleContext::switching has the details); the run's clock and the envelope wait until the
 // switch is done. A refusal there asks for drive off (App::drive_off_on_error()).
+// Packets that stop during a run (the controller's communication error, a restart) refuse the run.
 #pragma once
 
 #include "axon/c4g/apps/open_mode.hpp"
@@ -56,6 +57,8 @@ class LawApp final : public OpenModeApp {
  protected:
   void setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) override;
   void step(const host::CycleContext& ctx, host::ReplyBuilder& reply) override;
+  // Packets stopped during a run: refused (the robot's state is unknown from here).
+  void silence() noexcept override;
 
  private:
   // Advances the run's clock and the envelope, and decides the fade and the exit.
