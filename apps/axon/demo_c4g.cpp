@@ -4,10 +4,7 @@
 // the same kind of socket, measured in the same run.
 #include "axon/c4g/apps/stream.hpp"
 #include "axon/c4g/host/server.hpp"
-#include "axon/c4g/sim/client_runner.hpp"
-#include "axon/c4g/sim/robots.hpp"
-#include "axon/c4g/sim/scenario.hpp"
-#include "axon/c4g/sim/udp_client.hpp"
+#include "axon/c4g/sim/simulated_controller.hpp"
 #include "axon/core/text.hpp"
 #include "demo_parts.hpp"
 #include "axon/net/udp_echo.hpp"
@@ -39,8 +36,6 @@ std::shared_ptr<const c4g::apps::Trajectory> demo_trajectory() {
   return std::make_shared<const c4g::apps::Trajectory>(need(c4g::apps::Trajectory::from_rows({0, 0.4, 0.8}, rows)));
 }
 
-double micros(std::int64_t ns) { return static_cast<double>(ns) * 1e-3; }
-
 // Round trips of six-axis-sized datagrams to `to`, p50 in us (0 when nothing came back).
 double demo_echo_p50_us(const net::SocketAddress& to, int rounds) {
   auto client = need(net::UdpSocket::open(net::SocketAddress{0x7f000001, 0}));
@@ -71,25 +66,21 @@ int demo_c4g() {
   fmt::print("1. PC server on {} running `stream` (mode 4: a 0.8 s joint trajectory, relative)\n",
              server->local_address().to_string());
 
-  auto controller = need(c4g::sim::Controller::create(need(c4g::sim::find_robot("six-axis")),
-                                                      need(c4g::sim::Scenario::parse(kProgram, "demo program"))));
-  const net::SocketAddress at = server->local_address();
-  auto udp = need(c4g::sim::UdpClient::open(net::Endpoint{"127.0.0.1", at.port}, std::nullopt));
-  fmt::print("2. controller simulator: six-axis robot, {} ms period, program: drive on, open mode 4, wait for PC, close\n",
-             controller.init().period_ms);
-  std::vector<std::string> modes;
-  c4g::sim::RunOptions ro;
-  ro.duration_s = 30;  // a bound; the program ends long before
-  ro.on_event = [&](const c4g::sim::Event& e) {
-    if (e.name == c4g::sim::event::kModeChange) modes.push_back(fmt::format("{:.3f} s {}", e.time_s, e.text));
-  };
-  const auto report = c4g::sim::run_client(controller, udp, ro);
+  c4g::sim::SimulatedControllerOptions co;
+  co.server = server->local_address().to_string();
+  co.scenario_yaml = std::string(kProgram);
+  co.duration_s = 30;  // a bound; the program ends long before
+  auto controller = c4g::sim::SimulatedController::start(co);
+  fmt::print("2. controller simulator: six-axis robot, program: drive on, open mode 4, wait for PC, close\n");
+  const auto report = controller.wait();
   server->stop();
 
-  const auto& s = controller.stats();
-  const bool ok = controller.scenario_done() && !controller.communication_error() && !app.has_error();
-  fmt::print("   program {} after {:.2f} s; modes seen:\n", ok ? "completed" : "FAILED", report.elapsed_s);
-  for (const auto& m : modes) fmt::print("     {}\n", m);
+  const auto& s = report.stats;
+  const bool ok = report.exit_code() == 0 && !app.has_error();
+  fmt::print("   program {} after {:.2f} s ({} ms period); modes seen:\n", ok ? "completed" : "FAILED", report.elapsed_s,
+             report.period_ms);
+  for (const auto& e : report.events)
+    if (e.name == c4g::sim::event::kModeChange) fmt::print("     {:.3f} s {}\n", e.time_s, e.text);
   const std::string summary = app.summary();
   for (const auto line : core::split_fields(summary, '\n'))
     if (!line.empty()) fmt::print("   {}\n", line);
@@ -97,15 +88,14 @@ int demo_c4g() {
   auto echo = need(net::UdpEchoServer::start());
   const double echo_us = demo_echo_p50_us(echo->address(), 2000);
   echo->stop();
-  const auto& h = report.rtt;
   fmt::print("\n3. the exchange, as the controller saw it\n");
   fmt::print("   {:<34} {:>10}\n", "cycles", s.ticks);
   fmt::print("   {:<34} {:>10}\n", "replies in time", s.replies_ok);
   fmt::print("   {:<34} {:>10}\n", "missed or late", s.misses);
-  fmt::print("   {:<34} {:>10.1f}\n", "round trip p50 [us]", micros(h.percentile(50)));
-  fmt::print("   {:<34} {:>10.1f}\n", "round trip p99 [us]", micros(h.percentile(99)));
+  fmt::print("   {:<34} {:>10.1f}\n", "round trip p50 [us]", report.rtt_p50_us);
+  fmt::print("   {:<34} {:>10.1f}\n", "round trip p99 [us]", report.rtt_p99_us);
   fmt::print("   {:<34} {:>10.1f}\n", "plain UDP echo p50 [us]", echo_us);
-  if (echo_us > 0) fmt::print("   {:<34} {:>10.2f}\n", "server / echo (p50)", micros(h.percentile(50)) / echo_us);
+  if (echo_us > 0) fmt::print("   {:<34} {:>10.2f}\n", "server / echo (p50)", report.rtt_p50_us / echo_us);
   return ok ? exit_code_value::ok : exit_code_value::failed;
 }
 

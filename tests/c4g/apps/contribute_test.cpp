@@ -25,7 +25,7 @@ TEST(ContributeApp, Mode9SendsASineCurrentFadedInAndOutThenExits) {
   h.start(app);
   h.set_modes(code(Mode::mode9));
   h.run(app);
-  EXPECT_EQ(app.phase(), ContributeApp::Phase::running);
+  EXPECT_EQ(app.phase(), Phase::running);
   // t = 2 ms: envelope 0.02, sin(2 pi 0.002) -> tiny; at t = 0.25 s the sine peaks at full envelope.
   int k = 1;
   for (; k < 125; ++k) h.run(app);
@@ -71,7 +71,7 @@ TEST(ContributeApp, LeavingTheModeUnaskedIsAnError) {
   h.run(app);
   h.set_modes(code(Mode::mode0));
   h.run(app);
-  EXPECT_EQ(app.phase(), ContributeApp::Phase::refused);
+  EXPECT_EQ(app.phase(), Phase::refused);
   EXPECT_NE(app.error().find("left mode 9"), std::string::npos) << app.error();
 }
 

@@ -99,7 +99,7 @@ TEST(CorrectApp, RefusesACorrectionTooFastForTheMotors) {
   CorrectApp app(o);
   Harness h;
   h.start(app);
-  EXPECT_EQ(app.phase(), CorrectApp::Phase::refused);
+  EXPECT_EQ(app.phase(), Phase::refused);
   EXPECT_NE(app.error().find("motor turns/s on axis 1"), std::string::npos) << app.error();
   h.set_modes(code(Mode::mode7));
   h.run(app);
@@ -117,7 +117,7 @@ TEST(CorrectApp, ControllerLeavingModeSevenIsAnError) {
   h.run(app);
   h.set_modes(code(Mode::mode0));
   h.run(app);
-  EXPECT_EQ(app.phase(), CorrectApp::Phase::refused);
+  EXPECT_EQ(app.phase(), Phase::refused);
   EXPECT_NE(app.error().find("left mode 7"), std::string::npos);
 }
 
@@ -191,7 +191,7 @@ TEST(CorrectLimits, ASineTooFastPerCycleIsRefusedAtTheInitializationPacket) {
   CorrectApp app(o);
   Harness h;
   h.start(app);
-  EXPECT_EQ(app.phase(), CorrectApp::Phase::refused);
+  EXPECT_EQ(app.phase(), Phase::refused);
   EXPECT_NE(app.error().find("in one cycle on axis 1"), std::string::npos) << app.error();
   h.set_modes(code(Mode::mode7));
   h.run(app);
@@ -207,9 +207,9 @@ TEST(CorrectLimits, AShortFadeCountsAgainstTheStepLimit) {
   CorrectApp app(o);
   Harness h;
   h.start(app);
-  EXPECT_EQ(app.phase(), CorrectApp::Phase::refused);
+  EXPECT_EQ(app.phase(), Phase::refused);
   o.ramp_s = 0.5;  // 0.016 deg per cycle
   CorrectApp slow(o);
   h.start(slow);
-  EXPECT_EQ(slow.phase(), CorrectApp::Phase::waiting);
+  EXPECT_EQ(slow.phase(), Phase::waiting);
 }

@@ -181,6 +181,6 @@ TEST(PidApp, ASineBeyondTheLimitsIsRefused) {
   PidApp fast(o);
   Harness h;
   h.start(fast);
-  EXPECT_EQ(fast.phase(), PidApp::Phase::refused);
+  EXPECT_EQ(fast.phase(), Phase::refused);
   EXPECT_NE(fast.error().find("in one cycle on axis 1"), std::string::npos) << fast.error();
 }

@@ -185,7 +185,7 @@ TEST(CorrectFeed, AFeedWithTheWrongAxisCountIsRefused) {
   CorrectApp app(o);
   Harness h;
   h.start(app);
-  EXPECT_EQ(app.phase(), CorrectApp::Phase::refused);
+  EXPECT_EQ(app.phase(), Phase::refused);
 }
 
 TEST(CorrectFeed, StopFadesToZeroThenExits) {
@@ -248,7 +248,7 @@ TEST(CorrectFeed, ReadingsBeyondTheLimitAreRefusedAndNeverApplied) {
   }
   EXPECT_EQ(app.refused_samples(), 3u);
   EXPECT_FALSE(app.has_error());
-  EXPECT_EQ(app.phase(), CorrectApp::Phase::correcting);
+  EXPECT_EQ(app.phase(), Phase::running);
   const auto texts = event_texts(app);
   EXPECT_TRUE(contains(texts, "feed reading refused: a value is beyond the correction limit")) << texts.size();
   EXPECT_NE(app.summary().find("3 readings refused beyond the limits"), std::string::npos) << app.summary();

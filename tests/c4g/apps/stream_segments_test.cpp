@@ -41,7 +41,7 @@ TEST(StreamSegments, MotionTypePicksTheSegmentAndSegmentsChain) {
   set_type(h, 1);
   h.set_modes(code(Mode::mode4));
   for (int k = 0; k < 80; ++k) h.run(app);  // segment 1 and some holding: no exit while holding
-  EXPECT_EQ(app.phase(), StreamApp::Phase::holding);
+  EXPECT_EQ(app.phase(), Phase::holding);
   EXPECT_FALSE(h.exit_requested());
   EXPECT_EQ(app.segment(), 1);
   const double out = h.rep.axes[0].d1;
@@ -49,7 +49,7 @@ TEST(StreamSegments, MotionTypePicksTheSegmentAndSegmentsChain) {
   // Motion type 2: the next segment starts from the last command (the robot has not followed here).
   set_type(h, 2);
   h.run(app);
-  EXPECT_EQ(app.phase(), StreamApp::Phase::playing);
+  EXPECT_EQ(app.phase(), Phase::running);
   EXPECT_EQ(app.segment(), 2);
   // Continuous: the first cycle moves one row of segment 2 away from where segment 1 ended.
   const double row = h.motor_axis1(4 * kDeg * 0.02) - h.motor_axis1(0);
@@ -85,13 +85,13 @@ TEST(StreamSegments, UnknownMotionTypeHoldsAndIsNoted) {
     EXPECT_FLOAT_EQ(h.rep.axes[0].d1, static_cast<float>(mid));  // held
     EXPECT_FLOAT_EQ(h.rep.axes[0].d2, 0.0f);
   }
-  EXPECT_EQ(app.phase(), StreamApp::Phase::idle);
+  EXPECT_EQ(app.phase(), Phase::idle);
   EXPECT_FALSE(h.exit_requested());
   EXPECT_TRUE(contains(event_texts(app), "stream: no segment for motion type 9: holding"));
   // A known type again resumes with its segment.
   set_type(h, 2);
   h.run(app);
-  EXPECT_EQ(app.phase(), StreamApp::Phase::playing);
+  EXPECT_EQ(app.phase(), Phase::running);
   EXPECT_FALSE(app.has_error());
 }
 
@@ -105,10 +105,10 @@ TEST(StreamSegments, Mode5EntryWithoutAMotionTypeAddsNothing) {
     h.run(app);
     EXPECT_FLOAT_EQ(h.rep.axes[0].d1, 0.0f);
   }
-  EXPECT_EQ(app.phase(), StreamApp::Phase::idle);
+  EXPECT_EQ(app.phase(), Phase::idle);
   set_type(h, 1);
   for (int k = 0; k < 60; ++k) h.run(app);
-  EXPECT_EQ(app.phase(), StreamApp::Phase::holding);
+  EXPECT_EQ(app.phase(), Phase::holding);
   EXPECT_FALSE(app.has_error());
 }
 
@@ -126,7 +126,7 @@ TEST(StreamSegments, AbsoluteSegmentAwayFromTheRobotIsRefused) {
   for (int k = 0; k < 60; ++k) h.run(app);
   set_type(h, 2);
   h.run(app);
-  EXPECT_EQ(app.phase(), StreamApp::Phase::refused);
+  EXPECT_EQ(app.phase(), Phase::refused);
   EXPECT_TRUE(h.exit_requested());
   EXPECT_NE(app.error().find("start point"), std::string::npos) << app.error();
 }

@@ -46,10 +46,10 @@ TEST(StreamApp, Mode4StreamsAbsoluteMotorTargetsThenExits) {
   h.place_at_link({0, 0, 0, 0, 0, 0});
   h.set_modes(code(Mode::mode0));
   h.run(app);
-  EXPECT_EQ(app.phase(), StreamApp::Phase::waiting);
+  EXPECT_EQ(app.phase(), Phase::waiting);
   h.set_modes(code(Mode::mode4));
   h.run(app);  // starts: row 0, then advances to row 1
-  EXPECT_EQ(app.phase(), StreamApp::Phase::playing);
+  EXPECT_EQ(app.phase(), Phase::running);
   EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(10 * kDeg * 0.002), 1e-4);
   for (int k = 0; k < 249; ++k) h.run(app);  // row 250: t = 0.5 s
   EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(5 * kDeg), 1e-4);
@@ -100,7 +100,7 @@ TEST(StreamApp, RefusesAStartPointAwayFromTheRobot) {
   h.place_at_link({0, 2 * kDeg, 0, 0, 0, 0});  // axis 2 is 2 deg away from the start
   h.set_modes(code(Mode::mode4));
   h.run(app);
-  EXPECT_EQ(app.phase(), StreamApp::Phase::refused);
+  EXPECT_EQ(app.phase(), Phase::refused);
   EXPECT_TRUE(app.has_error());
   EXPECT_NE(app.error().find("axis 2 is at 2.000 deg, the trajectory starts at 0.000 deg"), std::string::npos) << app.error();
   EXPECT_TRUE(h.exit_requested());
@@ -129,7 +129,7 @@ TEST(StreamApp, RefusesADiscontinuousTrajectoryBeforeMoving) {
   StreamApp app(options(4, t));
   Harness h;
   h.start(app);
-  EXPECT_EQ(app.phase(), StreamApp::Phase::refused);
+  EXPECT_EQ(app.phase(), Phase::refused);
   EXPECT_NE(app.error().find("not continuous: axis 1"), std::string::npos) << app.error();
   h.place_at_link({0, 0, 0, 0, 0, 0});
   h.set_modes(code(Mode::mode4));
@@ -180,6 +180,6 @@ TEST(StreamApp, LeavingTheModeDuringTheTrajectoryIsAnError) {
   for (int k = 0; k < 10; ++k) h.run(app);
   h.set_modes(code(Mode::drive_off));
   h.run(app);
-  EXPECT_EQ(app.phase(), StreamApp::Phase::refused);
+  EXPECT_EQ(app.phase(), Phase::refused);
   EXPECT_NE(app.error().find("left mode 4"), std::string::npos) << app.error();
 }

@@ -62,11 +62,15 @@ std::string App::error() const {
 }
 
 void App::fail(const char* format, ...) noexcept {
-  if (error_set_.load(std::memory_order_acquire)) return;  // the first error is the cause
   va_list ap;
   va_start(ap, format);
-  std::vsnprintf(error_.data(), error_.size(), format, ap);
+  fail_v(format, ap);
   va_end(ap);
+}
+
+void App::fail_v(const char* format, va_list args) noexcept {
+  if (error_set_.load(std::memory_order_acquire)) return;  // the first error is the cause
+  std::vsnprintf(error_.data(), error_.size(), format, args);
   error_set_.store(true, std::memory_order_release);
 }
 

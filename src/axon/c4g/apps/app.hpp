@@ -24,6 +24,7 @@
 
 #include <array>
 #include <atomic>
+#include <cstdarg>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -135,6 +136,7 @@ class App : public host::Controller {
 
   // Cycle thread helpers.
   void fail(const char* format, ...) noexcept __attribute__((format(printf, 2, 3)));
+  void fail_v(const char* format, va_list args) noexcept __attribute__((format(printf, 2, 0)));
   void note(std::int32_t code, int axis = -1, std::int32_t aux = 0) noexcept;
   // Sets exit from open for the arm (once per cycle; logs the first request of a series).
   void exit_from_open(host::ReplyBuilder& reply, std::size_t arm) noexcept;

@@ -12,7 +12,7 @@
 // so the app serves it for experiments and tests.
 #pragma once
 
-#include "axon/c4g/apps/app.hpp"
+#include "axon/c4g/apps/open_mode.hpp"
 
 #include <vector>
 
@@ -30,17 +30,12 @@ struct ContributeOptions {
   double max_motor_speed = 100.0;
 };
 
-class ContributeApp final : public App {
+class ContributeApp final : public OpenModeApp {
  public:
-  enum class Phase : std::uint8_t { waiting, running, fading, exiting, done, refused };
-  enum : std::int32_t { kNoteStarted = 1, kNoteFading, kNoteDone };
-
   explicit ContributeApp(ContributeOptions options);
   [[nodiscard]] std::string_view name() const noexcept override { return "contribute"; }
   [[nodiscard]] std::string status() const override;
   [[nodiscard]] std::string summary() const override;
-  [[nodiscard]] bool finished() const noexcept override { return phase() == Phase::done; }
-  [[nodiscard]] Phase phase() const noexcept { return phase_.load(std::memory_order_acquire); }
   // The contribution sent last on the arm's axis j, in the option's units (any thread, relaxed).
   [[nodiscard]] double last(std::size_t j) const noexcept { return last_[j].load(std::memory_order_relaxed); }
   [[nodiscard]] double peak(std::size_t j) const noexcept { return peak_[j].load(std::memory_order_relaxed); }
@@ -51,18 +46,12 @@ class ContributeApp final : public App {
   [[nodiscard]] std::string note_text(std::int32_t code) const override;
 
  private:
-  void set_phase(Phase p) noexcept { phase_.store(p, std::memory_order_release); }
-
   ContributeOptions options_;
-  std::atomic<Phase> phase_{Phase::waiting};
   std::array<std::atomic<double>, protocol::kAxesPerArm> last_{}, peak_{};
-  std::atomic<double> elapsed_{0};
   // Cycle thread.
   std::size_t first_ = 0, count_ = 0;
   double period_s_ = 0.002;
-  std::array<double, protocol::kAxesPerArm> amplitude_{}, frequency_{};
-  std::uint64_t ticks_ = 0;
-  double fade_start_ = 0;
+  SineExcitation sine_;
 };
 
 }  // namespace axon::c4g::apps

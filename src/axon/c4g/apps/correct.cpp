@@ -16,6 +16,11 @@ using protocol::Mode;
 
 namespace {
 
+OpenModeApp::Style correct_style(const CorrectOptions& o) {
+  return {.app = "correct", .waiting = "waiting for mode 7", .running = "correcting", .mode = "7", .ramp_s = o.ramp_s,
+          .fade_in = false, .rearm = o.rearm};
+}
+
 Exception refused(std::string text) { return Exception(Error(CoreErrc::invalid_argument, std::move(text))); }
 
 // The sine's amplitudes and the file's values within max_abs: checked when the app is built.
@@ -32,7 +37,7 @@ void check_sources(const CorrectOptions& o) {
 }
 }  // namespace
 
-CorrectApp::CorrectApp(CorrectOptions options) : options_(std::move(options)) {
+CorrectApp::CorrectApp(CorrectOptions options) : OpenModeApp(correct_style(options)), options_(std::move(options)) {
   for (auto& a : applied_) a.store(0, std::memory_order_relaxed);
   const int sources = (options_.values ? 1 : 0) + (options_.feed ? 1 : 0) + (options_.amplitude_rad.empty() ? 0 : 1);
   if (sources != 1)
@@ -46,14 +51,9 @@ CorrectApp::CorrectApp(CorrectOptions options) : options_(std::move(options)) {
 }
 
 void CorrectApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) {
-  if ((phase() == Phase::done && !options_.rearm) || phase() == Phase::refused) return;
-  set_phase(Phase::waiting);
+  if (!begin_setup()) return;
   auto v = make_arm_view(init, axes, options_.arm);
-  if (!v) {
-    fail("correct: %s", v.error().detail.c_str());
-    set_phase(Phase::refused);
-    return;
-  }
+  if (!v) return refuse("correct: %s", v.error().detail.c_str());
   view_ = std::move(v).value();
   const std::size_t n = view_->count;
   const double period = view_->period_s;
@@ -65,11 +65,7 @@ void CorrectApp::setup(const protocol::InitPacket& init, const protocol::AxisMap
     }
   } else if (options_.values) {
     const Trajectory& f = *options_.values;
-    if (f.axes() != n) {
-      fail("correct: the file has %zu axes, arm %zu has %zu", f.axes(), options_.arm, n);
-      set_phase(Phase::refused);
-      return;
-    }
+    if (f.axes() != n) return refuse("correct: the file has %zu axes, arm %zu has %zu", f.axes(), options_.arm, n);
     // Continuity of the file as it will be played, from a zero correction.
     protocol::ArmTransform::Vector link(static_cast<Eigen::Index>(n)), prev = protocol::ArmTransform::Vector::Zero(static_cast<Eigen::Index>(n));
     const auto rows = static_cast<std::size_t>(std::ceil(f.end_time() / period)) + 1;
@@ -77,33 +73,23 @@ void CorrectApp::setup(const protocol::InitPacket& init, const protocol::AxisMap
       correction(static_cast<double>(k) * period, 1.0, link);
       const auto step = view_->transform.motor_velocity(link - prev);
       for (std::size_t j = 0; j < n; ++j)
-        if (std::fabs(step[static_cast<Eigen::Index>(j)]) > max_step) {
-          fail("correct: the correction is not continuous: axis %zu moves %.4f motor turns in one cycle at t=%.3f s "
-               "(limit %.4f)",
-               j + 1, std::fabs(step[static_cast<Eigen::Index>(j)]), static_cast<double>(k) * period, max_step);
-          set_phase(Phase::refused);
-          return;
-        }
+        if (std::fabs(step[static_cast<Eigen::Index>(j)]) > max_step)
+          return refuse("correct: the correction is not continuous: axis %zu moves %.4f motor turns in one cycle at "
+                        "t=%.3f s (limit %.4f)",
+                        j + 1, std::fabs(step[static_cast<Eigen::Index>(j)]), static_cast<double>(k) * period, max_step);
       prev = link;
     }
   } else {
-    for (std::size_t j = 0; j < n; ++j) {
-      const auto& a = options_.amplitude_rad;
-      const auto& f = options_.frequency_hz;
-      amplitude_[j] = a.size() == 1 ? a[0] : (j < a.size() ? a[j] : 0.0);
-      frequency_[j] = f.empty() ? 0.5 : (f.size() == 1 ? f[0] : (j < f.size() ? f[j] : 0.0));
-    }
+    sine_.configure(options_.amplitude_rad, options_.frequency_hz, n);
     // Peak motor speed: |K_r| times the link peak speeds 2 pi f A (over 2 pi per turn).
     const auto& kr = view_->transform.kr();
     for (std::size_t i = 0; i < n; ++i) {
       double peak = 0;
       for (std::size_t j = 0; j < n; ++j)
-        peak += std::fabs(kr(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j))) * std::fabs(frequency_[j] * amplitude_[j]);
-      if (peak > options_.max_motor_speed) {
-        fail("correct: the sine needs up to %.1f motor turns/s on axis %zu (limit %.1f)", peak, i + 1, options_.max_motor_speed);
-        set_phase(Phase::refused);
-        return;
-      }
+        peak += std::fabs(kr(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j))) * std::fabs(sine_.frequency(j) * sine_.amplitude(j));
+      if (peak > options_.max_motor_speed)
+        return refuse("correct: the sine needs up to %.1f motor turns/s on axis %zu (limit %.1f)", peak, i + 1,
+                      options_.max_motor_speed);
     }
   }
   if (!options_.feed && !check_steps(period)) set_phase(Phase::refused);
@@ -127,7 +113,7 @@ bool CorrectApp::check_steps(double period) noexcept {
       }
       step += peak * fade;
     } else {
-      step = sine_step_bound(amplitude_[j], frequency_[j], period, options_.ramp_s);
+      step = sine_step_bound(sine_.amplitude(j), sine_.frequency(j), period, options_.ramp_s);
     }
     if (step > options_.limits.max_step(j) * (1 + 1e-9)) {
       fail("correct: the correction can change by %.4f deg in one cycle on axis %zu (fades included), beyond the limit "
@@ -146,8 +132,7 @@ void CorrectApp::correction(double t, double env, protocol::ArmTransform::Vector
     options_.values->sample(t, std::span<double>(pos.data(), n), std::span<double>(vel.data(), n));
     for (std::size_t j = 0; j < n; ++j) link[static_cast<Eigen::Index>(j)] = env * pos[j];
   } else {
-    for (std::size_t j = 0; j < n; ++j)
-      link[static_cast<Eigen::Index>(j)] = env * amplitude_[j] * std::sin(2.0 * std::numbers::pi * frequency_[j] * t);
+    for (std::size_t j = 0; j < n; ++j) link[static_cast<Eigen::Index>(j)] = env * sine_.value(j, t);
   }
 }
 
@@ -207,90 +192,37 @@ int CorrectApp::out_of_bounds(const protocol::ArmTransform::Vector& link) const 
 }
 
 void CorrectApp::refuse_now(host::ReplyBuilder& reply) noexcept {
-  set_phase(Phase::refused);
+  set_phase(Phase::refused);  // after fail()
   for (std::size_t i = 0; i < view_->count; ++i) reply.axis(view_->first + i).d1 = 0;
   exit_from_open(reply, view_->arm);
 }
 
-void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
-  if (!view_) return;
-  const auto& req = ctx.request;
-  const std::size_t n = view_->count, first = view_->first;
-  if (first + n > req.count) return;
-  bool all_in = true;
-  for (std::size_t j = 0; j < n; ++j) all_in = all_in && req.axes[first + j].mode == code(Mode::mode7);
-  const std::int32_t m0 = req.axes[first].mode;
-  Phase ph = phase();
-  const double period = view_->period_s;
-
-  if (ph == Phase::done && options_.rearm && m0 == code(Mode::mode0)) {
-    set_phase(Phase::waiting);
-    ph = Phase::waiting;
-  }
-
-  switch (ph) {
-    case Phase::done: return;
-    case Phase::refused:
-      if (all_in) exit_from_open(reply, view_->arm);  // the safe reply adds nothing
-      return;
-    case Phase::waiting:
-      if (!all_in || stop_requested()) return;
-      t_ = 0;
-      ticks_ = 0;
-      last_ = {};
-      link_last_ = {};
-      for (auto& a : applied_) a.store(0, std::memory_order_relaxed);
-      runs_.fetch_add(1, std::memory_order_relaxed);
-      set_phase(Phase::correcting);
-      ph = Phase::correcting;
-      note(kNoteStarted);
-      break;
-    case Phase::exiting:
-      if (m0 == code(Mode::mode0)) {
-        set_phase(Phase::done);
-        note(kNoteDone);
-        return;
-      }
-      if (all_in) exit_from_open(reply, view_->arm);
-      return;  // 7, 7', 7'': zero increments (the safe reply)
-    case Phase::correcting:
-    case Phase::fading:
-      if (!all_in) {
-        fail("correct: the controller left mode 7 during the correction (axis 1 of arm %zu in mode %d)", view_->arm, m0);
-        set_phase(Phase::refused);
-        return;
-      }
-      break;
-  }
-
-  t_ = static_cast<double>(++ticks_) * period;
-  elapsed_.store(t_, std::memory_order_relaxed);
-  double env = 1.0;
-  if (ph == Phase::correcting) {
-    const bool file_end = options_.values && t_ >= options_.values->end_time() && !stop_requested();
-    const bool time_up = options_.open_time_s > 0 && t_ >= options_.open_time_s;
-    if (file_end) {
-      set_phase(Phase::exiting);
-      ph = Phase::exiting;
-    } else if (stop_requested() || time_up) {
-      fade_start_ = t_;
-      set_phase(Phase::fading);
-      ph = Phase::fading;
-      note(kNoteFading);
-    }
-  }
-  if (ph == Phase::fading) {
-    env = options_.ramp_s > 0 ? std::max(0.0, 1.0 - (t_ - fade_start_) / options_.ramp_s) : 0.0;
-    if (env < 1e-9) {
-      env = 0.0;
-      set_phase(Phase::exiting);
-      ph = Phase::exiting;
-    }
-  }
-  emit(env, ph, reply);
+void CorrectApp::restart() noexcept {
+  last_ = {};
+  link_last_ = {};
+  for (auto& a : applied_) a.store(0, std::memory_order_relaxed);
+  started();
 }
 
-void CorrectApp::emit(double env, Phase ph, host::ReplyBuilder& reply) noexcept {
+void CorrectApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
+  if (!view_) return;
+  const Turn turned = turn(gate_for(ctx.request, view_->first, view_->count, code(Mode::mode7)), reply, view_->arm);
+  if (turned == Turn::skip) return;
+  if (turned == Turn::start) restart();
+  const double t = advance(view_->period_s);
+  if (phase() == Phase::running) {
+    const bool file_end = options_.values && t >= options_.values->end_time() && !stop_requested();
+    const bool time_up = options_.open_time_s > 0 && t >= options_.open_time_s;
+    if (file_end) set_phase(Phase::exiting);
+    else if (stop_requested() || time_up) start_fade();
+  }
+  double env = envelope().step(view_->period_s);
+  if (phase() == Phase::exiting) env = 1.0;  // the file's end: its last offset stays applied
+  else if (envelope().faded()) set_phase(Phase::exiting);
+  emit(env, reply);
+}
+
+void CorrectApp::emit(double env, host::ReplyBuilder& reply) noexcept {
   const std::size_t n = view_->count, first = view_->first;
   const double period = view_->period_s;
   protocol::ArmTransform::Vector link(static_cast<Eigen::Index>(n));
@@ -298,7 +230,7 @@ void CorrectApp::emit(double env, Phase ph, host::ReplyBuilder& reply) noexcept 
     feed_target(env, link);
     slew(link);
   } else {
-    correction(t_, env, link);
+    correction(run_time(), env, link);
   }
   if (const int j = out_of_bounds(link); j >= 0) {
     fail("correct: the correction on axis %d (%.4f deg, %.4f deg since the last cycle) breaks its limits (%.4f deg, "
@@ -317,10 +249,7 @@ void CorrectApp::emit(double env, Phase ph, host::ReplyBuilder& reply) noexcept 
       m = last_[j] + std::clamp(m - last_[j], -max_step, max_step);
       at_zero = at_zero && std::fabs(m) < 1e-12;
     }
-    if (ph == Phase::exiting && !at_zero) {
-      set_phase(Phase::fading);
-      ph = Phase::fading;
-    }
+    if (phase() == Phase::exiting && !at_zero) set_phase(Phase::fading);
   }
   for (std::size_t j = 0; j < n; ++j) {
     const double inc = motor[static_cast<Eigen::Index>(j)] - last_[j];
@@ -337,36 +266,31 @@ void CorrectApp::emit(double env, Phase ph, host::ReplyBuilder& reply) noexcept 
     last_[j] = c;
     link_last_[j] = link[static_cast<Eigen::Index>(j)];
   }
-  if (ph == Phase::exiting) exit_from_open(reply, view_->arm);
+  if (phase() == Phase::exiting) exit_from_open(reply, view_->arm);
 }
 
 std::string CorrectApp::note_text(std::int32_t c) const {
   switch (c) {
     case kNoteStarted: return fmt::format("correct: correction started (mode 7, arm {})", options_.arm);
     case kNoteFading: return "correct: fading the correction out";
-    case kNoteDone: return "correct: done, the arm is back in mode 0";
     case kNoteFeedStale:
       return fmt::format("correct: no feed values for {:.0f} ms: correction returning to zero", options_.feed_timeout_s * 1e3);
     case kNoteFeedBack: return "correct: feed values again";
     case kNoteFeedRefused:
       return "correct: feed reading refused: a value is beyond the correction limit (the correction keeps the last good "
              "reading; the summary names the last one refused)";
-    default: return App::note_text(c);
+    default: return OpenModeApp::note_text(c);
   }
 }
 
 std::string CorrectApp::status() const {
-  static constexpr std::string_view names[] = {"waiting for mode 7", "correcting", "fading", "exiting", "done", "refused"};
-  std::string out = App::status() + fmt::format(" {} t={:.3f} s correction[turns]", names[static_cast<int>(phase())],
-                                                elapsed_.load(std::memory_order_relaxed));
+  std::string out = OpenModeApp::status() + " correction[turns]";
   for (std::size_t j = 0; j < 6 && j < protocol::kAxesPerArm; ++j) out += fmt::format(" {:.4f}", applied(j));
   return out;
 }
 
 std::string CorrectApp::summary() const {
-  static constexpr std::string_view names[] = {"waiting", "correcting", "fading", "exiting", "done", "refused"};
-  std::string out = App::summary() + fmt::format("correct: {:.3f} s corrected, phase {}\n",
-                                                elapsed_.load(std::memory_order_relaxed), names[static_cast<int>(phase())]);
+  std::string out = App::summary() + fmt::format("correct: {:.3f} s corrected, phase {}\n", elapsed_s(), to_string(phase()));
   if (options_.feed) {
     out += fmt::format("correct: feed on port {}: {} datagrams accepted, {} rejected, {} from other senders ignored, "
                        "{} readings refused beyond the limits, {} stale cycles, {} cycles slewed\n", options_.feed->port(),

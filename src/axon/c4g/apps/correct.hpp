@@ -29,7 +29,7 @@
 // a sine: open_time or a stop request, then a fade over ramp_s, then exit from open.
 #pragma once
 
-#include "axon/c4g/apps/app.hpp"
+#include "axon/c4g/apps/open_mode.hpp"
 #include "axon/c4g/apps/correction_limits.hpp"
 #include "axon/c4g/apps/sensor_feed.hpp"
 #include "axon/c4g/apps/trajectory.hpp"
@@ -55,19 +55,14 @@ struct CorrectOptions {
   bool rearm = false;
 };
 
-class CorrectApp final : public App {
+class CorrectApp final : public OpenModeApp {
  public:
-  enum class Phase : std::uint8_t { waiting, correcting, fading, exiting, done, refused };
-  enum : std::int32_t { kNoteStarted = 1, kNoteFading, kNoteDone, kNoteFeedStale, kNoteFeedBack, kNoteFeedRefused };
+  enum : std::int32_t { kNoteFeedStale = kFirstAppNote, kNoteFeedBack, kNoteFeedRefused };
 
   explicit CorrectApp(CorrectOptions options);
   [[nodiscard]] std::string_view name() const noexcept override { return "correct"; }
   [[nodiscard]] std::string status() const override;
   [[nodiscard]] std::string summary() const override;
-  [[nodiscard]] bool finished() const noexcept override { return !options_.rearm && phase() == Phase::done; }
-  // Corrections started so far (any thread).
-  [[nodiscard]] std::uint64_t runs() const noexcept { return runs_.load(std::memory_order_relaxed); }
-  [[nodiscard]] Phase phase() const noexcept { return phase_.load(std::memory_order_acquire); }
   // Sum of the increments sent so far on the arm's axis j [motor turns] (any thread, relaxed).
   [[nodiscard]] double applied(std::size_t j) const noexcept { return applied_[j].load(std::memory_order_relaxed); }
   // Live feed: cycles spent without fresh values (any thread).
@@ -83,7 +78,6 @@ class CorrectApp final : public App {
   [[nodiscard]] std::string note_text(std::int32_t code) const override;
 
  private:
-  void set_phase(Phase p) noexcept { phase_.store(p, std::memory_order_release); }
   // Link-side correction at time t with envelope env, into link (size n).
   void correction(double t, double env, protocol::ArmTransform::Vector& link) const noexcept;
   // Live feed: the link-side target from the latest fresh reading (zero when stale).
@@ -98,28 +92,24 @@ class CorrectApp final : public App {
   bool check_steps(double period) noexcept;
   // Builds this cycle's correction (envelope env), checks it against every bound and sends its
   // increment; with the feed, may move an exiting phase back to fading until the correction is zero.
-  void emit(double env, Phase ph, host::ReplyBuilder& reply) noexcept;
+  void emit(double env, host::ReplyBuilder& reply) noexcept;
+  // A new correction from zero (Turn::start).
+  void restart() noexcept;
   // Refuses and leaves mode 7 with zero increments.
   void refuse_now(host::ReplyBuilder& reply) noexcept;
 
   CorrectOptions options_;
   std::optional<ArmView> view_;
-  std::atomic<Phase> phase_{Phase::waiting};
   std::array<std::atomic<double>, protocol::kAxesPerArm> applied_{};
-  std::atomic<double> elapsed_{0};
   std::atomic<std::uint64_t> stale_cycles_{0};
   std::atomic<std::uint64_t> refused_samples_{0};
   std::atomic<std::uint64_t> slewed_cycles_{0};
   std::atomic<int> refused_axis_{0};        // last refused reading: its axis (0-based) and value [rad]
   std::atomic<double> refused_value_{0};
-  std::atomic<std::uint64_t> runs_{0};
   // Cycle thread.
-  std::array<double, protocol::kAxesPerArm> amplitude_{}, frequency_{};
+  SineExcitation sine_;
   std::array<double, protocol::kAxesPerArm> last_{};  // last motor-side correction
   std::array<double, protocol::kAxesPerArm> link_last_{};  // last link-side correction [rad]
-  double t_ = 0;
-  std::uint64_t ticks_ = 0;
-  double fade_start_ = 0;
   SensorFeed::Reading reading_;       // the last reading within the limits
   SensorFeed::Reading incoming_;      // the feed's latest, before the check
   std::uint64_t seen_sequence_ = 0;

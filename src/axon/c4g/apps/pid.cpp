@@ -29,7 +29,14 @@ double AxisPid::update(const PidGains& g, double p_target, double v_target, doub
   return out;
 }
 
-PidApp::PidApp(PidOptions options) : options_(std::move(options)) {
+namespace {
+OpenModeApp::Style pid_style(const PidOptions& o) {
+  return {.app = "pid", .waiting = "waiting for mode 1/2", .running = "controlling", .mode = "1/2", .ramp_s = o.ramp_s,
+          .exiting_runs = true, .pc_closes_loops = true};
+}
+}  // namespace
+
+PidApp::PidApp(PidOptions options) : OpenModeApp(pid_style(options)), options_(std::move(options)) {
   if (options_.ramp_s < 0 || options_.open_time_s < 0)
     throw Exception(Error(CoreErrc::invalid_argument, "pid: times must not be negative"));
   for (const auto& g : options_.gains)
@@ -40,116 +47,82 @@ PidApp::PidApp(PidOptions options) : options_(std::move(options)) {
 }
 
 void PidApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) {
-  if (phase() == Phase::done || phase() == Phase::refused) return;
-  set_phase(Phase::waiting);
+  if (!begin_setup()) return;
   auto v = make_arm_view(init, axes, options_.arm);
-  if (!v) {
-    fail("pid: %s", v.error().detail.c_str());
-    set_phase(Phase::refused);
-    return;
-  }
+  if (!v) return refuse("pid: %s", v.error().detail.c_str());
   view_ = std::move(v).value();
   const auto limits = axes.per_open_axis(init.current_limit);
+  sine_.configure(options_.amplitude_rad, options_.frequency_hz, view_->count);
   for (std::size_t j = 0; j < view_->count; ++j) {
     const auto& g = options_.gains;
-    gains_[j] = g.empty() ? PidGains{} : (g.size() == 1 ? g[0] : (j < g.size() ? g[j] : g.back()));
-    const auto& a = options_.amplitude_rad;
-    const auto& f = options_.frequency_hz;
-    amplitude_[j] = a.empty() ? 0.0 : (a.size() == 1 ? a[0] : (j < a.size() ? a[j] : 0.0));
-    frequency_[j] = f.empty() ? 0.5 : (f.size() == 1 ? f[0] : (j < f.size() ? f[j] : 0.0));
+    gains_[j] = g.empty() ? PidGains{} : g[std::min(j, g.size() - 1)];
     limit_[j] = std::fabs(limits[view_->first + j]);
-    const double step = sine_step_bound(amplitude_[j], frequency_[j], view_->period_s, options_.ramp_s);
-    if (step > options_.limits.max_step(j) * (1 + 1e-9)) {
-      fail("pid: the sine can change by %.4f deg in one cycle on axis %zu (fades included), beyond the limit %.4f deg per "
-           "cycle (--max-correction-step)", step * kRadToDeg, j + 1, options_.limits.max_step(j) * kRadToDeg);
-      set_phase(Phase::refused);
-      return;
-    }
+    const double step = sine_step_bound(sine_.amplitude(j), sine_.frequency(j), view_->period_s, options_.ramp_s);
+    if (step > options_.limits.max_step(j) * (1 + 1e-9))
+      return refuse("pid: the sine can change by %.4f deg in one cycle on axis %zu (fades included), beyond the limit "
+                    "%.4f deg per cycle (--max-correction-step)", step * kRadToDeg, j + 1,
+                    options_.limits.max_step(j) * kRadToDeg);
   }
 }
 
 void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
   if (!view_) return;
   const auto& req = ctx.request;
-  const std::size_t n = view_->count, first = view_->first;
-  if (first + n > req.count) return;
-  const std::int32_t m0 = req.axes[first].mode;
-  bool same = true;
-  for (std::size_t j = 1; j < n; ++j) same = same && req.axes[first + j].mode == m0;
-  const bool mode1 = m0 == code(Mode::mode1) || m0 == code(Mode::mode1_standby);
-  const bool mode2 = m0 == code(Mode::mode2) || m0 == code(Mode::mode2_standby);
-  const double period = view_->period_s;
-  Phase ph = phase();
-
-  if (ph == Phase::done || ph == Phase::refused) return;
-  if (ph == Phase::waiting) {
-    if (!same || !(mode1 || mode2) || stop_requested()) return;
-    for (std::size_t j = 0; j < n; ++j) {
+  Gate g = gate_for(req, view_->first, view_->count, req.axes[view_->first].mode);  // every axis in one mode
+  const bool loop_mode = g.first_mode == code(Mode::mode1) || g.first_mode == code(Mode::mode1_standby) ||
+                         g.first_mode == code(Mode::mode2) || g.first_mode == code(Mode::mode2_standby);
+  g.entered = g.inside = g.entered && loop_mode;
+  const Turn turned = turn(g, reply, view_->arm);
+  if (turned == Turn::skip) return;
+  if (turned == Turn::start) {
+    for (std::size_t j = 0; j < view_->count; ++j) {
       loops_[j].reset();
-      hold_[j] = req.axes[first + j].d3;
+      hold_[j] = req.axes[view_->first + j].d3;
       last_ref_[j] = hold_[j];
     }
-    t_ = 0;
-    ticks_ = 0;
     env_ = 0;
-    mode_ = mode1 ? 1 : 2;
+    mode_ = g.first_mode == code(Mode::mode1) || g.first_mode == code(Mode::mode1_standby) ? 1 : 2;
     active_mode_.store(mode_, std::memory_order_relaxed);
-    set_phase(Phase::controlling);
-    ph = Phase::controlling;
-    note(kNoteStarted, -1, mode_);
+    started(kNoteStarted, mode_);
   }
-  if (m0 == code(Mode::mode0)) {
-    set_phase(Phase::done);
-    note(kNoteDone);
-    return;
-  }
-  if (!same || !(mode1 || mode2)) {
-    fail("pid: the controller left the loop modes (axis 1 of arm %zu in mode %d)", view_->arm, m0);
-    set_phase(Phase::refused);
-    return;
-  }
-
-  const bool leaving_by_pc = mode_ == 1;
   // Soft switching: mode 1's own trajectory waits until the switch to the PC is done.
-  const bool switched = ctx.switching == nullptr || ctx.switching->axis(first).interval == protocol::SwitchInterval::done;
-  if (m0 == code(Mode::mode1) && switched) {
-    t_ = static_cast<double>(++ticks_) * period;
-    elapsed_.store(t_, std::memory_order_relaxed);
-    if (ph == Phase::controlling) {
-      env_ = options_.ramp_s > 0 ? std::min(1.0, t_ / options_.ramp_s) : 1.0;
-      if (leaving_by_pc && (stop_requested() || (options_.open_time_s > 0 && t_ >= options_.open_time_s))) {
-        set_phase(Phase::fading);
-        ph = Phase::fading;
-        settle_s_ = 0;
-        note(kNoteLeaving);
-      }
-    }
-    if (ph == Phase::fading) {
-      env_ = options_.ramp_s > 0 ? std::max(0.0, env_ - period / options_.ramp_s) : 0.0;
-      if (env_ < 1e-9) {
-        env_ = 0.0;
-        // Soft switching back needs a still robot: ask for the exit once every axis has settled on
-        // the hold position (or after kMaxSettle_s, when the watchdog will tell).
-        bool settled = true;
-        for (std::size_t j = 0; j < n; ++j) {
-          const auto& q = req.axes[first + j];
-          settled = settled && std::fabs(q.d3 - hold_[j]) < kSettleTurns && std::fabs(q.d4) / period < kSettleTurnsPerS;
-        }
-        settle_s_ += period;
-        if (settled || settle_s_ >= kMaxSettle_s) {
-          set_phase(Phase::exiting);
-          ph = Phase::exiting;
-        }
-      }
-    }
-  } else if (m0 == code(Mode::mode2)) {
-    t_ = static_cast<double>(++ticks_) * period;
-    elapsed_.store(t_, std::memory_order_relaxed);
-  }
+  const bool switched = ctx.switching == nullptr || ctx.switching->axis(view_->first).interval == protocol::SwitchInterval::done;
+  if (g.first_mode == code(Mode::mode1) && switched) advance_mode1(req);
+  else if (g.first_mode == code(Mode::mode2)) advance(view_->period_s);
+  control(ctx, reply);
+}
 
+void PidApp::advance_mode1(const protocol::Packet& req) noexcept {
+  const std::size_t n = view_->count, first = view_->first;
+  const double period = view_->period_s;
+  const double t = advance(period);
+  // Mode 1 is the PC's to leave (mode 2 the controller's).
+  if (phase() == Phase::running && mode_ == 1 && (stop_requested() || (options_.open_time_s > 0 && t >= options_.open_time_s))) {
+    start_fade();
+    settle_s_ = 0;
+  }
+  env_ = envelope().step(period);
+  if (phase() != Phase::fading || !envelope().faded()) return;
+  // Soft switching back needs a still robot: ask for the exit once every axis has settled on the
+  // hold position (or after kMaxSettle_s, when the watchdog will tell).
+  bool settled = true;
+  for (std::size_t j = 0; j < n; ++j) {
+    const auto& q = req.axes[first + j];
+    settled = settled && std::fabs(q.d3 - hold_[j]) < kSettleTurns && std::fabs(q.d4) / period < kSettleTurnsPerS;
+  }
+  settle_s_ += period;
+  if (settled || settle_s_ >= kMaxSettle_s) set_phase(Phase::exiting);
+}
+
+void PidApp::control(const host::CycleContext& ctx, host::ReplyBuilder& reply) noexcept {
+  const auto& req = ctx.request;
+  const std::size_t n = view_->count, first = view_->first;
+  const double period = view_->period_s;
+  const std::int32_t m0 = req.axes[first].mode;
+  const bool mode1 = m0 == code(Mode::mode1) || m0 == code(Mode::mode1_standby);
   protocol::ArmTransform::Vector link(static_cast<Eigen::Index>(n));
   for (std::size_t j = 0; j < n; ++j)
-    link[static_cast<Eigen::Index>(j)] = env_ * amplitude_[j] * std::sin(2.0 * std::numbers::pi * frequency_[j] * t_);
+    link[static_cast<Eigen::Index>(j)] = env_ * sine_.value(j, run_time());
   const auto offset = view_->transform.motor_velocity(link);
 
   double worst = max_error_.load(std::memory_order_relaxed);
@@ -194,23 +167,21 @@ void PidApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
   max_switch_error_.store(worst_switch, std::memory_order_relaxed);
   max_switch_current_.store(worst_current, std::memory_order_relaxed);
   if (any_saturated) saturated_cycles_.fetch_add(1, std::memory_order_relaxed);
-  if (ph == Phase::exiting && m0 == code(Mode::mode1)) exit_from_open(reply, view_->arm);
+  if (phase() == Phase::exiting && m0 == code(Mode::mode1)) exit_from_open(reply, view_->arm);
 }
 
 std::string PidApp::note_text(std::int32_t c) const {
   switch (c) {
     case kNoteStarted: return fmt::format("pid: closing the loops (arm {})", options_.arm);
-    case kNoteLeaving: return "pid: leaving mode 1";
-    case kNoteDone: return "pid: done, the arm is back in mode 0";
-    default: return App::note_text(c);
+    case kNoteFading: return "pid: leaving mode 1";
+    default: return OpenModeApp::note_text(c);
   }
 }
 
 std::string PidApp::status() const {
-  static constexpr std::string_view names[] = {"waiting for mode 1/2", "controlling", "fading", "exiting", "done", "refused"};
-  return App::status() + fmt::format(" {} mode {} t={:.3f} s max following error {:.5f} turns, saturated {}",
-                                     names[static_cast<int>(phase())], active_mode_.load(std::memory_order_relaxed),
-                                     elapsed_.load(std::memory_order_relaxed), max_following_error(), saturated_cycles());
+  return OpenModeApp::status() + fmt::format(" mode {} max following error {:.5f} turns, saturated {}",
+                                             active_mode_.load(std::memory_order_relaxed), max_following_error(),
+                                             saturated_cycles());
 }
 
 std::string PidApp::summary() const {

@@ -35,7 +35,7 @@
 // also tracks the largest following error for the status line.
 #pragma once
 
-#include "axon/c4g/apps/app.hpp"
+#include "axon/c4g/apps/open_mode.hpp"
 #include "axon/c4g/apps/correction_limits.hpp"
 
 #include <vector>
@@ -88,18 +88,14 @@ class AxisPid {
   bool saturated_ = false;
 };
 
-class PidApp final : public App {
+class PidApp final : public OpenModeApp {
  public:
-  enum class Phase : std::uint8_t { waiting, controlling, fading, exiting, done, refused };
-  enum : std::int32_t { kNoteStarted = 1, kNoteLeaving, kNoteDone };
 
   explicit PidApp(PidOptions options);
   [[nodiscard]] std::string_view name() const noexcept override { return "pid"; }
   [[nodiscard]] std::string status() const override;
   [[nodiscard]] std::string summary() const override;
-  [[nodiscard]] bool finished() const noexcept override { return phase() == Phase::done; }
   [[nodiscard]] bool drive_off_on_error() const noexcept override { return true; }
-  [[nodiscard]] Phase phase() const noexcept { return phase_.load(std::memory_order_acquire); }
   [[nodiscard]] double max_following_error() const noexcept { return max_error_.load(std::memory_order_relaxed); }
   [[nodiscard]] std::uint64_t saturated_cycles() const noexcept { return saturated_cycles_.load(std::memory_order_relaxed); }
   // Largest |D1 - D3| [motor turns] and |D5| [A] over the packets of a soft switch (T1..T3).
@@ -114,26 +110,26 @@ class PidApp final : public App {
   [[nodiscard]] std::string note_text(std::int32_t code) const override;
 
  private:
-  void set_phase(Phase p) noexcept { phase_.store(p, std::memory_order_release); }
+  // Mode 1: the hold point plus the faded sine; leaving, the exit once the robot has settled.
+  void advance_mode1(const protocol::Packet& req) noexcept;
+  // Every axis's loops for this cycle into the reply.
+  void control(const host::CycleContext& ctx, host::ReplyBuilder& reply) noexcept;
 
   PidOptions options_;
   std::optional<ArmView> view_;
-  std::atomic<Phase> phase_{Phase::waiting};
   std::atomic<double> max_error_{0};
   std::atomic<std::uint64_t> saturated_cycles_{0};
   std::atomic<double> max_switch_error_{0};
   std::atomic<double> max_switch_current_{0};
   std::atomic<double> factor_{0};
-  std::atomic<double> elapsed_{0};
   std::atomic<int> active_mode_{0};
   // Cycle thread.
   std::array<PidGains, protocol::kAxesPerArm> gains_{};
-  std::array<double, protocol::kAxesPerArm> amplitude_{}, frequency_{}, limit_{};
+  std::array<double, protocol::kAxesPerArm> limit_{};
+  SineExcitation sine_;
   std::array<AxisPid, protocol::kAxesPerArm> loops_{};
   std::array<double, protocol::kAxesPerArm> hold_{};      // motor position when mode 1 started
   std::array<double, protocol::kAxesPerArm> last_ref_{};  // last mode-1 target
-  double t_ = 0;
-  std::uint64_t ticks_ = 0;
   double env_ = 0;
   double settle_s_ = 0;  // time spent at the end of the fade waiting for the robot to settle
   static constexpr double kSettleTurns = 2e-4, kSettleTurnsPerS = 0.02, kMaxSettle_s = 1.0;

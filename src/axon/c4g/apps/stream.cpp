@@ -16,7 +16,14 @@ namespace {
 constexpr double kDeg = 180.0 / std::numbers::pi;
 }
 
-StreamApp::StreamApp(StreamOptions options) : options_(std::move(options)) {
+namespace {
+OpenModeApp::Style stream_style(const StreamOptions& o) {
+  return {.app = "stream", .waiting = "waiting for mode", .running = "playing", .mode = o.mode == 5 ? "5" : "4",
+          .rearm = o.rearm, .exiting_runs = true};
+}
+}  // namespace
+
+StreamApp::StreamApp(StreamOptions options) : OpenModeApp(stream_style(options)), options_(std::move(options)) {
   if (!options_.trajectory && options_.segments.empty())
     throw Exception(Error(CoreErrc::invalid_argument, "stream: no trajectory"));
   if (options_.trajectory && !options_.segments.empty())
@@ -34,14 +41,9 @@ StreamApp::StreamApp(StreamOptions options) : options_(std::move(options)) {
 }
 
 void StreamApp::setup(const protocol::InitPacket& init, const protocol::AxisMap& axes) {
-  if ((phase() == Phase::done && !options_.rearm) || phase() == Phase::refused) return;  // one run per serve
-  set_phase(Phase::waiting);
+  if (!begin_setup()) return;  // one run per serve (without re-arm)
   auto v = make_arm_view(init, axes, options_.arm);
-  if (!v) {
-    fail("stream: %s", v.error().detail.c_str());
-    set_phase(Phase::refused);
-    return;
-  }
+  if (!v) return refuse("stream: %s", v.error().detail.c_str());
   view_ = std::move(v).value();
   const double period = view_->period_s;
   period_.store(period, std::memory_order_relaxed);
@@ -49,10 +51,7 @@ void StreamApp::setup(const protocol::InitPacket& init, const protocol::AxisMap&
   if (options_.trajectory) tables_.push_back(Table{0, options_.trajectory, {}, 0});
   for (const auto& seg : options_.segments) tables_.push_back(Table{seg.motion_type, seg.trajectory, {}, 0});
   for (auto& t : tables_)
-    if (!build(*t.trajectory, t.motor, t.rows)) {
-      set_phase(Phase::refused);
-      return;
-    }
+    if (!build(*t.trajectory, t.motor, t.rows)) return set_phase(Phase::refused);
   table_ = tables_.front().motor.data();
   rows_ = tables_.front().rows;
   hold_cycles_ = static_cast<std::size_t>(std::ceil(options_.hold_s / period - 1e-9));
@@ -110,11 +109,10 @@ bool StreamApp::start(std::size_t idx, const protocol::Packet& req, bool from_co
     const double here = options_.relative ? 0.0 : link[static_cast<Eigen::Index>(j)];
     if (std::fabs(begin - here) > options_.start_tolerance_rad) {
       if (options_.relative)
-        fail("stream: start point: a relative trajectory must start at 0, axis %zu starts at %.3f deg", j + 1, begin * kDeg);
+        refuse("stream: start point: a relative trajectory must start at 0, axis %zu starts at %.3f deg", j + 1, begin * kDeg);
       else
-        fail("stream: start point: axis %zu is at %.3f deg, the trajectory%s starts at %.3f deg (tolerance %.3f deg)",
-             j + 1, here * kDeg, t.motion_type != 0 ? " segment" : "", begin * kDeg, options_.start_tolerance_rad * kDeg);
-      set_phase(Phase::refused);
+        refuse("stream: start point: axis %zu is at %.3f deg, the trajectory%s starts at %.3f deg (tolerance %.3f deg)",
+               j + 1, here * kDeg, t.motion_type != 0 ? " segment" : "", begin * kDeg, options_.start_tolerance_rad * kDeg);
       return false;
     }
   }
@@ -131,7 +129,7 @@ bool StreamApp::start(std::size_t idx, const protocol::Packet& req, bool from_co
   held_ = 0;
   hold_last_ = false;
   segment_.store(t.motion_type, std::memory_order_relaxed);
-  set_phase(Phase::playing);
+  set_phase(Phase::running);
   return true;
 }
 
@@ -146,89 +144,43 @@ double StreamApp::command(std::size_t j, double s) const noexcept {
   return base_[j] + p0 + a * (p1 - p0);
 }
 
-void StreamApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
-  if (!view_ || (rows_ == 0 && phase() != Phase::refused)) return;
-  const auto& req = ctx.request;
+void StreamApp::enter(const host::CycleContext& ctx) noexcept {
   const std::size_t n = view_->count, first = view_->first;
-  if (first + n > req.count) return;
-  const std::int32_t mode = options_.mode;
-  const std::int32_t standby = mode == 4 ? code(Mode::mode4_standby) : code(Mode::mode5_standby);
-  bool all_in = true;
-  for (std::size_t j = 0; j < n; ++j) all_in = all_in && req.axes[first + j].mode == mode;
-  const std::int32_t m0 = req.axes[first].mode;
-  Phase ph = phase();
-  if (ph == Phase::done && options_.rearm && m0 == code(Mode::mode0)) {
-    set_phase(Phase::waiting);
-    ph = Phase::waiting;
-  }
-
   const bool segmented = !options_.segments.empty();
   const std::uint8_t type = ctx.motion_type(view_->arm);
-  if (ph == Phase::waiting) {
-    if (!all_in || stop_requested()) return;
-    type_ = type;
-    played_ = false;
-    const std::size_t idx = segmented ? find(type) : 0;
-    if (idx == static_cast<std::size_t>(-1)) {
-      for (std::size_t j = 0; j < n; ++j) last_[j] = req.axes[first + j].d3;
-      hold_last_ = true;
-      set_phase(Phase::idle);
-      ph = Phase::idle;
-      note(kNoteUnknownType + type);
-    } else if (start(idx, req, false)) {
-      ph = Phase::playing;
-      played_ = true;
-      runs_.fetch_add(1, std::memory_order_relaxed);
-      note(segmented ? kNoteSegment + type : kNoteStarted);
-    } else {
-      ph = Phase::refused;
-    }
-  } else if (segmented && type != type_ && (ph == Phase::playing || ph == Phase::holding || ph == Phase::idle) && all_in) {
-    // The program picked another segment.
-    type_ = type;
-    const std::size_t idx = find(type);
-    if (type == 0 && played_) {
-      set_phase(Phase::exiting);
-      ph = Phase::exiting;
-      note(kNoteTypeCleared);
-    } else if (idx == static_cast<std::size_t>(-1)) {
-      hold_last_ = true;
-      set_phase(Phase::idle);
-      ph = Phase::idle;
-      note(kNoteUnknownType + type);
-    } else if (start(idx, req, true)) {
-      ph = Phase::playing;
-      played_ = true;
-      note(kNoteSegment + type);
-    } else {
-      ph = Phase::refused;
-    }
+  type_ = type;
+  played_ = false;
+  const std::size_t idx = segmented ? find(type) : 0;
+  if (idx == static_cast<std::size_t>(-1)) {
+    for (std::size_t j = 0; j < n; ++j) last_[j] = ctx.request.axes[first + j].d3;
+    hold_last_ = true;
+    set_phase(Phase::idle);
+    note(kNoteUnknownType + type);
+  } else if (start(idx, ctx.request, false)) {
+    played_ = true;
+    started(segmented ? kNoteSegment + type : kNoteStarted);
   }
+}
 
-  if (ph == Phase::refused) {
-    // Nothing moves: mode 4 holds (the server's safe reply: last target or actual position), mode 5
-    // adds nothing; leave the open mode.
-    if (all_in) exit_from_open(reply, view_->arm);
-    return;
+void StreamApp::change_segment(const host::CycleContext& ctx, std::uint8_t type) noexcept {
+  type_ = type;
+  const std::size_t idx = find(type);
+  if (type == 0 && played_) {
+    set_phase(Phase::exiting);
+    note(kNoteTypeCleared);
+  } else if (idx == static_cast<std::size_t>(-1)) {
+    hold_last_ = true;
+    set_phase(Phase::idle);
+    note(kNoteUnknownType + type);
+  } else if (start(idx, ctx.request, true)) {
+    played_ = true;
+    note(kNoteSegment + type);
   }
-  if (ph == Phase::done) return;
+}
 
-  if (ph == Phase::playing || ph == Phase::holding || ph == Phase::exiting || ph == Phase::idle) {
-    if (m0 == code(Mode::mode0) && ph == Phase::exiting) {
-      set_phase(Phase::done);
-      note(kNoteDone);
-      return;
-    }
-    if (!all_in && m0 != standby) {
-      fail("stream: the controller left mode %d during the trajectory (axis 1 of arm %zu in mode %d) at t=%.3f s", mode,
-           view_->arm, m0, s_ * view_->period_s);
-      set_phase(Phase::refused);
-      return;
-    }
-  }
-
-  // Advance.
-  if (ph == Phase::playing) {
+void StreamApp::advance_playback() noexcept {
+  const Phase ph = phase();
+  if (ph == Phase::running) {
     if (stop_requested() && rate_ == 1.0) note(kNoteStopping);
     if (stop_requested()) rate_ = std::max(0.0, rate_ - view_->period_s / std::max(options_.stop_ramp_s, view_->period_s));
     if (rate_ < 1e-9) rate_ = 0;
@@ -236,27 +188,48 @@ void StreamApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
     if (s_ >= static_cast<double>(rows_ - 1)) {
       s_ = static_cast<double>(rows_ - 1);
       set_phase(Phase::holding);
-      ph = Phase::holding;
       note(kNoteEnded);
     } else if (rate_ <= 0.0) {
       set_phase(Phase::exiting);
-      ph = Phase::exiting;
     }
   } else if (ph == Phase::holding || ph == Phase::idle) {
     // Segments: hold until the motion type changes (or a stop request).
-    if ((!segmented && ++held_ >= hold_cycles_) || stop_requested()) {
-      set_phase(Phase::exiting);
-      ph = Phase::exiting;
-    }
+    if ((options_.segments.empty() && ++held_ >= hold_cycles_) || stop_requested()) set_phase(Phase::exiting);
   }
-  if (m0 == standby) {
+}
+
+void StreamApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
+  if (!view_ || (rows_ == 0 && phase() != Phase::refused)) return;
+  const auto& req = ctx.request;
+  const std::size_t n = view_->count, first = view_->first;
+  const std::int32_t mode = options_.mode;
+  const std::int32_t standby = mode == 4 ? code(Mode::mode4_standby) : code(Mode::mode5_standby);
+  Gate g = gate_for(req, first, n, mode);
+  g.inside = g.entered || g.first_mode == standby;
+  const Turn turned = turn(g, reply, view_->arm);
+  if (turned == Turn::skip) return;
+  const std::uint8_t type = ctx.motion_type(view_->arm);
+  const Phase ph = phase();
+  if (turned == Turn::start) enter(ctx);
+  else if (!options_.segments.empty() && type != type_ && g.entered &&
+           (ph == Phase::running || ph == Phase::holding || ph == Phase::idle))
+    change_segment(ctx, type);  // the program picked another segment
+  if (phase() == Phase::refused) {
+    // Nothing moves: mode 4 holds (the server's safe reply: last target or actual position), mode 5
+    // adds nothing; leave the open mode.
+    if (g.entered) exit_from_open(reply, view_->arm);
+    return;
+  }
+  advance(view_->period_s);
+  advance_playback();
+  if (g.first_mode == standby) {
     // Leaving (4' / 5'): hold the last target, no increments.
     for (std::size_t j = 0; j < n; ++j) {
       auto& r = reply.axis(first + j);
       r.d1 = mode == 4 ? static_cast<float>(last_[j]) : 0.0f;
       r.d2 = 0;
     }
-    if (ph == Phase::playing || ph == Phase::holding) set_phase(Phase::exiting);
+    if (phase() == Phase::running || phase() == Phase::holding) set_phase(Phase::exiting);
     return;
   }
   for (std::size_t j = 0; j < n; ++j) {
@@ -268,22 +241,18 @@ void StreamApp::step(const host::CycleContext& ctx, host::ReplyBuilder& reply) {
     last_[j] = c;
   }
   progress_.store(s_, std::memory_order_relaxed);
-  if (ph == Phase::exiting) exit_from_open(reply, view_->arm);
+  if (phase() == Phase::exiting) exit_from_open(reply, view_->arm);
 }
 
 void StreamApp::silence() noexcept {
   const Phase p = phase();
-  if (p == Phase::playing || p == Phase::holding) {
-    fail("stream: packets stopped during the trajectory");
-    set_phase(Phase::refused);
-  }
+  if (p == Phase::running || p == Phase::holding) refuse("stream: packets stopped during the trajectory");
 }
 
 std::string StreamApp::note_text(std::int32_t c) const {
   switch (c) {
     case kNoteStarted: return fmt::format("stream: trajectory started (mode {}, arm {}, {} cycles)", options_.mode, options_.arm, rows_);
     case kNoteEnded: return "stream: trajectory ended, holding the last point";
-    case kNoteDone: return "stream: done, the arm is back in mode 0";
     case kNoteStopping: return "stream: stop requested, slowing down to rest";
     case kNoteTypeCleared: return "stream: motion type 0: the segments are over, leaving the open mode";
     default:
@@ -294,23 +263,21 @@ std::string StreamApp::note_text(std::int32_t c) const {
         return fmt::format("stream: segment for motion type {} started (mode {}, arm {}, {} cycles)", c - kNoteSegment,
                            options_.mode, options_.arm, i < tables_.size() ? tables_[i].rows : 0);
       }
-      return App::note_text(c);
+      return OpenModeApp::note_text(c);
   }
 }
 
 std::string StreamApp::status() const {
-  static constexpr std::string_view names[] = {"waiting for mode", "playing", "holding", "exiting", "done", "refused", "holding (no segment)"};
   const double period = period_.load(std::memory_order_relaxed);
-  return App::status() + fmt::format(" {} t={:.3f}/{:.3f} s", names[static_cast<int>(phase())], progress() * period,
+  const std::string_view text = phase() == Phase::idle ? "holding (no segment)" : phase_text();
+  return App::status() + fmt::format(" {} t={:.3f}/{:.3f} s", text, progress() * period,
                                      rows_ > 0 ? static_cast<double>(rows_ - 1) * period : 0.0);
 }
 
 std::string StreamApp::summary() const {
-  static constexpr std::string_view names[] = {"waiting", "playing", "holding", "exiting", "done", "refused", "idle"};
   const double period = period_.load(std::memory_order_relaxed);
   return App::summary() + fmt::format("stream: played {:.3f} s of {:.3f} s, phase {}\n", progress() * period,
-                                      rows_ > 0 ? static_cast<double>(rows_ - 1) * period : 0.0,
-                                      names[static_cast<int>(phase())]);
+                                      rows_ > 0 ? static_cast<double>(rows_ - 1) * period : 0.0, to_string(phase()));
 }
 
 }  // namespace axon::c4g::apps

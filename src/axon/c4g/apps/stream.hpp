@@ -6,14 +6,14 @@
 // cycles may exceed max_motor_speed x period on any axis; a trajectory that does is refused before
 // anything moves.
 //
-// Cycle:
+// Cycle (the phases of open_mode.hpp):
 //   - waiting: until every axis of the arm is in the chosen mode. Then the start-point check: the
 //     robot's actual position (D3, converted to the link side) must match the trajectory's first
 //     row within start_tolerance (or, with `relative`, the trajectory is taken as offsets from that
 //     position and its first row must be zero). A mismatch refuses: nothing moves, exit from open.
-//   - playing: one table row per cycle. Mode 4 sends the absolute target (D1) and the change since
-//     the previous cycle (D2, delta motor turns); mode 5 sends that change as the position increment
-//     (D1) and as velocity (D2): the controller integrates it.
+//   - playing (Phase::running): one table row per cycle. Mode 4 sends the absolute target (D1)
+//     and the change since the previous cycle (D2, delta motor turns); mode 5 sends that change as
+//     the position increment (D1) and as velocity (D2): the controller integrates it.
 //   - holding: the last point for hold_s, then exit from open until the controller is back in
 //     mode 0 (through 4' / 5'), which finishes the app.
 //   - a stop request slows the playback down to rest over stop_ramp_s (along the path), then exits
@@ -31,7 +31,7 @@
 // opens the same mode several times; `--app handover` uses it).
 #pragma once
 
-#include "axon/c4g/apps/app.hpp"
+#include "axon/c4g/apps/open_mode.hpp"
 #include "axon/c4g/apps/trajectory.hpp"
 
 #include <memory>
@@ -62,12 +62,13 @@ struct StreamOptions {
   bool rearm = false;
 };
 
-class StreamApp final : public App {
+// Phases (open_mode.hpp): running while playing the table, holding its last point, idle while a
+// motion type without a segment holds the last command.
+class StreamApp final : public OpenModeApp {
  public:
-  enum class Phase : std::uint8_t { waiting, playing, holding, exiting, done, refused, idle };
   // Note codes (segments: base + motion type).
   enum : std::int32_t {
-    kNoteStarted = 1, kNoteEnded, kNoteDone, kNoteStopping, kNoteTypeCleared,
+    kNoteEnded = kFirstAppNote, kNoteStopping, kNoteTypeCleared,
     kNoteSegment = 1000, kNoteUnknownType = 2000,
   };
 
@@ -75,10 +76,6 @@ class StreamApp final : public App {
   [[nodiscard]] std::string_view name() const noexcept override { return "stream"; }
   [[nodiscard]] std::string status() const override;
   [[nodiscard]] std::string summary() const override;
-  [[nodiscard]] bool finished() const noexcept override { return !options_.rearm && phase() == Phase::done; }
-  // Runs the trajectory played so far (any thread).
-  [[nodiscard]] std::uint64_t runs() const noexcept { return runs_.load(std::memory_order_relaxed); }
-  [[nodiscard]] Phase phase() const noexcept { return phase_.load(std::memory_order_acquire); }
   [[nodiscard]] std::size_t table_rows() const noexcept { return rows_; }
   // Motion type of the segment played last (0: none yet, or no segments); any thread.
   [[nodiscard]] std::uint8_t segment() const noexcept { return segment_.load(std::memory_order_relaxed); }
@@ -92,7 +89,12 @@ class StreamApp final : public App {
   [[nodiscard]] std::string note_text(std::int32_t code) const override;
 
  private:
-  void set_phase(Phase p) noexcept { phase_.store(p, std::memory_order_release); }
+  // Entering the mode (Turn::start): the table of the motion type, or idle without one.
+  void enter(const host::CycleContext& ctx) noexcept;
+  // A new motion type while in the mode (segments).
+  void change_segment(const host::CycleContext& ctx, std::uint8_t type) noexcept;
+  // Advances the playback one cycle (stop ramp, end of table, hold time).
+  void advance_playback() noexcept;
   // Motor position of the arm's axis j at fractional row s (base included).
   double command(std::size_t j, double s) const noexcept;
   // Samples one trajectory into a table (set-up); false after fail().
@@ -118,10 +120,8 @@ class StreamApp final : public App {
   std::uint8_t type_ = 0;          // motion type seen last (segments)
   bool played_ = false;            // a segment was played in this entry
   bool hold_last_ = false;         // no segment: hold the last command
-  std::atomic<Phase> phase_{Phase::waiting};
   std::atomic<double> progress_{0};
   std::atomic<double> period_{0.001};  // for status()
-  std::atomic<std::uint64_t> runs_{0};
   // Cycle thread.
   std::array<double, protocol::kAxesPerArm> base_{};  // motor offset: calibration, or start position
   std::array<double, protocol::kAxesPerArm> last_{};  // last commanded motor position

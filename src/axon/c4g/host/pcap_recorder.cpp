@@ -1,5 +1,6 @@
 #include "axon/c4g/host/pcap_recorder.hpp"
 
+#include "axon/c4g/protocol/init_packet.hpp"
 #include "axon/net/udp_frame.hpp"
 
 #include <boost/lockfree/spsc_queue.hpp>
@@ -176,6 +177,32 @@ void PcapRecorder::close() {
   impl_->wake_cv.notify_one();
   if (impl_->writer.joinable()) impl_->writer.join();
   impl_.reset();
+}
+
+Result<std::vector<std::byte>> read_init_packet(const std::string& path) {
+  char err[PCAP_ERRBUF_SIZE] = {};
+  pcap_t* p = pcap_open_offline(path.c_str(), err);
+  if (!p) return Error(CoreErrc::invalid_argument, fmt::format("cannot read capture {}: {}", path, err));
+  constexpr std::size_t kInitSize = protocol::kInitPacketSize;
+  std::vector<std::byte> out;
+  const int link = pcap_datalink(p);
+  pcap_pkthdr* hdr = nullptr;
+  const u_char* data = nullptr;
+  while (out.empty() && pcap_next_ex(p, &hdr, &data) == 1) {
+    std::size_t off = link == DLT_EN10MB ? 14 : (link == DLT_RAW ? 0 : SIZE_MAX);
+    if (off == SIZE_MAX || hdr->caplen < off + 28) continue;
+    if (link == DLT_EN10MB && (data[12] != 0x08 || data[13] != 0x00)) continue;
+    const std::size_t ihl = (data[off] & 0x0F) * 4u;
+    if ((data[off] >> 4) != 4 || data[off + 9] != 17) continue;
+    const std::size_t udp = off + ihl;
+    const std::size_t len = (static_cast<std::size_t>(data[udp + 4]) << 8 | data[udp + 5]);
+    if (len != 8 + kInitSize || hdr->caplen < udp + len) continue;
+    const auto* payload = reinterpret_cast<const std::byte*>(data + udp + 8);
+    out.assign(payload, payload + kInitSize);
+  }
+  pcap_close(p);
+  if (out.empty()) return Error(CoreErrc::invalid_argument, fmt::format("{}: no 1200-byte initialization packet in the capture", path));
+  return out;
 }
 
 }  // namespace axon::c4g::host

@@ -22,6 +22,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace axon::c4g::host {
 
@@ -93,5 +94,10 @@ class PcapRecorder {
   std::atomic<bool> stop_{false};
   std::atomic<bool> closed_{false};
 };
+
+// The first 1200-byte UDP payload of a capture (Ethernet or raw IPv4, UDP): the controller's
+// initialization packet as PcapRecorder or tcpdump on an Ethernet interface recorded it.
+// invalid_argument naming the file when it cannot be read or holds none.
+Result<std::vector<std::byte>> read_init_packet(const std::string& pcap_path);
 
 }  // namespace axon::c4g::host

@@ -116,18 +116,18 @@ struct ServerOptions {
   // unknown until then); the initialization packet's period wins.
   std::chrono::nanoseconds period{0};
   protocol::ReplyNumbering numbering = protocol::ReplyNumbering::same;
-  net::UdpOptions udp;
-  CycleOptions cycle;
-  SafetyConfig safety;
-  std::string pcap_path;  // empty: no recording
-  PcapOptions pcap;
+  net::UdpOptions udp{};
+  CycleOptions cycle{};
+  SafetyConfig safety{};
+  std::string pcap_path{};  // empty: no recording
+  PcapOptions pcap{};
   // Controller budget: a call longer than this counts as late; this many late calls in a row
   // latch a fault (0 disables).
   std::chrono::nanoseconds controller_budget = std::chrono::microseconds(400);
   int max_late_cycles = 3;
   // Soft control switching intervals T1, T2, T3 of the controller (the PC infers the switch's phase
   // from the modes and these; they must match the controller's configuration).
-  protocol::SwitchTimes soft_switch;
+  protocol::SwitchTimes soft_switch{};
 };
 
 enum class ServerState : std::uint8_t {
