@@ -240,14 +240,22 @@ TEST(MotionLock, ReadsSettingsAndStopsStillGoOutWhileLocked) {
     co_await t.lock();
     CommandClient& client = t.rig.array->client(0);
     Positioner* p = t.rig.array->find(3);
-    EXPECT_TRUE((co_await p->read_status()).has_value());
-    EXPECT_TRUE((co_await p->read_position()).has_value());
-    EXPECT_TRUE((co_await p->set_speed(1000, 1000)).has_value());
-    EXPECT_TRUE((co_await p->set_collision_margin(10, 20)).has_value());
-    EXPECT_TRUE((co_await p->set_loop(Arm::beta, Loop::open, false)).has_value());
-    EXPECT_TRUE((co_await p->abort()).has_value());
-    EXPECT_TRUE((co_await p->stop()).has_value());
-    EXPECT_TRUE((co_await client.broadcast_now(CommandId::trajectory_abort)).has_value());
+    const bool ok1 = (co_await p->read_status()).has_value();
+    EXPECT_TRUE(ok1);
+    const bool ok2 = (co_await p->read_position()).has_value();
+    EXPECT_TRUE(ok2);
+    const bool ok3 = (co_await p->set_speed(1000, 1000)).has_value();
+    EXPECT_TRUE(ok3);
+    const bool ok4 = (co_await p->set_collision_margin(10, 20)).has_value();
+    EXPECT_TRUE(ok4);
+    const bool ok5 = (co_await p->set_loop(Arm::beta, Loop::open, false)).has_value();
+    EXPECT_TRUE(ok5);
+    const bool ok6 = (co_await p->abort()).has_value();
+    EXPECT_TRUE(ok6);
+    const bool ok7 = (co_await p->stop()).has_value();
+    EXPECT_TRUE(ok7);
+    const bool ok8 = (co_await client.broadcast_now(CommandId::trajectory_abort)).has_value();
+    EXPECT_TRUE(ok8);
     auto st = co_await client.broadcast(CommandId::get_status);
     EXPECT_TRUE(st.has_value());
     EXPECT_GT(t.on_wire(CommandId::get_status), 0u);
@@ -355,9 +363,12 @@ TEST(MotionLock, AClientWithALockOfItsOwnRefusesMovesCountsThemAndLetsTheRestThr
     EXPECT_EQ(client.counters().sent, 0u);
     EXPECT_TRUE(device.requests().empty());
     // Stops and settings go out.
-    EXPECT_TRUE((co_await client.request(7, CommandId::stop_trajectory)).has_value());
-    EXPECT_TRUE((co_await client.request(7, CommandId::set_speed, zeros_for(CommandId::set_speed))).has_value());
-    EXPECT_TRUE((co_await client.broadcast_now(CommandId::trajectory_abort)).has_value());
+    const bool ok9 = (co_await client.request(7, CommandId::stop_trajectory)).has_value();
+    EXPECT_TRUE(ok9);
+    const bool ok10 = (co_await client.request(7, CommandId::set_speed, zeros_for(CommandId::set_speed))).has_value();
+    EXPECT_TRUE(ok10);
+    const bool ok11 = (co_await client.broadcast_now(CommandId::trajectory_abort)).has_value();
+    EXPECT_TRUE(ok11);
     // Released: the same moves go out.
     lock->clear();
     EXPECT_FALSE(lock->locked());
