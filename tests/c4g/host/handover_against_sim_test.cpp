@@ -97,7 +97,6 @@ Outcome run_example(const H::Server& server) {
   EXPECT_TRUE(udp);
   S::RunOptions ro;
   ro.duration_s = 30;
-  ro.reply_deadline = std::chrono::milliseconds(20);
   ro.on_event = [&](const S::Event& e) { o.events.push_back(e); };
   S::run_client(c.value(), udp.value(), ro);
   o.done = c.value().scenario_done();
