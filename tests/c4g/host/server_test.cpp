@@ -195,8 +195,8 @@ TEST(Server, ControllerSeesTheTypedPacketAndItsReplyGoesOut) {
     }
   };
   auto req = cyclic(20, code(Mode::mode4));
-  req.axes[0].d3 = 1.0f;
-  req.axes[1].d3 = -2.0f;
+  req.axes[0].d1 = req.axes[0].d3 = 1.0f;  // at rest: the controller's target is where the axis is
+  req.axes[1].d1 = req.axes[1].d3 = -2.0f;
   const auto a = rig.peer.ask(req);
   EXPECT_EQ(a.num, 20);
   EXPECT_EQ(a.axes[0].mode, code(Mode::mode4));
@@ -384,7 +384,9 @@ TEST(Server, SafeReplyHoldsTheLastAbsoluteTarget) {
   Rig rig;
   rig.init();
   rig.controller.law = [](const CycleContext&, ReplyBuilder& r) { r.axis(0).d1 = 2.5f; };
-  EXPECT_FLOAT_EQ(rig.peer.ask(cyclic(100, code(Mode::mode4))).axes[0].d1, 2.5f);
+  auto first = cyclic(100, code(Mode::mode4));
+  first.axes[0].d1 = 2.45f;  // the controller's target: the PC's first target continues from it
+  EXPECT_FLOAT_EQ(rig.peer.ask(first).axes[0].d1, 2.5f);
   // A controller that leaves the reply as given sends the safe reply: the held target, not zero.
   rig.controller.law = nullptr;
   EXPECT_FLOAT_EQ(rig.peer.ask(cyclic(101, code(Mode::mode4))).axes[0].d1, 2.5f);

@@ -273,9 +273,11 @@ void Server::build_safe_reply(const protocol::Packet& req, protocol::Packet& rep
         r.d1 = q.d1;
         r.d2 = q.d2;
         break;
+      case code(Mode::mode1):
+      case code(Mode::mode1_standby):
       case code(Mode::mode4):
-      case code(Mode::mode4_standby):  // absolute target: hold it, never command zero
-        r.d1 = have_target_[i] ? last_target_[i] : q.d3;
+      case code(Mode::mode4_standby):  // absolute target: hold it (else the controller's), never command zero
+        r.d1 = have_target_[i] ? last_target_[i] : q.d1;
         break;
       default: break;  // increments and contributions: zero is "no change"
     }
@@ -316,7 +318,8 @@ void Server::enforce_mode_rules(const protocol::Packet& req, protocol::Packet& r
 std::size_t Server::encode(const protocol::Packet& req, protocol::Packet& rep, std::span<std::byte> out) noexcept {
   // Remember absolute targets so a later safe reply holds them.
   for (std::size_t i = 0; i < rep.count; ++i) {
-    if (req.axes[i].mode == code(Mode::mode4) || req.axes[i].mode == code(Mode::mode4_standby)) {
+    const std::int32_t m = req.axes[i].mode;
+    if (m == code(Mode::mode4) || m == code(Mode::mode4_standby) || m == code(Mode::mode1) || m == code(Mode::mode1_standby)) {
       last_target_[i] = rep.axes[i].d1;
       have_target_[i] = true;
     } else {

@@ -25,8 +25,9 @@
 //
 // Safe reply (used before the controller runs, when it throws, when it is faulted): every axis
 // echoes its mode; data are zero except where zero would move the robot: mode 0' echoes targets
-// (the manual's echo test), modes 4/4' hold the last commanded target (else the actual position).
-// Modes 1 and 2 (PC closes the loops) have no passive safe reply: a fault there asks for drive off.
+// (the manual's echo test), modes 1/1' and 4/4' hold the last commanded target (else the
+// controller's own target D1, so that nothing jumps). Modes 1 and 2 (PC closes the loops) have no passive safe current: a fault there asks
+// for drive off.
 #pragma once
 
 #include "axon/c4g/host/cycle_thread.hpp"
