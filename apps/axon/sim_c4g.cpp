@@ -116,7 +116,7 @@ int run_sim_c4g(const SimC4gArgs& o) {
 void add_sim_c4g_command(CLI::App& sim_cmd) {
   auto o = std::make_shared<SimC4gArgs>();
   auto* c = sim_cmd.add_subcommand("c4g", "simulated C4G controller (open interface client) playing a robot program");
-  c->add_option("--robot", o->robot, "robot model (six-axis)");
+  c->add_option("--robot", o->robot, "robot: six-axis (the manual's example), or a file: a captured 1200-byte initialization packet or its fields in YAML (docs/c4g-simulator.md)");
   c->add_option("--server", o->server, "the PC server HOST[:PORT] (default 127.0.0.1:11000, where `axon c4g serve` listens by default; a host alone: the manual's port 1000)");
   c->add_option("--bind", o->bind, "local HOST:PORT of the controller (default: any)");
   c->add_option("--period-ms", o->period_ms, "controller period, 1 or 2 ms (default: the robot's, 2)")->check(CLI::Range(1, 2));

@@ -109,6 +109,7 @@ std::unique_ptr<H::Server> start(HandoverPc& pc) {
   H::ServerOptions o;
   o.listen = net::Endpoint{"127.0.0.1", 0};
   o.max_late_cycles = 0;
+  o.verify_reply_fields = true;  // no reply may carry data in a field its mode does not use
   auto s = H::Server::start(pc, o);
   EXPECT_TRUE(s) << s.error().detail;
   return std::move(s).value();

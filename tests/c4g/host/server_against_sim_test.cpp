@@ -53,6 +53,7 @@ class TestController : public H::Controller {
 std::unique_ptr<H::Server> start_server(H::Controller& c, H::ServerOptions o = {}) {
   o.listen = net::Endpoint{"127.0.0.1", 0};
   o.max_late_cycles = 0;  // a loaded test machine must not trip the lateness check
+  o.verify_reply_fields = true;  // no reply may carry data in a field its mode does not use
   auto s = H::Server::start(c, o);
   if (!s) ADD_FAILURE() << s.error().detail;
   return std::move(s).value();

@@ -23,6 +23,7 @@ apps::ServeOptions loopback() {
   apps::ServeOptions o;
   o.server.listen = net::Endpoint{"127.0.0.1", 0};
   o.server.max_late_cycles = 0;  // a loaded test machine must not trip the lateness check
+  o.server.verify_reply_fields = true;  // no reply may carry data in a field its mode does not use
   o.stop_timeout_s = 2;
   o.until_controller_ends = true;  // answer the program's last cycles too
   return o;

@@ -130,35 +130,36 @@ TEST(C4gSimUdp, ASilentPcEndsInTheCommunicationError) {
 // A PC that always answers 1 ms after the send: within a period of 2 ms, but twice the manual's
 // T_CYCLE1. The controller's window (the default) takes each of its replies as a miss and the late
 // answer as late, and ends in the communication error after 10; the lenient window lets it pass.
+struct SlowPcRun {
+  Controller c = make_controller("steps:\n  - drive_on\n  - delay: 0.1\n");
+  RunReport report;
+  explicit SlowPcRun(ReplyWindow window) {
+    EchoPc pc;
+    pc.reply_delay_us = 1000;
+    auto udp = UdpClient::open(net::Endpoint{"127.0.0.1", pc.port()});
+    EXPECT_TRUE(udp.has_value());
+    RunOptions o;
+    o.window = window;
+    o.duration_s = 30;
+    if (udp) report = run_client(c, udp.value(), o);
+  }
+};
+
 TEST(C4gSimUdp, AReplyAfterTheManualsWindowIsAMissAndTenOfThemTheCommunicationError) {
-  EchoPc pc;
-  pc.reply_delay_us = 1000;
-  auto c = make_controller("steps:\n  - drive_on\n  - delay: 0.1\n");
-  auto udp = UdpClient::open(net::Endpoint{"127.0.0.1", pc.port()});
-  ASSERT_TRUE(udp.has_value());
-  RunOptions o;  // the manual's window
-  o.duration_s = 30;
-  const auto report = run_client(c, udp.value(), o);
-  EXPECT_EQ(report.window_ns, 500'000);
-  EXPECT_TRUE(c.communication_error());
-  EXPECT_EQ(c.stats().max_consecutive_misses, 10u);
-  EXPECT_GE(c.stats().late_replies, 9u);  // each missed packet's reply, when it came
-  EXPECT_EQ(c.stats().replies_ok, 3u);  // the three sync packets only: no cyclic reply was in time
+  const SlowPcRun run(ReplyWindow::manual);
+  const auto& s = run.c.stats();
+  EXPECT_EQ(run.report.window_ns, 500'000);
+  EXPECT_TRUE(run.c.communication_error());
+  EXPECT_EQ(s.max_consecutive_misses, 10u);
+  EXPECT_GE(s.late_replies, 9u);  // each missed packet's reply, when it came
+  EXPECT_EQ(s.replies_ok, 3u);    // the three sync packets only: no cyclic reply was in time
 }
 
 TEST(C4gSimUdp, TheLenientWindowOfAPeriodAcceptsTheSlowPc) {
-  EchoPc pc;
-  pc.reply_delay_us = 1000;
-  auto c = make_controller("steps:\n  - drive_on\n  - delay: 0.1\n");
-  auto udp = UdpClient::open(net::Endpoint{"127.0.0.1", pc.port()});
-  ASSERT_TRUE(udp.has_value());
-  RunOptions o;
-  o.window = ReplyWindow::period;
-  o.duration_s = 30;
-  const auto report = run_client(c, udp.value(), o);
-  EXPECT_EQ(report.window_ns, 2'000'000);
-  EXPECT_FALSE(c.communication_error());
-  EXPECT_TRUE(c.scenario_done()) << c.scenario_error();
+  const SlowPcRun run(ReplyWindow::period);
+  EXPECT_EQ(run.report.window_ns, 2'000'000);
+  EXPECT_FALSE(run.c.communication_error());
+  EXPECT_TRUE(run.c.scenario_done()) << run.c.scenario_error();
 }
 
 TEST(C4gSimUdp, TheManualWindowIsNeverLongerThanThePeriodAndAnExplicitOneWins) {

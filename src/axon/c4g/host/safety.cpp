@@ -22,6 +22,7 @@ std::string_view to_string(FaultReason r) noexcept {
     case FaultReason::stroke_end: return "commanded position beyond a stroke end";
     case FaultReason::discontinuity: return "commanded position jumped more than the allowed step";
     case FaultReason::not_finite: return "reply holds a value that is not finite";
+    case FaultReason::unused_field: return "reply carries data in a field its mode does not use";
     case FaultReason::controller_exception: return "controller threw an exception";
     case FaultReason::controller_late: return "controller overran its budget";
     case FaultReason::bad_packet: return "malformed packet from the robot controller";

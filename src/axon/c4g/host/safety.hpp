@@ -52,6 +52,7 @@ enum class FaultReason : std::uint8_t {
   stroke_end,           // commanded position outside the configured range
   discontinuity,        // commanded position jumped more than the allowed step
   not_finite,           // NaN or infinity in a reply
+  unused_field,         // a reply field the mode does not use is not zero (ServerOptions::verify_reply_fields)
   controller_exception, // the user's controller threw
   controller_late,      // the user's controller overran its budget too many cycles in a row
   bad_packet,           // the controller sent a packet that does not decode

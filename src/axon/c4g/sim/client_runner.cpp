@@ -29,8 +29,10 @@ struct LateReply {
 // Sends this tick's packet and collects the replies that arrive within the window.
 void exchange(Controller& c, UdpClient& udp, std::span<const std::byte> d, Clock::duration window, RunReport& report,
               std::array<std::byte, 2048>& buf, LateReply& late) {
-  const auto sent_at = Clock::now();  // before the send: the window includes the send itself
   if (auto r = udp.send(d); !r) c.on_send_failed(r.error().detail);
+  // The window starts once the datagram is out: a simulator preempted before or inside the send
+  // must not charge its own delay to the PC (a reply may even arrive before this: rtt 0).
+  const auto sent_at = Clock::now();
   const auto deadline = sent_at + window;
   while (c.awaiting_reply() && !c.reply_received()) {
     auto got = udp.receive(buf, deadline);

@@ -32,7 +32,7 @@ namespace axon::c4g::sim {
 struct SimulatedControllerOptions {
   std::string server = "127.0.0.1:11000";  // the PC server, HOST[:PORT] (a host alone: port 1000)
   std::string bind{};                      // the controller's local HOST:PORT (empty: any)
-  std::string robot = "six-axis";          // robots.hpp
+  std::string robot = "six-axis";          // robots.hpp: a name, or a robot file (robot_file.hpp)
   // The robot program (scenario.hpp): YAML text, or a file; neither: the default program.
   std::string scenario_yaml{};
   std::string scenario_file{};
