@@ -53,6 +53,8 @@ struct ServeArgs {
   std::vector<int> cpus;
   bool busy_poll = false;
   double max_step = 0;
+  std::vector<std::string> stroke_ends;  // [ARM.]AXIS=MIN:MAX [deg]
+  bool no_stroke_ends = false, no_continuity_check = false, no_following_error_check = false;
   double duration_s = 0;
   double status_interval_s = 1.0;
   double stop_timeout_s = 5.0;
@@ -113,6 +115,11 @@ apps::ServeOptions serve_options(const ServeArgs& o) {
   so.udp.busy_poll = o.busy_poll;
   if (o.max_step > 0)
     for (auto& a : so.safety.axes) a.max_step = static_cast<float>(o.max_step);
+  so.safety.max_motor_speed = o.app.max_motor_speed;
+  for (const auto& spec : o.stroke_ends) need(host::parse_stroke_end(spec, o.app.arm, so.safety));
+  so.safety.check_stroke_ends = !o.no_stroke_ends;
+  so.safety.check_continuity = !o.no_continuity_check;
+  so.safety.check_following_error = !o.no_following_error_check;
   if (o.csv.empty() && o.moni >= 0) throw bad("--moni needs --csv FILE");
   s.csv = o.csv;
   s.moni = o.moni < 0 ? 0 : o.moni;
@@ -223,7 +230,7 @@ void add_serve(CLI::App* c4g) {
   s->add_option("--units", o->app.units, "angles in the CSV: rad or deg (else the file's '# units:' line, else rad)");
   s->add_flag("--relative", o->app.relative, "stream: the trajectory is offsets from the robot's position at the start");
   s->add_option("--start-tolerance", o->app.start_tolerance_deg, "stream: start-point tolerance [deg] (default 0.5)")->check(non_negative());
-  s->add_option("--max-motor-speed", o->app.max_motor_speed, "continuity limit [motor turns/s] (default 100)")->check(positive());
+  s->add_option("--max-motor-speed", o->app.max_motor_speed, "continuity limit [motor turns/s] of the apps and of Safety (default 100)")->check(positive());
   s->add_option("--arm", o->app.arm, "the arm the application drives (default 1)")->check(CLI::Range(1, 4));
   s->add_option("--amplitude", o->app.amplitude, "correct/pid: sine amplitude per axis [deg, link side]; contribute: [motor turns/s] (mode 8) or [A] (mode 9)")->delimiter(',');
   s->add_option("--frequency", o->app.frequency_hz, "correct/pid: sine frequency per axis [Hz] (default 0.5)")->delimiter(',')->check(non_negative());
@@ -252,7 +259,11 @@ void add_serve(CLI::App* c4g) {
   s->add_option("--rt-priority", o->rt_priority, "SCHED_FIFO priority of the cycle thread (and mlockall)")->check(CLI::Range(0, 99));
   s->add_option("--cpu", o->cpus, "pin the cycle thread to this CPU (repeatable)");
   s->add_flag("--busy-poll", o->busy_poll, "spin on the socket instead of sleeping (a dedicated core)");
-  s->add_option("--max-step", o->max_step, "Safety: max change of a commanded position per cycle [motor turns] (0: off)")->check(non_negative());
+  s->add_option("--max-step", o->max_step, "Safety: max change of a commanded position per cycle [motor turns] (default: --max-motor-speed x the period)")->check(non_negative());
+  s->add_option("--stroke-end", o->stroke_ends, "Safety: a joint's stroke ends at the link, [ARM.]AXIS=MIN:MAX [deg] (arm: --arm's; default -180:180 for every joint); repeatable");
+  s->add_flag("--no-stroke-ends", o->no_stroke_ends, "Safety: do not check the stroke ends (the manual makes them the PC's job)");
+  s->add_flag("--no-continuity-check", o->no_continuity_check, "Safety: do not check the continuity of commanded positions");
+  s->add_flag("--no-following-error-check", o->no_following_error_check, "Safety: do not check the following error in modes 1, 2, 4 and 5");
   s->add_option("--duration", o->duration_s, "stop after this many seconds (default: until Ctrl-C or the app finishes)")->check(non_negative());
   s->add_option("--status-interval", o->status_interval_s, "seconds between status lines (0: none; default 1)")->check(non_negative());
   s->add_option("--stop-timeout", o->stop_timeout_s, "seconds to wait for mode 0 when stopping before drive off (default 5)")->check(non_negative());

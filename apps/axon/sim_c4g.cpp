@@ -29,6 +29,7 @@ struct SimC4gArgs {
   std::string scenario;
   double duration_s = 0;
   double reply_deadline_us = 0;
+  bool lenient_timing = false;
   std::string numbering = "same";
   int sync_packets = 3;
   bool json = false;
@@ -49,6 +50,7 @@ sim::SimulatedControllerOptions sim_options(const SimC4gArgs& o) {
   s.controller.sync_packets = o.sync_packets;
   if (o.numbering == "next") s.controller.numbering = c4g::protocol::ReplyNumbering::next;
   else if (o.numbering != "same") throw Exception(Error(CoreErrc::invalid_argument, "--numbering is same or next"));
+  if (o.lenient_timing) s.reply_window = sim::ReplyWindow::period;
   if (o.reply_deadline_us > 0) s.reply_deadline = std::chrono::nanoseconds(static_cast<std::int64_t>(o.reply_deadline_us * 1000));
   s.switch_t1_s = o.switch_t1_ms >= 0 ? o.switch_t1_ms * 1e-3 : -1;
   s.switch_t2_s = o.switch_t2_ms >= 0 ? o.switch_t2_ms * 1e-3 : -1;
@@ -76,7 +78,7 @@ nlohmann::json report_json(const sim::SimulatedControllerReport& r) {
           {"max_consecutive_misses", s.max_consecutive_misses}, {"late_replies", s.late_replies},
           {"wrong_number", s.wrong_number}, {"wrong_size", s.wrong_size}, {"malformed", s.malformed},
           {"frozen_cycles", s.frozen_cycles}, {"refused_requests", s.refused_requests},
-          {"saturated_cycles", s.saturated_cycles}, {"overruns", r.overruns},
+          {"saturated_cycles", s.saturated_cycles}, {"overruns", r.overruns}, {"reply_window_us", r.reply_window_us},
           {"rtt_us", {{"count", r.rtt_count}, {"min", r.rtt_min_us}, {"mean", r.rtt_mean_us}, {"p50", r.rtt_p50_us},
                       {"p99", r.rtt_p99_us}, {"p999", r.rtt_p999_us}, {"max", r.rtt_max_us}}},
           {"events", events}};
@@ -91,8 +93,8 @@ void print_text(const sim::SimulatedControllerReport& r) {
               r.outcome_text.c_str(), r.elapsed_s, u(s.ticks), u(s.packets_sent), u(s.sync_sent), u(s.init_sent),
               u(s.replies_ok), u(s.misses), u(s.max_consecutive_misses), u(s.late_replies), u(s.wrong_number),
               u(s.wrong_size), u(s.malformed), u(r.overruns));
-  std::printf("rtt: %llu samples, p50 %.1f us, p99 %.1f us, max %.1f us\n", u(r.rtt_count), r.rtt_p50_us, r.rtt_p99_us,
-              r.rtt_max_us);
+  std::printf("rtt: %llu samples, p50 %.1f us, p99 %.1f us, max %.1f us; reply window %.0f us\n", u(r.rtt_count),
+              r.rtt_p50_us, r.rtt_p99_us, r.rtt_max_us, r.reply_window_us);
 }
 
 int run_sim_c4g(const SimC4gArgs& o) {
@@ -114,13 +116,14 @@ int run_sim_c4g(const SimC4gArgs& o) {
 void add_sim_c4g_command(CLI::App& sim_cmd) {
   auto o = std::make_shared<SimC4gArgs>();
   auto* c = sim_cmd.add_subcommand("c4g", "simulated C4G controller (open interface client) playing a robot program");
-  c->add_option("--robot", o->robot, "robot model (six-axis)");
+  c->add_option("--robot", o->robot, "robot: six-axis (the manual's example), or a file: a captured 1200-byte initialization packet or its fields in YAML (docs/c4g-simulator.md)");
   c->add_option("--server", o->server, "the PC server HOST[:PORT] (default 127.0.0.1:11000, where `axon c4g serve` listens by default; a host alone: the manual's port 1000)");
   c->add_option("--bind", o->bind, "local HOST:PORT of the controller (default: any)");
   c->add_option("--period-ms", o->period_ms, "controller period, 1 or 2 ms (default: the robot's, 2)")->check(CLI::Range(1, 2));
   c->add_option("--scenario", o->scenario, "scenario YAML (docs/c4g-simulator.md); default: drive on, mode 0, a move, run");
   c->add_option("--duration", o->duration_s, "stop after this many seconds (default: when the scenario ends or Ctrl-C)")->check(non_negative());
-  c->add_option("--reply-deadline-us", o->reply_deadline_us, "reply deadline after each send (default: one period)")->check(positive());
+  c->add_option("--reply-deadline-us", o->reply_deadline_us, "reply window after each send [us] (default: the manual's T_CYCLE1, 500 us)")->check(positive());
+  c->add_flag("--lenient-timing", o->lenient_timing, "accept a reply up to a whole period after the send (slow or loaded machines; the real controller does not)");
   c->add_option("--numbering", o->numbering, "reply numbering expected: same (manual) or next (NUM + 1)");
   c->add_option("--sync-packets", o->sync_packets, "answered sync packets before the initialization packet")->check(CLI::Range(0, 1000));
   c->add_flag("--json", o->json, "print the summary (and events) as JSON");

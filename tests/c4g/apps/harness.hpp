@@ -71,6 +71,9 @@ struct Harness {
     const host::CycleContext ctx{req, &init, &map, cycle, static_cast<std::int64_t>(cycle) * 2'000'000, tracker};
     host::ReplyBuilder builder(rep);
     app.on_cycle(ctx, builder);
+    // The per-mode field table on every reply: no data in a field the axis's mode does not use.
+    const auto fields = protocol::check_reply_fields(rep);
+    EXPECT_TRUE(fields.ok()) << "cycle " << cycle << ": axis " << fields.axis << " mode " << fields.got << " field " << fields.field;
     ++cycle;
     req.num = (req.num + 1) & 0x7FFF;
     return rep;

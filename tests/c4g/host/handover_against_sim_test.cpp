@@ -97,7 +97,6 @@ Outcome run_example(const H::Server& server) {
   EXPECT_TRUE(udp);
   S::RunOptions ro;
   ro.duration_s = 30;
-  ro.reply_deadline = std::chrono::milliseconds(20);
   ro.on_event = [&](const S::Event& e) { o.events.push_back(e); };
   S::run_client(c.value(), udp.value(), ro);
   o.done = c.value().scenario_done();
@@ -110,6 +109,7 @@ std::unique_ptr<H::Server> start(HandoverPc& pc) {
   H::ServerOptions o;
   o.listen = net::Endpoint{"127.0.0.1", 0};
   o.max_late_cycles = 0;
+  o.verify_reply_fields = true;  // no reply may carry data in a field its mode does not use
   auto s = H::Server::start(pc, o);
   EXPECT_TRUE(s) << s.error().detail;
   return std::move(s).value();

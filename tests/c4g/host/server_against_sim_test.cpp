@@ -25,6 +25,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -52,6 +53,7 @@ class TestController : public H::Controller {
 std::unique_ptr<H::Server> start_server(H::Controller& c, H::ServerOptions o = {}) {
   o.listen = net::Endpoint{"127.0.0.1", 0};
   o.max_late_cycles = 0;  // a loaded test machine must not trip the lateness check
+  o.verify_reply_fields = true;  // no reply may carry data in a field its mode does not use
   auto s = H::Server::start(c, o);
   if (!s) ADD_FAILURE() << s.error().detail;
   return std::move(s).value();
@@ -73,8 +75,9 @@ struct SimRun {
   }
 };
 
-// Runs the six-axis simulator against `port` until its scenario ends or max_s passes.
-SimRun run_sim(std::uint16_t port, std::string_view yaml, double max_s = 20) {
+// Runs the six-axis simulator against `port` until its scenario ends or max_s passes, holding the
+// server to the manual's reply window (500 us) unless a test says otherwise.
+SimRun run_sim(std::uint16_t port, std::string_view yaml, double max_s = 20, S::ReplyWindow window = S::ReplyWindow::manual) {
   SimRun r;
   auto scenario = S::Scenario::parse(yaml);
   EXPECT_TRUE(scenario) << scenario.error().detail;
@@ -85,7 +88,7 @@ SimRun run_sim(std::uint16_t port, std::string_view yaml, double max_s = 20) {
   EXPECT_TRUE(udp);
   S::RunOptions ro;
   ro.duration_s = max_s;
-  ro.reply_deadline = std::chrono::milliseconds(20);  // generous: scheduling noise is not the subject
+  ro.window = window;
   ro.on_event = [&](const S::Event& e) { r.events.push_back(e); };
   r.report = S::run_client(*r.c, udp.value(), ro);
   return r;
@@ -191,6 +194,85 @@ TEST(ServerAgainstSim, FollowingErrorInMode1Sends508AndTheControllerDrivesOff) {
   EXPECT_FALSE(run.c->communication_error());
 }
 
+// ---- PC-side safety where the PC generates the trajectory (manual: "PC-side safety controls") ------
+
+// A PC that plays a ramp on axis 1 in mode 4 from where the robot is: `step` motor turns per cycle,
+// and `jump` turns more at cycle 20 when non-zero.
+void ramp_in_mode4(TestController& pc, float step, float jump = 0) {
+  auto start = std::make_shared<float>(0.0f);
+  auto k = std::make_shared<int>(0);
+  pc.cycle = [=](const H::CycleContext& ctx, H::ReplyBuilder& r) {
+    if (ctx.request.axes[0].mode != 4) return;
+    if (*k == 0) *start = ctx.request.axes[0].d1;
+    ++*k;
+    const float target = *start + step * static_cast<float>(*k) + (*k >= 20 ? jump : 0.0f);
+    r.axis(0).d1 = target;
+    r.axis(0).d2 = step;
+  };
+}
+
+constexpr const char* kMode4Program = R"(steps:
+  - drive_on
+  - go_open: {type: A, mode: 4, arms: [1]}
+  - wait_for_pc: {timeout: 5}
+  - run)";
+
+TEST(ServerAgainstSim, AMode4TrajectoryCrossingAStrokeEndIsRefusedWithDriveOff505) {
+  // Axis 1 may go to +-3 deg at the link (1.5 motor turns); the PC's ramp runs on past it. The
+  // command beyond the stroke end never goes out: the reply is drive off, the controller reports
+  // the PC's drive off and the joint stays inside.
+  TestController pc;
+  ramp_in_mode4(pc, 0.01f);
+  H::ServerOptions o;
+  ASSERT_TRUE(H::parse_stroke_end("1=-3:3", 1, o.safety));
+  auto server = start_server(pc, o);
+  const auto run = run_sim(server->local_address().port, kMode4Program, 3.0);
+  EXPECT_EQ(server->safety().reason(), H::FaultReason::stroke_end);
+  EXPECT_EQ(server->safety().fault_axis(), 0);
+  EXPECT_TRUE(run.has(S::event::kDriveOffFromPc)) << run.log();
+  EXPECT_FALSE(run.c->drives_on(1));
+  // No command beyond 3 deg went out; the axis follows the last one within a few thousandths.
+  EXPECT_LT(std::fabs(run.c->joint_degrees(1)[0]), 3.01) << run.log();
+  EXPECT_GT(std::fabs(run.c->joint_degrees(1)[0]), 2.5) << run.log();  // it did move up to the end
+}
+
+TEST(ServerAgainstSim, AMode4TrajectoryThatJumpsIsRefusedWithDriveOff505) {
+  // A jump of one motor turn in one cycle (the default bound: 100 turns/s, 0.2 turns at 2 ms).
+  TestController pc;
+  ramp_in_mode4(pc, 0.001f, 1.0f);
+  auto server = start_server(pc);
+  const auto run = run_sim(server->local_address().port, kMode4Program, 3.0);
+  EXPECT_EQ(server->safety().reason(), H::FaultReason::discontinuity);
+  EXPECT_EQ(server->safety().fault_axis(), 0);
+  EXPECT_TRUE(run.has(S::event::kDriveOffFromPc)) << run.log();
+  EXPECT_FALSE(run.c->drives_on(1));
+  // The jump never reached the drive: the axis stopped near where the ramp was (19 x 0.001 turns).
+  EXPECT_LT(std::fabs(run.c->axis_position(0) - run.c->init().calibration[0][0]), 0.1) << run.log();
+}
+
+TEST(ServerAgainstSim, FollowingErrorInMode5Sends508AndTheControllerDrivesOff) {
+  // Mode 5: the controller integrates the PC's increments; the PC checks the following error as
+  // the manual suggests. A tight threshold (0.001 turns) is exceeded as soon as the axis lags.
+  TestController pc;
+  pc.cycle = [](const H::CycleContext& ctx, H::ReplyBuilder& r) {
+    if (ctx.request.axes[0].mode != 5) return;
+    r.axis(0).d1 = 0.01f;
+    r.axis(0).d2 = 0.01f;
+  };
+  H::ServerOptions o;
+  o.safety.following_error_override[0] = 0.001f;
+  auto server = start_server(pc, o);
+  const auto run = run_sim(server->local_address().port, R"(steps:
+  - drive_on
+  - go_open: {type: A, mode: 5, arms: [1]}
+  - wait_for_pc: {timeout: 5}
+  - run)", 3.0);
+  EXPECT_EQ(server->safety().reason(), H::FaultReason::following_error);
+  EXPECT_EQ(server->safety().fault_axis(), 0);
+  EXPECT_TRUE(run.has(S::event::kFollowErrorFromPc, "arm 1 axis 1 Following error out of range")) << run.log();
+  EXPECT_FALSE(run.c->drives_on(1));
+}
+
 TEST(ServerAgainstSim, ThrowingControllerGetsDriveOff505) {
   TestController pc;
   int cycles4 = 0;
@@ -214,12 +296,15 @@ TEST(ServerAgainstSim, ThrowingControllerGetsDriveOff505) {
 TEST(ServerAgainstSim, Restart506SendsTheInitializationPacketAgainWithoutSync) {
   TestController pc;
   auto server = start_server(pc);
+  // This test counts every packet answered (misses == 0): on a loaded test machine (load 12 on 2
+  // cores while the tests ran) the server's thread misses the manual's 500 us a few times a run, so
+  // it takes the lenient window; the subject is the restart sequence, not the timing.
   const auto run = run_sim(server->local_address().port, R"(steps:
   - drive_on
   - delay: 0.1
   - restart
   - delay: 0.1
-  - exit_open)");
+  - exit_open)", 20, S::ReplyWindow::period);
   EXPECT_TRUE(run.c->scenario_done()) << run.log();
   EXPECT_EQ(run.c->stats().sync_sent, 3u);
   EXPECT_EQ(run.c->stats().init_sent, 2u);

@@ -195,8 +195,8 @@ TEST(Server, ControllerSeesTheTypedPacketAndItsReplyGoesOut) {
     }
   };
   auto req = cyclic(20, code(Mode::mode4));
-  req.axes[0].d3 = 1.0f;
-  req.axes[1].d3 = -2.0f;
+  req.axes[0].d1 = req.axes[0].d3 = 1.0f;  // at rest: the controller's target is where the axis is
+  req.axes[1].d1 = req.axes[1].d3 = -2.0f;
   const auto a = rig.peer.ask(req);
   EXPECT_EQ(a.num, 20);
   EXPECT_EQ(a.axes[0].mode, code(Mode::mode4));
@@ -295,6 +295,26 @@ TEST(Server, StrokeEndsAndContinuityAreChecked) {
   }
 }
 
+TEST(Server, ReplyDataInAFieldTheModeDoesNotUseIsCountedAndWithVerifyDrivesOff) {
+  auto o = loopback_options();
+  {
+    Rig rig(o);  // production default: counted only
+    rig.init();
+    rig.controller.law = [](const CycleContext&, ReplyBuilder& r) { r.axis(0).d5 = 1.0f; };  // a current in mode 7
+    EXPECT_EQ(rig.peer.ask(cyclic(64, code(Mode::mode7))).axes[0].mode, code(Mode::mode7));
+    EXPECT_EQ(rig.server->counters().unused_fields.load(), 1u);
+    EXPECT_FALSE(rig.server->safety().faulted());
+  }
+  o.verify_reply_fields = true;
+  Rig rig(o);
+  rig.init();
+  rig.controller.law = [](const CycleContext&, ReplyBuilder& r) { r.axis(1).d5 = 1.0f; };
+  const auto a = rig.peer.ask(cyclic(65, code(Mode::mode7)));
+  for (const auto& ax : a.open_axes()) EXPECT_EQ(ax.mode, code(Mode::drive_off));
+  EXPECT_EQ(rig.server->safety().reason(), FaultReason::unused_field);
+  EXPECT_EQ(rig.server->safety().fault_axis(), 1);
+}
+
 TEST(Server, MalformedPacketsAreCountedAndAnsweredWithDriveOffWhenPossible) {
   Rig rig;
   rig.init();
@@ -384,7 +404,9 @@ TEST(Server, SafeReplyHoldsTheLastAbsoluteTarget) {
   Rig rig;
   rig.init();
   rig.controller.law = [](const CycleContext&, ReplyBuilder& r) { r.axis(0).d1 = 2.5f; };
-  EXPECT_FLOAT_EQ(rig.peer.ask(cyclic(100, code(Mode::mode4))).axes[0].d1, 2.5f);
+  auto first = cyclic(100, code(Mode::mode4));
+  first.axes[0].d1 = first.axes[0].d3 = 2.45f;  // at rest there: the PC's first target continues from it
+  EXPECT_FLOAT_EQ(rig.peer.ask(first).axes[0].d1, 2.5f);
   // A controller that leaves the reply as given sends the safe reply: the held target, not zero.
   rig.controller.law = nullptr;
   EXPECT_FLOAT_EQ(rig.peer.ask(cyclic(101, code(Mode::mode4))).axes[0].d1, 2.5f);

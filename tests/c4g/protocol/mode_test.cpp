@@ -148,3 +148,28 @@ TEST(C4gMode, StateMachineTransitions) {
   EXPECT_EQ(next_state(S::closed, E::exit_from_open), std::nullopt);
   EXPECT_EQ(to_string(S::open_b), "open_b");
 }
+
+TEST(C4gMode, AReplyMayCarryDataOnlyInTheFieldsItsModeUses) {
+  Packet p;
+  p.count = 3;
+  p.axes[0].mode = code(Mode::mode4);
+  p.axes[0].d1 = 1.5f;  // target position and velocity: mode 4's fields
+  p.axes[0].d2 = 0.01f;
+  p.axes[1].mode = code(Mode::mode9);
+  p.axes[1].d5 = 2.0f;  // current contribution
+  p.axes[2].mode = code(Mode::drive_off);
+  EXPECT_TRUE(check_reply_fields(p).ok());
+  EXPECT_EQ(nonzero_fields(p.axes[0]), kFieldD1 | kFieldD2);
+
+  p.axes[1].d4 = 0.1f;  // a velocity contribution in mode 9
+  auto f = check_reply_fields(p);
+  EXPECT_EQ(f.code, ProtocolErrc::field_not_null);
+  EXPECT_EQ(f.axis, 1);
+  EXPECT_EQ(f.field, 4);
+  EXPECT_EQ(f.got, 9);
+  p.axes[1].d4 = 0;
+  p.axes[2].ext1 = 1.0f;  // a special code carries no data
+  f = check_reply_fields(p);
+  EXPECT_EQ(f.axis, 2);
+  EXPECT_EQ(f.field, 6);
+}

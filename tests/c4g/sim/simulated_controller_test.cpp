@@ -23,6 +23,7 @@ apps::ServeOptions loopback() {
   apps::ServeOptions o;
   o.server.listen = net::Endpoint{"127.0.0.1", 0};
   o.server.max_late_cycles = 0;  // a loaded test machine must not trip the lateness check
+  o.server.verify_reply_fields = true;  // no reply may carry data in a field its mode does not use
   o.stop_timeout_s = 2;
   o.until_controller_ends = true;  // answer the program's last cycles too
   return o;
@@ -77,6 +78,35 @@ TEST(SimulatedController, PlaysAMode4TrajectoryAgainstAServeSession) {
   EXPECT_NEAR(seen.joint_degrees[1][0], 3.0, 0.05);
   EXPECT_NEAR(seen.joint_degrees[1][1], -2.0, 0.05);
   EXPECT_NE(served.json().find("\"cyclic_packets\""), std::string::npos);
+}
+
+TEST(SimulatedController, AStreamPastAStrokeEndEndsTheSessionInASafetyStopWithDriveOff) {
+  // The trajectory goes 8 deg on axis 1; its stroke ends are +-5 deg. The server refuses the first
+  // command beyond (drive off, 505), the controller reports the PC's drive off, the session ends in
+  // a safety stop once the controller has obeyed, and the joint never passed the stroke end.
+  apps::StreamOptions so;
+  so.trajectory = std::make_shared<apps::Trajectory>(
+      apps::Trajectory::from_rows({0.0, 0.5}, {{0, 0, 0, 0, 0, 0}, {8 * kDeg, 0, 0, 0, 0, 0}}).value());
+  so.relative = true;
+  apps::StreamApp app(so);
+  auto options = loopback();
+  options.until_controller_ends = false;
+  ASSERT_TRUE(host::parse_stroke_end("1=-5:5", 1, options.server.safety));
+  apps::ServeSession session(app, options);
+  session.start();
+  auto controller = sim::SimulatedController::start(program(session, open_mode_program(4)));
+  const auto served = session.run();
+  const auto seen = controller.stop();
+  EXPECT_EQ(served.reason, "safety stop: commanded position beyond a stroke end") << served.text();
+  EXPECT_EQ(served.exit_code(), 4);
+  EXPECT_FALSE(served.finished);
+  const bool drive_off = std::any_of(seen.events.begin(), seen.events.end(),
+                                     [](const sim::Event& e) { return e.name == sim::event::kDriveOffFromPc; });
+  EXPECT_TRUE(drive_off);
+  ASSERT_EQ(seen.joint_degrees[1].size(), 6u);
+  // No command beyond 5 deg went out; the axis follows the last one within a few thousandths.
+  EXPECT_LT(seen.joint_degrees[1][0], 5.01);
+  EXPECT_GT(seen.joint_degrees[1][0], 4.0);  // it did move up to the stroke end
 }
 
 TEST(SimulatedController, StopEndsAProgramThatRunsForeverAndReportsIt) {

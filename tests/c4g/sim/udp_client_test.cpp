@@ -38,6 +38,7 @@ class EchoPc {
   }
   std::uint16_t port() const { return port_; }
   std::atomic<bool> answer{true};
+  std::atomic<int> reply_delay_us{0};  // sleep this long before each cyclic reply after the init packet
   std::atomic<int> inits{0};
   std::atomic<int> packets{0};
 
@@ -68,6 +69,8 @@ class EchoPc {
         for (std::size_t i = 0; i < r.count; ++i) r.axes[i].mode = req.axes[i].mode;
       }
       if (!answer) continue;
+      if (reply_delay_us > 0 && inits > 0 && P::classify(d.size()) == P::DatagramKind::cyclic)
+        std::this_thread::sleep_for(std::chrono::microseconds(reply_delay_us.load()));
       std::array<std::byte, P::kMaxPacketSize> out{};
       if (!P::encode_packet(r, out).ok()) continue;
       ::sendto(fd_, out.data(), P::packet_size(r.count), 0, reinterpret_cast<sockaddr*>(&from), len);
@@ -122,6 +125,48 @@ TEST(C4gSimUdp, ASilentPcEndsInTheCommunicationError) {
   EXPECT_TRUE(silenced.load());
   EXPECT_TRUE(c.communication_error());
   EXPECT_EQ(c.stats().max_consecutive_misses, 10u);
+}
+
+// A PC that always answers 1 ms after the send: within a period of 2 ms, but twice the manual's
+// T_CYCLE1. The controller's window (the default) takes each of its replies as a miss and the late
+// answer as late, and ends in the communication error after 10; the lenient window lets it pass.
+struct SlowPcRun {
+  Controller c = make_controller("steps:\n  - drive_on\n  - delay: 0.1\n");
+  RunReport report;
+  explicit SlowPcRun(ReplyWindow window) {
+    EchoPc pc;
+    pc.reply_delay_us = 1000;
+    auto udp = UdpClient::open(net::Endpoint{"127.0.0.1", pc.port()});
+    EXPECT_TRUE(udp.has_value());
+    RunOptions o;
+    o.window = window;
+    o.duration_s = 30;
+    if (udp) report = run_client(c, udp.value(), o);
+  }
+};
+
+TEST(C4gSimUdp, AReplyAfterTheManualsWindowIsAMissAndTenOfThemTheCommunicationError) {
+  const SlowPcRun run(ReplyWindow::manual);
+  const auto& s = run.c.stats();
+  EXPECT_EQ(run.report.window_ns, 500'000);
+  EXPECT_TRUE(run.c.communication_error());
+  EXPECT_EQ(s.max_consecutive_misses, 10u);
+  EXPECT_GE(s.late_replies, 9u);  // each missed packet's reply, when it came
+  EXPECT_EQ(s.replies_ok, 3u);    // the three sync packets only: no cyclic reply was in time
+}
+
+TEST(C4gSimUdp, TheLenientWindowOfAPeriodAcceptsTheSlowPc) {
+  const SlowPcRun run(ReplyWindow::period);
+  EXPECT_EQ(run.report.window_ns, 2'000'000);
+  EXPECT_FALSE(run.c.communication_error());
+  EXPECT_TRUE(run.c.scenario_done()) << run.c.scenario_error();
+}
+
+TEST(C4gSimUdp, TheManualWindowIsNeverLongerThanThePeriodAndAnExplicitOneWins) {
+  EXPECT_EQ(reply_window(ReplyWindow::manual, {}, 0.002), std::chrono::microseconds(500));
+  EXPECT_EQ(reply_window(ReplyWindow::manual, {}, 0.0004), std::chrono::microseconds(400));
+  EXPECT_EQ(reply_window(ReplyWindow::period, {}, 0.001), std::chrono::milliseconds(1));
+  EXPECT_EQ(reply_window(ReplyWindow::manual, std::chrono::milliseconds(20), 0.001), std::chrono::milliseconds(20));
 }
 
 }  // namespace

@@ -172,7 +172,8 @@ void ServeSession::pump(const Hooks& hooks) {
 
 bool ServeSession::settled() const {
   const auto st = server_->state();
-  return app_.quiescent() || st == host::ServerState::silent || st == host::ServerState::waiting || app_.controller_exited();
+  return app_.quiescent() || st == host::ServerState::silent || st == host::ServerState::waiting || app_.controller_exited() ||
+         server_->safety().obeyed();
 }
 
 ServeReport ServeSession::run(const Hooks& hooks) {
@@ -196,6 +197,10 @@ ServeReport ServeSession::run(const Hooks& hooks) {
       break;
     }
     if (app_.controller_exited()) { why = "controller ended the exchange (504)"; break; }
+    if (const auto fault = server_->safety().reason(); fault != host::FaultReason::none && fault != host::FaultReason::user_request) {
+      why = fmt::format("safety stop: {}", host::to_string(fault));  // the server asks for drive off meanwhile
+      break;
+    }
     if (options_.status_interval_s > 0 && now >= next_status) {
       if (hooks.on_status) hooks.on_status(status_line());
       next_status = now + seconds(options_.status_interval_s);

@@ -11,7 +11,9 @@
 // inline there, under the real-time rules of app.hpp), an optional per-cycle CSV recorder (moni
 // views), the loop that waits for the end (the app finished or failed, the controller ended the
 // exchange or went silent after the app finished, a duration, stop()), the graceful stop (the app leaves its open modes; if the
-// controller is not back in mode 0 within stop_timeout_s, drive off), and the final report.
+// controller is not back in mode 0 within stop_timeout_s, drive off), and the final report. A
+// safety fault of the server (stroke end, jump, following error...) ends run() too ("safety
+// stop: ..."), once the controller has obeyed the drive off or the stop timeout passed.
 //
 // Threads: start(), run() and the destructor on the caller's thread; stop() from any thread (or a
 // signal handler: it only sets an atomic). Hooks run on run()'s thread between polls.

@@ -273,9 +273,11 @@ void Server::build_safe_reply(const protocol::Packet& req, protocol::Packet& rep
         r.d1 = q.d1;
         r.d2 = q.d2;
         break;
+      case code(Mode::mode1):
+      case code(Mode::mode1_standby):
       case code(Mode::mode4):
-      case code(Mode::mode4_standby):  // absolute target: hold it, never command zero
-        r.d1 = have_target_[i] ? last_target_[i] : q.d3;
+      case code(Mode::mode4_standby):  // absolute target: hold it (else the controller's), never command zero
+        r.d1 = have_target_[i] ? last_target_[i] : q.d1;
         break;
       default: break;  // increments and contributions: zero is "no change"
     }
@@ -301,9 +303,10 @@ void Server::enforce_mode_rules(const protocol::Packet& req, protocol::Packet& r
     if (change == protocol::ModeChange::allowed && req.axes[i].mode == code(Mode::mode0) &&
         !protocol::is_special_mode(rep.axes[i].mode)) {
       // What the rules cannot see (docs/c4g-server.md, "Who sets the mode"): an open mode needs the
-      // drives on (chapter 11, second phase) and the controller's trajectory at rest (chapter 13:
-      // between two moves); its target velocity D2 tells.
-      refused = !protocol::drives_on(req.infpar, arm) || arm_trajectory_moving(req, arm);
+      // drives on (chapter 11, second phase) and the state machine's still state S00 (chapter 24:
+      // no GO OPEN from S10, the controller's trajectory moving; its target velocity D2 tells).
+      const auto state = arm_trajectory_moving(req, arm) ? protocol::MotionState::closed : protocol::MotionState::stop;
+      refused = !protocol::drives_on(req.infpar, arm) || !protocol::next_state(state, protocol::MotionEvent::go_open_a);
     }
     if (refused) {
       bump(counters_.refused_mode_changes);
@@ -316,7 +319,8 @@ void Server::enforce_mode_rules(const protocol::Packet& req, protocol::Packet& r
 std::size_t Server::encode(const protocol::Packet& req, protocol::Packet& rep, std::span<std::byte> out) noexcept {
   // Remember absolute targets so a later safe reply holds them.
   for (std::size_t i = 0; i < rep.count; ++i) {
-    if (req.axes[i].mode == code(Mode::mode4) || req.axes[i].mode == code(Mode::mode4_standby)) {
+    const std::int32_t m = req.axes[i].mode;
+    if (m == code(Mode::mode4) || m == code(Mode::mode4_standby) || m == code(Mode::mode1) || m == code(Mode::mode1_standby)) {
       last_target_[i] = rep.axes[i].d1;
       have_target_[i] = true;
     } else {
@@ -440,6 +444,10 @@ std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Data
     bump(counters_.safe_replies);
   }
   ++cyclic_count_;
+  if (const auto f = protocol::check_reply_fields(reply_); !f.ok()) {
+    bump(counters_.unused_fields);
+    if (options_.verify_reply_fields) safety_.trip(FaultReason::unused_field, f.axis);
+  }
   safety_.apply(request_, reply_);
   return encode(request_, reply_, out);
 }
@@ -453,11 +461,13 @@ std::string Server::summary() const {
                  counters_.sessions.load(), counters_.foreign.load(), foreign_source_text());
   fmt::format_to(it,
                  "Packets {} (init {}, cyclic {}), protocol errors {}, unanswered {}, controller exceptions {}, "
-                 "late {}, refused mode changes {}, safe replies {}, frozen cycles {} (freezes {}, now {})\n",
+                 "late {}, refused mode changes {}, safe replies {}, frozen cycles {} (freezes {}, now {}), "
+                 "replies with unused fields set {}\n",
                  counters_.packets.load(), counters_.init_packets.load(), counters_.cyclic_packets.load(),
                  counters_.protocol_errors.load(), counters_.unanswered.load(), counters_.controller_exceptions.load(),
                  counters_.controller_late.load(), counters_.refused_mode_changes.load(), counters_.safe_replies.load(),
-                 counters_.frozen_cycles.load(), counters_.freezes.load(), to_string(freeze_state()));
+                 counters_.frozen_cycles.load(), counters_.freezes.load(), to_string(freeze_state()),
+                 counters_.unused_fields.load());
   fmt::format_to(it, "Safety: {} (axis {}), currents clamped {}, drive-off replies {}, following-error replies {}\n",
                  to_string(safety_.reason()), safety_.fault_axis(), safety_.counters().currents_clamped.load(),
                  safety_.counters().drive_off_replies.load(), safety_.counters().following_error_replies.load());

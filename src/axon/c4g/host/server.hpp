@@ -25,8 +25,9 @@
 //
 // Safe reply (used before the controller runs, when it throws, when it is faulted): every axis
 // echoes its mode; data are zero except where zero would move the robot: mode 0' echoes targets
-// (the manual's echo test), modes 4/4' hold the last commanded target (else the actual position).
-// Modes 1 and 2 (PC closes the loops) have no passive safe reply: a fault there asks for drive off.
+// (the manual's echo test), modes 1/1' and 4/4' hold the last commanded target (else the
+// controller's own target D1, so that nothing jumps). Modes 1 and 2 (PC closes the loops) have no passive safe current: a fault there asks
+// for drive off.
 #pragma once
 
 #include "axon/c4g/host/cycle_thread.hpp"
@@ -125,6 +126,11 @@ struct ServerOptions {
   // latch a fault (0 disables).
   std::chrono::nanoseconds controller_budget = std::chrono::microseconds(400);
   int max_late_cycles = 3;
+  // Checks every reply against the per-mode field table (protocol::check_reply_fields: a field the
+  // mode does not use must be zero). Violations are always counted (ServerCounters::unused_fields);
+  // with this set, one is a safety fault (drive off). Off in production by default; the tests turn
+  // it on, so that no built-in reply sends data the controller does not expect.
+  bool verify_reply_fields = false;
   // Soft control switching intervals T1, T2, T3 of the controller (the PC infers the switch's phase
   // from the modes and these; they must match the controller's configuration).
   protocol::SwitchTimes soft_switch{};
@@ -154,6 +160,7 @@ struct ServerCounters {
   std::atomic<std::uint64_t> safe_replies{0};      // cycles answered without the controller's reply
   std::atomic<std::uint64_t> frozen_cycles{0};     // cycles answered under active freezing (500 .. back to 0)
   std::atomic<std::uint64_t> freezes{0};           // active freezings the controller entered
+  std::atomic<std::uint64_t> unused_fields{0};     // replies with data in a field their mode does not use
 };
 
 // Active freezing (special mode 500), as the Server drives it.

@@ -25,6 +25,8 @@ class ProtocolCategory final : public std::error_category {
         return "c4g axis mode code is not defined by the open interface";
       case ProtocolErrc::singular_transform:
         return "c4g transmission matrix is singular (an axis has a zero transmission ratio)";
+      case ProtocolErrc::field_not_null:
+        return "c4g reply carries data in a field its axis mode does not use (the manual wants it null)";
     }
     return "unknown c4g protocol error";
   }

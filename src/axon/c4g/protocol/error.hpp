@@ -16,6 +16,7 @@ enum class ProtocolErrc {
   bad_axis_map,         // open-axis lists that do not describe a consistent axis mapping
   unknown_mode,         // an axis mode code the interface does not define
   singular_transform,   // transmission matrix that cannot be inverted (a zero transmission ratio)
+  field_not_null,       // a reply field the axis's mode does not use is not zero
 };
 
 const std::error_category& protocol_category() noexcept;

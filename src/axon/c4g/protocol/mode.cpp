@@ -148,6 +148,33 @@ Fault check_modes(const Packet& pkt) noexcept {
   return {};
 }
 
+FieldMask nonzero_fields(const Axis& a) noexcept {
+  const float v[8] = {a.d1, a.d2, a.d3, a.d4, a.d5, a.ext1, a.ext2, a.ext3};
+  FieldMask m = 0;
+  for (int k = 0; k < 8; ++k)
+    if (!(v[k] == 0.0f)) m = static_cast<FieldMask>(m | (1u << (k + 1)));
+  return m;
+}
+
+Fault check_reply_fields(const Packet& reply) noexcept {
+  int i = 0;
+  for (const Axis& a : reply.open_axes()) {
+    const ModeInfo* info = find_mode(a.mode);
+    const FieldMask extra = info != nullptr ? static_cast<FieldMask>(nonzero_fields(a) & ~info->pc_fields) : FieldMask{0};
+    if (extra != 0) {
+      Fault f;
+      f.code = ProtocolErrc::field_not_null;
+      f.axis = i;
+      for (int k = 1; k <= 8 && f.field < 0; ++k)
+        if (extra & (1u << k)) f.field = k;
+      f.got = a.mode;
+      return f;
+    }
+    ++i;
+  }
+  return {};
+}
+
 ModeChange check_mode_change(std::int32_t current, std::int32_t requested, bool exit_from_open_sent) noexcept {
   if (requested == current) return ModeChange::unchanged;
   if (!is_known_mode(requested)) return ModeChange::unknown_mode;

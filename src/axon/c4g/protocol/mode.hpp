@@ -89,6 +89,14 @@ std::optional<std::int32_t> parse_mode(std::string_view text) noexcept;
 // The first open axis of pkt whose SM is not a defined mode (Fault unknown_mode, field 0).
 Fault check_modes(const Packet& pkt) noexcept;
 
+// The data fields of an axis that are not zero (kFieldD1 .. kFieldExt3; NaN counts as not zero).
+FieldMask nonzero_fields(const Axis& a) noexcept;
+// The per-mode table against a PC reply: every field is on the wire, and those the axis's mode does
+// not use must be null (chapter 8 and the mode tables of chapter 14). The first offending open
+// axis: Fault field_not_null, field = the field's bit (1 = D1 .. 8 = EXT3), got = the mode. Axes
+// whose mode is not defined are left to check_modes.
+Fault check_reply_fields(const Packet& reply) noexcept;
+
 // ---- Mode changes -------------------------------------------------------------------------------
 // Whether the controller accepts a change of an axis from `current` to `requested` asked by the PC.
 // Rules (manual chapters 11, 13, 15 and the field libraries): unchanged is always fine; drive-off

@@ -1,5 +1,6 @@
 #include "axon/c4g/sim/client_runner.hpp"
 
+#include <algorithm>
 #include <array>
 #include <ctime>
 
@@ -18,13 +19,45 @@ void sleep_until(Clock::time_point t) {
   }
 }
 
+// A reply that arrived after its window: handed to the controller once the tick is closed, where
+// it counts as late.
+struct LateReply {
+  std::array<std::byte, 2048> bytes{};
+  std::size_t size = 0;
+};
+
+// Sends this tick's packet and collects the replies that arrive within the window.
+void exchange(Controller& c, UdpClient& udp, std::span<const std::byte> d, Clock::duration window, RunReport& report,
+              std::array<std::byte, 2048>& buf, LateReply& late) {
+  if (auto r = udp.send(d); !r) c.on_send_failed(r.error().detail);
+  // The window starts once the datagram is out: a simulator preempted before or inside the send
+  // must not charge its own delay to the PC (a reply may even arrive before this: rtt 0).
+  const auto sent_at = Clock::now();
+  const auto deadline = sent_at + window;
+  while (c.awaiting_reply() && !c.reply_received()) {
+    auto got = udp.receive(buf, deadline);
+    if (!got || got.value().size == 0) break;
+    const std::size_t n = std::min(got.value().size, buf.size());
+    if (got.value().arrived > deadline) {
+      std::copy_n(buf.begin(), n, late.bytes.begin());
+      late.size = n;
+      break;
+    }
+    c.on_datagram(std::span<const std::byte>(buf.data(), n));
+    if (c.reply_received())
+      report.rtt.add(std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(got.value().arrived - sent_at).count()));
+  }
+}
+
 }  // namespace
 
 RunReport run_client(Controller& c, UdpClient& udp, const RunOptions& o) {
   RunReport report;
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(c.period_s()));
-  const auto deadline_after = o.reply_deadline.count() > 0 ? std::chrono::duration_cast<Clock::duration>(o.reply_deadline) : period;
+  const auto window = reply_window(o.window, o.reply_deadline, c.period_s());
+  report.window_ns = window.count();
   std::array<std::byte, 2048> buf{};
+  LateReply late;
   const auto start = Clock::now();
   auto next = start;
   for (;;) {
@@ -39,18 +72,10 @@ RunReport run_client(Controller& c, UdpClient& udp, const RunOptions& o) {
     }
     sleep_until(next);
     const auto d = c.begin_cycle();
-    if (!d.empty()) {
-      const auto sent_at = Clock::now();
-      if (auto r = udp.send(d); !r) c.on_send_failed(r.error().detail);
-      const auto deadline = sent_at + deadline_after;
-      while (c.awaiting_reply() && !c.reply_received()) {
-        auto n = udp.receive(buf, deadline);
-        if (!n || n.value() == 0) break;
-        c.on_datagram(std::span<const std::byte>(buf.data(), std::min(n.value(), buf.size())));
-        if (c.reply_received()) report.rtt.add(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - sent_at).count());
-      }
-    }
+    late.size = 0;
+    if (!d.empty()) exchange(c, udp, d, std::chrono::duration_cast<Clock::duration>(window), report, buf, late);
     c.end_cycle();
+    if (late.size > 0) c.on_datagram(std::span<const std::byte>(late.bytes.data(), late.size));
     if (o.on_event)
       for (const auto& e : c.take_events()) o.on_event(e);
     next += period;

@@ -889,7 +889,10 @@ bool Controller::start_step(const Step& s) {
           return false;
         }
         const bool switches = s.mode == 1 || s.mode == 2;  // soft switching needs a still robot (T1..T3)
-        if (a.move.active || (switches && arm_moving(arm))) {
+        const bool moving = a.move.active || (switches && arm_moving(arm));
+        // The state machine (chapter 24): GO OPEN only from S00, the robot still (not from S10).
+        const auto event = s.type == OpenType::a ? P::MotionEvent::go_open_a : P::MotionEvent::go_open_b;
+        if (!a.open && !P::next_state(moving ? P::MotionState::closed : P::MotionState::stop, event)) {
           fail_scenario(s, fmt::format("arm {}: the robot moves; modes change only between moves", arm));
           return false;
         }
@@ -925,7 +928,9 @@ bool Controller::start_step(const Step& s) {
         fail_scenario(s, fmt::format("arm {}: drives are not on", arm));
         return false;
       }
-      if (a.open && a.type == OpenType::a) {
+      // The state machine: MOVE from S00 (to S10) or as the controller's part of S11 (type B); none
+      // from S01, where the PC alone moves the robot.
+      if (a.open && a.type == OpenType::a && !P::next_state(P::MotionState::open_a, P::MotionEvent::move)) {
         fail_scenario(s, "MOVE while open type A (the PC moves the robot; the state machine forbids it)");
         return false;
       }

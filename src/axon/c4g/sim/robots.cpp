@@ -1,6 +1,10 @@
 #include "axon/c4g/sim/robots.hpp"
 
+#include "axon/c4g/sim/robot_file.hpp"
+
 #include <fmt/format.h>
+
+#include <filesystem>
 
 namespace axon::c4g::sim {
 
@@ -51,7 +55,9 @@ std::vector<std::string> robot_names() { return {"six-axis"}; }
 
 Result<RobotConfig> find_robot(std::string_view name) {
   if (name == "six-axis") return six_axis_robot();
-  return Error(CoreErrc::invalid_argument, fmt::format("unknown robot '{}' (known: six-axis)", name));
+  if (std::filesystem::is_regular_file(std::filesystem::path(std::string(name)))) return load_robot_file(std::string(name));
+  return Error(CoreErrc::invalid_argument,
+               fmt::format("unknown robot '{}' (known: six-axis, or a file: a 1200-byte initialization packet or its fields in YAML)", name));
 }
 
 }  // namespace axon::c4g::sim

@@ -63,7 +63,8 @@ protocol::InitPacket six_axis_init();
 // The default simulated robot built on it.
 RobotConfig six_axis_robot();
 
-// Robots by name ("six-axis"); invalid_argument listing the known names otherwise.
+// Robots by name ("six-axis") or from a file (robot_file.hpp: a captured initialization packet or
+// its fields in YAML); invalid_argument listing the known names otherwise.
 Result<RobotConfig> find_robot(std::string_view name);
 std::vector<std::string> robot_names();
 

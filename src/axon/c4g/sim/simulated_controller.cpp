@@ -68,6 +68,7 @@ struct SimulatedController::Impl {
     RunOptions ro;
     ro.duration_s = options.duration_s;
     ro.stop = &stop_flag;
+    ro.window = options.reply_window;
     ro.reply_deadline = options.reply_deadline;
     std::vector<Event> events;
     ro.on_event = [&](const Event& e) {
@@ -103,6 +104,7 @@ struct SimulatedController::Impl {
     r.period_ms = controller.init().period_ms;
     r.stats = controller.stats();
     r.overruns = rr.overruns;
+    r.reply_window_us = static_cast<double>(rr.window_ns) / 1000.0;
     r.elapsed_s = rr.elapsed_s;
     r.stopped = rr.stopped;
     const auto& h = rr.rtt;
@@ -150,8 +152,13 @@ SimulatedController SimulatedController::start(SimulatedControllerOptions option
                                                            event::kSocketError, server.port, opened.error().detail)));
   auto impl = std::make_unique<Impl>(std::move(controller), std::move(opened).value(), std::move(options));
   const auto& c = impl->controller;
-  impl->description = fmt::format("robot {}, {} open axes, {} ms, scenario '{}', server {}, from {}", c.robot().name,
-                                  c.axis_count(), c.init().period_ms, program, server.to_string(), impl->local);
+  const auto window = reply_window(impl->options.reply_window, impl->options.reply_deadline, c.period_s());
+  impl->description = fmt::format("robot {}, {} open axes, {} ms, scenario '{}', server {}, from {}, reply window {} us{}",
+                                  c.robot().name, c.axis_count(), c.init().period_ms, program, server.to_string(),
+                                  impl->local, std::chrono::duration_cast<std::chrono::microseconds>(window).count(),
+                                  impl->options.reply_deadline.count() > 0          ? ""
+                                  : impl->options.reply_window == ReplyWindow::manual ? " (the manual's T_CYCLE1)"
+                                                                                      : " (lenient: one period)");
   impl->thread = std::thread([p = impl.get()] { p->run(); });
   return SimulatedController(std::move(impl));
 }

@@ -17,6 +17,7 @@
 #include "axon/c4g/protocol/packet.hpp"
 #include "axon/c4g/sim/controller.hpp"
 #include "axon/c4g/sim/events.hpp"
+#include "axon/c4g/sim/reply_window.hpp"
 #include "axon/c4g/sim/robots.hpp"
 
 #include <chrono>
@@ -31,13 +32,17 @@ namespace axon::c4g::sim {
 struct SimulatedControllerOptions {
   std::string server = "127.0.0.1:11000";  // the PC server, HOST[:PORT] (a host alone: port 1000)
   std::string bind{};                      // the controller's local HOST:PORT (empty: any)
-  std::string robot = "six-axis";          // robots.hpp
+  std::string robot = "six-axis";          // robots.hpp: a name, or a robot file (robot_file.hpp)
   // The robot program (scenario.hpp): YAML text, or a file; neither: the default program.
   std::string scenario_yaml{};
   std::string scenario_file{};
   ControllerOptions controller{};         // numbering, sync packets, period...
   double duration_s = 0;                   // 0: until the program ends
-  std::chrono::nanoseconds reply_deadline{0};  // after each send; 0: one period
+  // How long after each send a reply may come (reply_window.hpp): the manual's 500 us by default;
+  // ReplyWindow::period is the lenient whole period for slow or loaded machines; reply_deadline > 0
+  // sets the window outright.
+  ReplyWindow reply_window = ReplyWindow::manual;
+  std::chrono::nanoseconds reply_deadline{0};
   // Soft control switching, overriding the robot's (negative: the robot's own).
   double switch_t1_s = -1, switch_t2_s = -1, switch_t3_s = -1;
   double switch_tolerance = -1;  // [motor turns]
@@ -55,6 +60,7 @@ struct SimulatedControllerReport {
   int period_ms = 0;
   ControllerStats stats;      // packets, replies, misses by kind
   std::uint64_t overruns = 0; // ticks more than a period late
+  double reply_window_us = 0; // the window the replies were held to
   double elapsed_s = 0;
   bool stopped = false;       // ended by stop() or the duration rather than by the program
   // Round-trip times of the accepted replies [us].

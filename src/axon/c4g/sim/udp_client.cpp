@@ -4,12 +4,14 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace axon::c4g::sim {
 
 Result<UdpClient> UdpClient::open(const net::Endpoint& server, const std::optional<net::Endpoint>& local) {
   AXON_TRY(to, net::resolve_ipv4(server));
   net::UdpOptions options;
-  options.kernel_timestamps = false;  // the controller times its round trips with its own clock
+  options.kernel_timestamps = true;  // replies are judged by their arrival, not by this thread's wake-up
   const net::Endpoint any{"0.0.0.0", 0};
   AXON_TRY(socket, net::UdpSocket::open(local ? *local : any, options));
   socket.set_peer(to);
@@ -18,13 +20,13 @@ Result<UdpClient> UdpClient::open(const net::Endpoint& server, const std::option
 
 Result<void> UdpClient::send(std::span<const std::byte> datagram) { return socket_.send_to(datagram, server_); }
 
-Result<std::size_t> UdpClient::receive(std::span<std::byte> buffer, Clock::time_point deadline) {
+Result<UdpClient::Received> UdpClient::receive(std::span<std::byte> buffer, Clock::time_point deadline) {
   for (;;) {
-    const auto left = deadline - Clock::now();
-    if (left <= Clock::duration::zero()) return std::size_t{0};
+    // Past the deadline: only look (timeout 0), so that what came in time is still judged.
+    const auto left = std::max(deadline - Clock::now(), Clock::duration::zero());
     auto got = socket_.receive(buffer, std::chrono::duration_cast<std::chrono::nanoseconds>(left));
     if (!got) {
-      if (got.error() == net::NetErrc::timeout) return std::size_t{0};
+      if (got.error() == net::NetErrc::timeout) return Received{};
       return got.error();
     }
     if (got.value().from != server_) {
@@ -32,8 +34,11 @@ Result<std::size_t> UdpClient::receive(std::span<std::byte> buffer, Clock::time_
       continue;
     }
     if (got.value().wire_size == 0) continue;  // an empty datagram: nothing to judge
-    // The size on the wire, so that an oversized reply is judged by its real length.
-    return got.value().wire_size;
+    // The size on the wire, so that an oversized reply is judged by its real length. The arrival:
+    // the monotonic clock at return minus the wake-up latency the kernel's stamp shows.
+    const auto& d = got.value();
+    const std::int64_t arrived_ns = d.steady_ns - (d.kernel_timestamp ? std::max<std::int64_t>(d.wakeup_latency_ns, 0) : 0);
+    return Received{d.wire_size, Clock::time_point(std::chrono::nanoseconds(arrived_ns))};
   }
 }
 

@@ -1,7 +1,8 @@
 // The controller's side of the UDP exchange: a net::UdpSocket bound to an ephemeral (or given)
 // local port that talks to one PC server. Adds what the simulated controller needs on top of the
 // socket: a receive with an absolute steady-clock deadline that ignores datagrams from anyone but
-// the server, and a drain of replies that came too late.
+// the server and tells when each datagram arrived (the kernel's stamp, so that a reply is judged by
+// its arrival and not by when this thread got the CPU), and a drain of replies that came too late.
 #pragma once
 
 #include "axon/core/error.hpp"
@@ -24,9 +25,14 @@ class UdpClient {
   static Result<UdpClient> open(const net::Endpoint& server, const std::optional<net::Endpoint>& local = std::nullopt);
 
   Result<void> send(std::span<const std::byte> datagram);
-  // One datagram from the server before the deadline: its size, 0 at the deadline. Datagrams
-  // from other senders are dropped and counted (foreign()).
-  Result<std::size_t> receive(std::span<std::byte> buffer, Clock::time_point deadline);
+  struct Received {
+    std::size_t size = 0;        // 0: nothing came
+    Clock::time_point arrived{}; // the kernel's arrival stamp on the steady clock (else the return time)
+  };
+  // One datagram from the server: waits until the deadline, and once it has passed still returns
+  // what is already queued (its arrival time tells whether it came in time). size 0: nothing.
+  // Datagrams from other senders are dropped and counted (foreign()).
+  Result<Received> receive(std::span<std::byte> buffer, Clock::time_point deadline);
   // Drops whatever is queued (replies that came after their deadline); returns how many.
   std::size_t drain(std::span<std::byte> scratch);
   [[nodiscard]] net::Endpoint local_endpoint() const;
