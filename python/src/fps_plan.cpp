@@ -18,6 +18,8 @@
 #include <fmt/format.h>
 
 #include <memory>
+#include <tuple>
+#include <utility>
 
 namespace axon::python {
 
@@ -27,24 +29,23 @@ namespace plan = fps::plan;
 using fps::FocalPlane;
 using Poses = std::vector<plan::Pose>;
 
-py::array_t<double> pose_array(const Poses& poses) {
-  py::array_t<double> a({static_cast<py::ssize_t>(poses.size()), py::ssize_t{2}});
+// An (n, 2) array whose row i is at(i) (a pair of doubles).
+template <class At>
+py::array_t<double> two_columns(std::size_t n, At at) {
+  py::array_t<double> a({static_cast<py::ssize_t>(n), py::ssize_t{2}});
   auto v = a.mutable_unchecked<2>();
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    v(i, 0) = poses[i].alpha_deg;
-    v(i, 1) = poses[i].beta_deg;
-  }
+  for (std::size_t i = 0; i < n; ++i) std::tie(v(i, 0), v(i, 1)) = at(i);
   return a;
 }
 
+// Poses as rows of alpha, beta (degrees).
+py::array_t<double> pose_array(const Poses& poses) {
+  return two_columns(poses.size(), [&](std::size_t i) { return std::pair{poses[i].alpha_deg, poses[i].beta_deg}; });
+}
+
+// An arm's points as rows of degrees, seconds (as plan.json and Client.run_trajectories have them).
 py::array_t<double> points_array(const std::vector<plan::TimedAngle>& points) {
-  py::array_t<double> a({static_cast<py::ssize_t>(points.size()), py::ssize_t{2}});
-  auto v = a.mutable_unchecked<2>();
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    v(i, 0) = points[i].deg;
-    v(i, 1) = points[i].t_s;
-  }
-  return a;
+  return two_columns(points.size(), [&](std::size_t i) { return std::pair{points[i].deg, points[i].t_s}; });
 }
 
 std::shared_ptr<plan::CollisionModel> model_of(const FocalPlane& layout, double buffer_mm) {
