@@ -12,6 +12,7 @@ packages=(
   libeigen3-dev zlib1g-dev libmodbus-dev libpcap-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-can             # interoperability tests against python-can
+  pybind11-dev python3-dev python3-pytest python3-numpy   # the Python module axon and its tests
   tcpdump                         # checks that pcap captures decode
 )
 

@@ -139,6 +139,29 @@ TEST(Client, ACallThatOverrunsItsTimeoutStopsEveryRobotAndThrows) {
   EXPECT_GT(error_deg(*plane.arms(2), {180, 90}), 1.0);  // stopped on the way
 }
 
+TEST(Client, InterruptFromAnotherThreadStopsEveryRobotAndEndsTheWaitingCall) {
+  auto slow = fast_plane();
+  slow.time_scale = 2;  // the move takes seconds of wall time
+  sim::SimulatedPlane plane("benchtop", slow);
+  Client fps(fast_client());
+  fps.open(plane.plane());
+  ASSERT_EQ(fps.discover().size(), 6u);
+  std::thread watchdog([&fps] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    fps.interrupt("watchdog");
+  });
+  try {
+    const auto out = fps.goto_absolute({{2, {180, 90}}});
+    EXPECT_FALSE(out.completed) << "the move finished before the interrupt";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), host::HostErrc::locked) << e.what();
+  }
+  watchdog.join();
+  EXPECT_TRUE(fps.locked());
+  EXPECT_NE(fps.lock_reason().find("watchdog"), std::string::npos) << fps.lock_reason();
+  EXPECT_GT(error_deg(*plane.arms(2), {180, 90}), 1.0);  // stopped on the way
+}
+
 TEST(Client, OpenedFromBusSpecsPlansOnceGivenTheLayout) {
   sim::SimulatedPlane plane("benchtop", fast_plane());
   Client fps(fast_client());

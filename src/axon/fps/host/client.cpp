@@ -9,6 +9,7 @@
 #include "axon/fps/plan/targets.hpp"
 #include "axon/net/endpoint.hpp"
 
+#include <boost/asio/post.hpp>
 #include <boost/asio/this_coro.hpp>
 #include <fmt/format.h>
 
@@ -318,6 +319,17 @@ bool Client::locked() const {
 std::string Client::lock_reason() const {
   auto& array = impl_->open_array();
   return impl_->loop.call([&array] { return array.locked() ? array.lock_state().reason : std::string(); });
+}
+
+void Client::interrupt(const std::string& reason) noexcept {
+  auto* impl = impl_.get();
+  try {
+    // On the loop, between the steps of the call that waits (request_stop must run there).
+    asio::post(impl->loop.executor(), [impl, reason] {
+      if (impl->array) impl->array->request_stop(reason);
+    });
+  } catch (...) {  // only allocation can fail here; there is nothing to stop then but the caller
+  }
 }
 
 }  // namespace axon::fps

@@ -22,7 +22,8 @@
 // bus (Array); a locked client refuses moves (HostErrc::locked) until unlock(). The destructor (and
 // close()) stop robots this client set moving, close the connections and never throw.
 //
-// Threading: one thread at a time may call a client (calls are not queued against each other).
+// Threading: one thread at a time may call a client (calls are not queued against each other);
+// interrupt() is the exception: any thread may call it, also while a call waits.
 #pragma once
 
 #include "axon/fps/layout/focal_plane.hpp"
@@ -167,6 +168,12 @@ class Client {
   UnlockOutcome unlock();
   [[nodiscard]] bool locked() const;
   [[nodiscard]] std::string lock_reason() const;  // empty when not locked
+
+  // From any thread, without waiting (a signal's watcher, a watchdog, Python's Ctrl-C): locks the
+  // array for `reason` and aborts every robot on every bus, as emergency_stop() does. The call
+  // waiting on the client's loop, if any, then ends soon (its moves fail as locked). Nothing
+  // happens when the client is not open. Never throws.
+  void interrupt(const std::string& reason) noexcept;
 
   // Stops what this client set moving, closes the connections. Idempotent, never throws.
   void close() noexcept;

@@ -1,0 +1,237 @@
+// axon.fps: the blocking array client (fps::Client) and the simulated focal plane
+// (fps::sim::SimulatedPlane). Every blocking call releases the GIL and answers Ctrl-C by
+// interrupting the client (every robot stopped, the array locked), then raising KeyboardInterrupt.
+#include "bindings.hpp"
+
+#include "axon/fps/host/client.hpp"
+#include "axon/fps/sim/simulated_plane.hpp"
+
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <fmt/format.h>
+
+namespace axon::python {
+
+namespace {
+
+using fps::Angles;
+using fps::Client;
+
+// Angles as Python sees them: (alpha, beta) in degrees.
+std::optional<std::pair<double, double>> pair_of(const std::optional<Angles>& a) {
+  if (!a) return std::nullopt;
+  return std::pair{a->alpha, a->beta};
+}
+
+std::map<std::uint16_t, Angles> angles_of(const std::map<std::uint16_t, std::pair<double, double>>& in) {
+  std::map<std::uint16_t, Angles> out;
+  for (const auto& [id, p] : in) out[id] = {p.first, p.second};
+  return out;
+}
+
+// One arm's points from an (n, 2) array: degrees, seconds after the start.
+std::vector<std::pair<double, double>> arm_of(const py::object& points) {
+  std::vector<std::pair<double, double>> out;
+  if (points.is_none()) return out;
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(points);
+  if (a && a.size() == 0) return out;
+  if (!a || a.ndim() != 2 || a.shape(1) != 2)
+    throw Exception(Error(CoreErrc::invalid_argument, "a trajectory arm is an (n, 2) array: degrees, seconds"));
+  const auto v = a.unchecked<2>();
+  for (py::ssize_t i = 0; i < v.shape(0); ++i) out.emplace_back(v(i, 0), v(i, 1));
+  return out;
+}
+
+// A client's blocking call from Python: GIL released, Ctrl-C stops the robots.
+template <class F>
+auto blocking(Client& c, F call) {
+  return interruptible(std::move(call), [&c] { c.interrupt("interrupted from Python (KeyboardInterrupt)"); });
+}
+
+void bind_outcomes(py::module_& m) {
+  py::class_<fps::RobotStatus>(m, "RobotStatus", "One robot's row of the status table.")
+      .def_readonly("id", &fps::RobotStatus::id)
+      .def_readonly("bus", &fps::RobotStatus::bus)
+      .def_readonly("state", &fps::RobotStatus::state, "ready, moving, collision, no-datum, bootloader, no-reply ...")
+      .def_readonly("ready", &fps::RobotStatus::ready)
+      .def_readonly("firmware", &fps::RobotStatus::firmware)
+      .def_readonly("flags", &fps::RobotStatus::flags)
+      .def_property_readonly("position", [](const fps::RobotStatus& r) { return pair_of(r.position); },
+                             "(alpha, beta) in degrees, None when the robot did not give it.")
+      .def_readonly("error", &fps::RobotStatus::error)
+      .def("__repr__", [](const fps::RobotStatus& r) {
+        return fmt::format("RobotStatus(id={}, state='{}', firmware='{}')", r.id, r.state, r.firmware);
+      });
+  py::class_<fps::RobotMove>(m, "RobotMove", "One robot of a move.")
+      .def_readonly("id", &fps::RobotMove::id)
+      .def_readonly("ok", &fps::RobotMove::ok)
+      .def_readonly("state", &fps::RobotMove::state)
+      .def_property_readonly("target", [](const fps::RobotMove& r) { return pair_of(r.target); })
+      .def_property_readonly("reached", [](const fps::RobotMove& r) { return pair_of(r.reached); })
+      .def_readonly("detail", &fps::RobotMove::detail)
+      .def("__repr__", [](const fps::RobotMove& r) { return fmt::format("RobotMove(id={}, state='{}')", r.id, r.state); });
+  py::class_<fps::MoveOutcome>(m, "MoveOutcome", "What a move did: completed, and per robot its end.")
+      .def_readonly("completed", &fps::MoveOutcome::completed)
+      .def_readonly("summary", &fps::MoveOutcome::summary)
+      .def_readonly("robots", &fps::MoveOutcome::robots)
+      .def("__bool__", [](const fps::MoveOutcome& o) { return o.completed; })
+      .def("__repr__", [](const fps::MoveOutcome& o) {
+        return fmt::format("MoveOutcome(completed={}, robots={})", o.completed ? "True" : "False", o.robots.size());
+      });
+  py::class_<fps::PlanOutcome>(m, "PlanOutcome", "The plan plan_and_move ran.")
+      .def_readonly("verified", &fps::PlanOutcome::verified)
+      .def_readonly("robots", &fps::PlanOutcome::robots)
+      .def_readonly("not_reached", &fps::PlanOutcome::not_reached)
+      .def_readonly("move_s", &fps::PlanOutcome::move_s)
+      .def_readonly("plan_s", &fps::PlanOutcome::plan_s)
+      .def_readonly("min_clearance_mm", &fps::PlanOutcome::min_clearance_mm)
+      .def_property_readonly("ends", [](const fps::PlanOutcome& o) {
+        std::map<std::uint16_t, std::pair<double, double>> out;
+        for (const auto& [id, a] : o.ends) out[id] = {a.alpha, a.beta};
+        return out;
+      }, "{id: (alpha, beta)} where the plan leaves each robot.")
+      .def_readonly("notes", &fps::PlanOutcome::notes);
+  py::class_<fps::PlanAndMoveOutcome>(m, "PlanAndMoveOutcome")
+      .def_readonly("plan", &fps::PlanAndMoveOutcome::plan)
+      .def_readonly("moved", &fps::PlanAndMoveOutcome::moved)
+      .def_readonly("move", &fps::PlanAndMoveOutcome::move);
+  py::class_<fps::StopOutcome>(m, "StopOutcome")
+      .def_readonly("reason", &fps::StopOutcome::reason)
+      .def_readonly("robots_reached", &fps::StopOutcome::robots_reached)
+      .def_readonly("buses_sent", &fps::StopOutcome::buses_sent)
+      .def_readonly("buses", &fps::StopOutcome::buses)
+      .def("__str__", [](const fps::StopOutcome& o) { return o.text; });
+  py::class_<fps::UnlockOutcome>(m, "UnlockOutcome")
+      .def_readonly("acknowledged", &fps::UnlockOutcome::acknowledged)
+      .def_readonly("silent", &fps::UnlockOutcome::silent);
+}
+
+std::unique_ptr<Client> make_client(double reply_timeout_s, double call_timeout_s, double poll_interval_s,
+                                    double discover_window_s, double position_tolerance_deg) {
+  return std::make_unique<Client>(
+      fps::ClientConfig{reply_timeout_s, call_timeout_s, poll_interval_s, discover_window_s, position_tolerance_deg});
+}
+
+fps::PlanSettings plan_settings(double speed_deg_s, double buffer_mm, std::uint64_t seed, bool park_bad_targets,
+                                bool allow_partial) {
+  return {speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial};
+}
+
+void bind_client_moves(py::class_<Client>& c) {
+  c.def("goto", [](Client& c, const std::map<std::uint16_t, std::pair<double, double>>& targets) {
+         const auto t = angles_of(targets);
+         return blocking(c, [&c, t] { return c.goto_absolute(t); });
+       }, py::arg("targets"), "Moves the robots {id: (alpha, beta)} (degrees) at once and waits for them.")
+      .def("run_trajectories", [](Client& c, const py::dict& paths) {
+         std::map<std::uint16_t, fps::ArmPath> p;
+         for (const auto& [id, arms] : paths) {
+           const auto pair = arms.cast<py::sequence>();
+           if (pair.size() != 2) throw Exception(Error(CoreErrc::invalid_argument, "each robot's path is (alpha, beta)"));
+           p[id.cast<std::uint16_t>()] = {arm_of(pair[0]), arm_of(pair[1])};
+         }
+         return blocking(c, [&c, p] { return c.run_trajectories(p); });
+       }, py::arg("paths"),
+       "{id: (alpha, beta)}: each arm an (n, 2) array of degrees and seconds after the start (the robot adds "
+       "where it stands); uploads, starts every robot together, follows and checks the ends.")
+      .def("plan_and_move", [](Client& c, const py::object& targets, double speed_deg_s, double buffer_mm,
+                               std::uint64_t seed, bool park_bad_targets, bool allow_partial) {
+         const auto s = plan_settings(speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial);
+         if (py::isinstance<py::str>(targets)) {
+           const auto file = targets.cast<std::string>();
+           return blocking(c, [&c, file, s] { return c.plan_and_move(file, s); });
+         }
+         const auto t = angles_of(targets.cast<std::map<std::uint16_t, std::pair<double, double>>>());
+         return blocking(c, [&c, t, s] { return c.plan_and_move(t, s); });
+       }, py::arg("targets"), py::kw_only(), py::arg("speed_deg_s") = 12.0, py::arg("buffer_mm") = 2.0,
+       py::arg("seed") = 1, py::arg("park_bad_targets") = true, py::arg("allow_partial") = false,
+       "Plans from where every robot of the layout stands to {id: (alpha, beta)} or a target file (robots not "
+       "listed fold), verifies and runs it.")
+      .def("emergency_stop", [](Client& c, const std::string& reason) {
+         return blocking(c, [&c, reason] { return c.emergency_stop(reason); });
+       }, py::arg("reason") = "emergency stop", "Locks the array and aborts every robot on every bus.")
+      .def("stop", [](Client& c, bool clear_flags) { blocking(c, [&c, clear_flags] { c.stop(clear_flags); }); },
+           py::arg("clear_flags") = false, "TRAJECTORY_ABORT on every bus, without locking.")
+      .def("unlock", [](Client& c) { return blocking(c, [&c] { return c.unlock(); }); },
+           "STOP_TRAJECTORY on every bus (clears collision flags), then unlocks.")
+      .def("interrupt", &Client::interrupt, py::arg("reason"),
+           "From any thread, without waiting: stops every robot and locks, as Ctrl-C does.");
+}
+
+void bind_client(py::module_& m) {
+  py::class_<Client> c(m, "Client", "The robots of a focal plane (or of some buses), from blocking calls.");
+  c.def(py::init(&make_client), py::kw_only(), py::arg("reply_timeout_s") = 1.0, py::arg("call_timeout_s") = 600.0,
+        py::arg("poll_interval_s") = 0.25, py::arg("discover_window_s") = 0.5, py::arg("position_tolerance_deg") = 0.1)
+      .def("open", [](Client& c, const std::vector<std::string>& specs) { blocking(c, [&c, specs] { c.open(specs); }); },
+           py::arg("bus_specs"), "Opens buses by spec (cannet://HOST:PORT/N, socketcand://..., socketcan:can0).")
+      .def("open", [](Client& c, const fps::FocalPlane& plane, const std::map<std::uint16_t, std::string>& addresses) {
+             blocking(c, [&c, plane, addresses] { c.open(plane, addresses); });
+           }, py::arg("layout"), py::arg("gateway_addresses") = std::map<std::uint16_t, std::string>{},
+           "Opens every gateway of a layout (at its address, or gateway_addresses[id]).")
+      .def("set_layout", &Client::set_layout, py::arg("layout"))
+      .def_property_readonly("is_open", &Client::is_open)
+      .def("set_call_timeout", &Client::set_call_timeout, py::arg("seconds"))
+      .def("discover", [](Client& c) { return blocking(c, [&c] { return c.discover(); }); },
+           "GET_ID on every bus, then firmware and status of every robot found: [RobotStatus].")
+      .def("status", [](Client& c) { return blocking(c, [&c] { return c.status(); }); },
+           "Firmware, status and position of every known robot: [RobotStatus] (status_table(): numpy).")
+      .def_property_readonly("robots", &Client::robots)
+      .def_property_readonly("locked", &Client::locked)
+      .def_property_readonly("lock_reason", &Client::lock_reason)
+      .def("close", &Client::close, py::call_guard<py::gil_scoped_release>(),
+           "Stops what this client set moving, closes the connections.")
+      .def("__enter__", [](py::object self) { return self; })
+      .def("__exit__", [](Client& c, py::args) {
+        py::gil_scoped_release release;
+        c.close();
+      });
+  bind_client_moves(c);
+}
+
+void bind_plane(py::module_& m) {
+  using fps::sim::SimulatedPlane;
+  py::class_<SimulatedPlane>(m, "SimulatedPlane",
+                             "A whole focal plane simulated in this process: its robots behind CAN@net gateway "
+                             "emulators on loopback TCP, and the PLC emulator.")
+      .def(py::init([](const py::object& layout, double time_scale, std::uint64_t seed, bool random_start, bool plc) {
+             fps::sim::SimulatedPlaneOptions o{time_scale, seed, random_start, plc};
+             if (py::isinstance<py::str>(layout)) {
+               const auto name = layout.cast<std::string>();
+               py::gil_scoped_release release;
+               return std::make_unique<SimulatedPlane>(name, o);
+             }
+             const auto plane = layout.cast<fps::FocalPlane>();
+             py::gil_scoped_release release;
+             return std::make_unique<SimulatedPlane>(plane, o);
+           }),
+           py::arg("layout") = "benchtop", py::kw_only(), py::arg("time_scale") = 10.0, py::arg("seed") = 1,
+           py::arg("random_start") = false, py::arg("plc") = true,
+           "layout: 'benchtop' (6 robots), 'default' (500), a layout file or a Layout. time_scale: simulated "
+           "seconds per wall second.")
+      .def_property_readonly("layout", [](const SimulatedPlane& s) { return s.plane(); },
+                             "The layout with the emulators' addresses (Client.open takes it).")
+      .def_property_readonly("gateway_addresses", &SimulatedPlane::gateway_addresses)
+      .def_property_readonly("bus_specs", &SimulatedPlane::bus_specs)
+      .def_property_readonly("plc_address", &SimulatedPlane::plc_address)
+      .def("arms", [](const SimulatedPlane& s, std::uint16_t id) { return pair_of(s.arms(id)); }, py::arg("id"),
+           "(alpha, beta) where the robot's arms physically are; None for an unknown robot.")
+      .def_property_readonly("collisions", &SimulatedPlane::collisions, "Collisions the simulator saw.")
+      .def("inject_collision", &SimulatedPlane::inject_collision, py::arg("id"),
+           "Makes the robot report a collision of its beta arm now (it stops and sets the flag).")
+      .def("stop", &SimulatedPlane::stop, py::call_guard<py::gil_scoped_release>())
+      .def("__enter__", [](py::object self) { return self; })
+      .def("__exit__", [](SimulatedPlane& s, py::args) {
+        py::gil_scoped_release release;
+        s.stop();
+      });
+}
+
+}  // namespace
+
+void bind_fps_client(py::module_& m) {
+  bind_outcomes(m);
+  bind_client(m);
+  bind_plane(m);
+}
+
+}  // namespace axon::python

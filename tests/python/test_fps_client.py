@@ -1,0 +1,112 @@
+"""axon.fps.Client against the focal plane simulated in this process."""
+
+import time
+
+import numpy as np
+import pytest
+
+import axon
+
+
+def test_discovery_finds_every_robot_ready(benchtop):
+    with axon.fps.Client() as fps:
+        fps.open(benchtop.layout)
+        robots = fps.discover()
+        assert len(robots) == 6 and all(r.ready for r in robots)
+        assert sorted(fps.robots) == sorted(int(i) for i in benchtop.layout.ids)
+
+
+def test_the_status_table_is_a_numpy_record_array(client):
+    table = client.status_table()
+    assert len(table) == 6
+    assert set(table.state) == {"ready"}
+    assert np.allclose(table.beta, 180.0, atol=0.1)
+
+
+def test_goto_moves_the_robots_to_their_targets(client, benchtop):
+    ids = client.robots[:2]
+    outcome = client.goto({ids[0]: (30.0, 150.0), ids[1]: (45.0, 160.0)})
+    assert outcome.completed, outcome.summary
+    assert benchtop.arms(ids[0]) == pytest.approx((30.0, 150.0), abs=0.1)
+    assert outcome.robots[0].reached == pytest.approx((30.0, 150.0), abs=0.1)
+
+
+def test_trajectories_from_numpy_run_to_their_last_points(client, benchtop):
+    rid = client.robots[0]
+    alpha = np.array([[10.0, 1.0], [20.0, 2.0]])  # degrees, seconds after the start
+    beta = np.array([[170.0, 1.5]])
+    outcome = client.run_trajectories({rid: (alpha, beta)})
+    assert outcome.completed, outcome.summary
+    assert benchtop.arms(rid) == pytest.approx((20.0, 170.0), abs=0.1)
+
+
+def test_a_plan_from_python_runs_on_the_robots(client, benchtop):
+    layout = benchtop.layout
+    target = axon.fps.random_poses(layout, seed=2)
+    where = {int(r.id): (r.alpha, r.beta) for r in client.status_table()}
+    start = np.array([where[int(i)] for i in layout.ids])  # layout order
+    p = axon.fps.plan(layout, start, target, seed=2)
+    assert p.verified
+    outcome = client.run_trajectories(axon.fps.plan_paths(p))
+    assert outcome.completed, outcome.summary
+    for rid, end in zip(layout.ids, p.end):
+        assert benchtop.arms(int(rid)) == pytest.approx(tuple(end), abs=0.1)
+    assert benchtop.collisions == 0
+
+
+def test_plan_and_move_reaches_every_planned_end(client, benchtop):
+    targets = {rid: (60.0 + 10 * k, 160.0) for k, rid in enumerate(client.robots)}
+    done = client.plan_and_move(targets)
+    assert done.plan.verified and done.move.completed
+    for rid, end in done.plan.ends.items():
+        assert benchtop.arms(rid) == pytest.approx(end, abs=0.1)
+
+
+def test_a_stopped_array_refuses_moves_until_unlocked(client):
+    rid = client.robots[0]
+    client.emergency_stop("test")
+    assert client.locked and "test" in client.lock_reason
+    with pytest.raises(axon.fps.MotionLocked) as e:
+        client.goto({rid: (20.0, 170.0)})
+    assert not isinstance(e.value, axon.fps.CollisionLocked)
+    client.unlock()
+    assert not client.locked
+    assert client.goto({rid: (20.0, 170.0)}).completed
+
+
+def test_a_collision_locks_the_array_and_moves_raise_collision_locked(client, benchtop):
+    rid = client.robots[0]
+    client.goto({rid: (40.0, 170.0)})
+    benchtop.inject_collision(rid)
+    for _ in range(200):  # the robot's collision report locks the array when it arrives
+        if client.locked:
+            break
+        time.sleep(0.01)
+    assert client.locked and "collision" in client.lock_reason
+    with pytest.raises(axon.fps.CollisionLocked):
+        client.goto({rid: (50.0, 170.0)})
+    client.unlock()
+    assert client.goto({rid: (50.0, 170.0)}).completed
+
+
+def test_calls_on_an_unopened_client_and_unknown_robots_raise_their_types(benchtop):
+    fps = axon.fps.Client()
+    with pytest.raises(axon.fps.InvalidArgument):
+        fps.discover()
+    fps.open(benchtop.layout)
+    fps.discover()
+    with pytest.raises(axon.fps.UnknownPositioner):
+        fps.goto({2000: (10.0, 170.0)})
+    fps.close()
+
+
+def test_moving_500_simulated_robots(tmp_path):
+    with axon.fps.SimulatedPlane("default", time_scale=20.0) as plane, axon.fps.Client() as fps:
+        fps.open(plane.layout)
+        assert len(fps.discover()) == 500
+        targets = {int(rid): (60.0 + 15.0 * (k % 7), 160.0) for k, rid in enumerate(plane.layout.ids)}
+        done = fps.plan_and_move(targets)
+        assert done.plan.verified and done.move.completed, done.move.summary
+        worst = max(abs(a - b) for rid, end in done.plan.ends.items() for a, b in zip(plane.arms(rid), end))
+        assert worst <= 0.1
+        assert plane.collisions == 0
