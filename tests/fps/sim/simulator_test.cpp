@@ -430,3 +430,116 @@ TEST(FpsSimulator, RefusesDuplicateIdsAndBadOptions) {
   o.time_scale = 0;
   EXPECT_THROW(Simulator(rig.io.get_executor(), o), Exception);
 }
+
+namespace {
+
+// Uploads `t` to robot `id` from the host node, every reply checked.
+asio::awaitable<void> upload(Rig& rig, std::uint16_t id, protocol::Trajectory t) {
+  const auto frames = protocol::upload_frames(id, t).value();
+  for (const auto& f : frames) {
+    (void)co_await rig.host->send(f);
+    auto r = co_await rig.host->receive(1s);
+    EXPECT_TRUE(r.has_value());
+    if (r) {
+      EXPECT_EQ(protocol::from_frame(r.value()).value().id.response, ResponseCode::accepted);
+    }
+  }
+}
+
+protocol::Trajectory alpha_to(double deg, double seconds) {
+  const std::vector<protocol::ArmPoint> alpha{{deg, seconds}};
+  return protocol::Trajectory::from_physical(alpha, {}).value();
+}
+
+// Two neighbours, beta arms straight out, that turn their alpha arms 120 deg the same way at the
+// same rate over 10 s, A (at the origin) 45 deg behind B (one pitch along +x). At equal instants
+// the capsules stay at least 4.7 mm apart (the buffers need 4 mm); with A a second or more ahead
+// of B, A's arm crosses where B's arm still is.
+struct Chase {
+  static constexpr double a_from = 225, a_to = 345, b_from = 180, b_to = 300, seconds = 10, pitch = 22.4;
+  static double distance(double ta, double tb) {
+    const auto at = [](double from, double to, double t) { return from + (to - from) * std::clamp(t / seconds, 0.0, 1.0); };
+    return segment_distance(beta_segment(RobotGeometry{{0, 0}}, at(a_from, a_to, ta), 0),
+                            beta_segment(RobotGeometry{{pitch, 0}}, at(b_from, b_to, tb), 0));
+  }
+};
+
+}  // namespace
+
+TEST(FpsSimulator, ChaseGeometryIsClearOnlyAtEqualInstants) {
+  double same = 1e9, skewed = 1e9;
+  for (int i = 0; i <= 100; ++i) {
+    const double t = Chase::seconds * i / 100;
+    same = std::min(same, Chase::distance(t, t));
+    skewed = std::min(skewed, Chase::distance(t + 2, t));
+  }
+  EXPECT_GT(same, 4.5);
+  EXPECT_LT(skewed, 1.0);
+}
+
+// Under load the tick that moves every robot came late, while the host's poll of one robot moved
+// that robot alone to the present: the collision check then compared it, seconds ahead, with
+// neighbours still in the past, and reported collisions that one sync edge and one clock (the
+// hardware) never produce. Every robot must be seen at the same instant.
+TEST(FpsSimulator, ALateTickComparesEveryRobotAtTheSameInstant) {
+  core::ManualClock clock;
+  SimulatorOptions o;
+  o.clock = &clock;
+  o.tick = 1h;  // steps only by hand: the late tick is the test's
+  Rig rig(o);
+  PositionerConfig ca, cb;
+  ca.start_position_deg = {{Chase::a_from, 0}};
+  cb.start_position_deg = {{Chase::b_from, 0}};
+  auto* a = rig.add(1, 0, 0, ca);
+  auto* b = rig.add(2, Chase::pitch, 0, cb);
+  rig.sim.start();
+  std::vector<protocol::Message> seen;
+  run(rig.io, [&]() -> asio::awaitable<void> {
+    co_await upload(rig, 1, alpha_to(Chase::a_to, Chase::seconds));
+    co_await upload(rig, 2, alpha_to(Chase::b_to, Chase::seconds));
+    rig.sim.sync_pulse();
+    const auto acks = co_await collect(*rig.host, 2, 1s);
+    EXPECT_EQ(acks.size(), 2u);
+    seen = co_await drive(rig, clock, 100ms, 40);  // 4 s, ticks on time
+    clock.advance(2s);                             // then no tick for 2 s
+    (void)co_await rig.host->send(request(1, CommandId::get_current_position, 1));  // but A is polled
+    const auto reply = co_await collect(*rig.host, 1, 1s);
+    EXPECT_EQ(reply.size(), 1u);
+    const auto rest = co_await drive(rig, clock, 100ms, 50);  // the late tick, then to the end
+    seen.insert(seen.end(), rest.begin(), rest.end());
+    rig.sim.stop();
+  });
+  EXPECT_EQ(rig.sim.stats().neighbour_collisions, 0u);
+  for (const auto& m : seen) EXPECT_NE(m.id.command, 18) << "collision reported by robot " << m.id.positioner;
+  EXPECT_NEAR(a->physical_deg(Arm::alpha), Chase::a_to, 1e-6);
+  EXPECT_NEAR(b->physical_deg(Arm::alpha), Chase::b_to, 1e-6);
+}
+
+// The sync line reaches every robot on the same edge: each starts its trajectory at that instant,
+// however long ago the simulator last moved it.
+TEST(FpsSimulator, SyncEdgeStartsEveryRobotAtTheSameInstant) {
+  core::ManualClock clock;
+  SimulatorOptions o;
+  o.clock = &clock;
+  o.tick = 1h;
+  Rig rig(o);
+  PositionerConfig ca, cb;
+  ca.start_position_deg = {{Chase::a_from, 0}};
+  cb.start_position_deg = {{Chase::b_from, 0}};
+  auto* a = rig.add(1, 0, 0, ca);
+  auto* b = rig.add(2, Chase::pitch, 0, cb);
+  rig.sim.start();
+  run(rig.io, [&]() -> asio::awaitable<void> {
+    co_await upload(rig, 1, alpha_to(Chase::a_to, Chase::seconds));
+    clock.advance(3s);  // B is answered 3 s later than A
+    co_await upload(rig, 2, alpha_to(Chase::b_to, Chase::seconds));
+    clock.advance(1s);
+    rig.sim.sync_pulse();
+    (void)co_await collect(*rig.host, 2, 1s);
+    (void)co_await drive(rig, clock, 100ms, 50);  // half of the move
+    rig.sim.stop();
+  });
+  // Both half way: 60 deg from where each started.
+  EXPECT_NEAR(a->physical_deg(Arm::alpha), Chase::a_from + 60, 1e-6);
+  EXPECT_NEAR(b->physical_deg(Arm::alpha), Chase::b_from + 60, 1e-6);
+}

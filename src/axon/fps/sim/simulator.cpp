@@ -117,6 +117,7 @@ struct Simulator::State final : std::enable_shared_from_this<State>, core::Deadl
   void arm_due(core::TimePoint at);
   void run_due();
   void on_deadline() override { run_due(); }
+  SimTime event_time();
   void step();
   void check_collisions(SimTime t);
 
@@ -148,7 +149,7 @@ Result<PositionerModel*> Simulator::State::add(
   bus->set_filters({can::Filter{std::uint32_t{config.id} << proto::kPositionerShift, kIdMask, can::Filter::Format::extended},
                     can::Filter{0, kIdMask, can::Filter::Format::extended}});
   const std::uint16_t id = config.id;
-  auto robot = std::make_unique<Robot>(PositionerModel(std::move(config), now()), std::move(bus));
+  auto robot = std::make_unique<Robot>(PositionerModel(std::move(config), event_time()), std::move(bus));
   Robot* r = robot.get();
   robots.push_back(std::move(robot));
   by_id.emplace(id, r);
@@ -213,6 +214,7 @@ void Simulator::State::run_due() {
   const auto later = [](const Due& a, const Due& b) { return a.at != b.at ? a.at > b.at : a.seq > b.seq; };
   due_armed = core::TimePoint::max();
   const auto t = core::SteadyClock::instance().now();
+  std::optional<SimTime> at;  // one instant for every frame answered in this round
   while (!stopped && !due.empty() && due.front().at <= t) {
     std::pop_heap(due.begin(), due.end(), later);
     Robot& r = *due.back().robot;
@@ -220,7 +222,8 @@ void Simulator::State::run_due() {
     if (r.current) {
       const proto::Message m = *r.current;
       r.current.reset();
-      emit(r, r.model.handle(m, now()));
+      if (!at) at = event_time();
+      emit(r, r.model.handle(m, *at));
     }
     if (!take_next(r)) r.idle.notify();
   }
@@ -297,6 +300,19 @@ asio::awaitable<void> Simulator::State::tick(std::shared_ptr<State> self) {
     if (self->stopped) break;
     self->step();
   }
+}
+
+SimTime Simulator::State::event_time() {
+  // The collision check compares the poses of every robot at one instant, so no robot may run
+  // ahead of the others. While anything moves, only step() moves time on (every robot, checks
+  // included): a frame is answered at the instant of the last step. Answering it at the present
+  // instead moved that robot alone ahead; under load, with the tick late, seconds ahead of its
+  // neighbours, and the check saw collisions that robots on one clock and one sync edge (the
+  // hardware) never have. With nothing moving, poses do not depend on time: the world jumps to
+  // the present, so a move starts when its frame arrives.
+  const bool any_moving = std::any_of(robots.begin(), robots.end(), [](const auto& r) { return r->model.moving(); });
+  if (!any_moving) last_step = std::max(last_step, now());
+  return last_step;
 }
 
 void Simulator::State::step() {
@@ -439,7 +455,7 @@ auto lookup(Map& by_id, std::span<const std::uint16_t> ids) -> Result<std::vecto
 }  // namespace
 
 void Simulator::power_off(bool save_position) {
-  const SimTime t = now();
+  const SimTime t = state_->event_time();
   for (auto& r : state_->robots) {
     r->model.power_off(t, save_position);
     while (r->bus->try_receive()) {
@@ -449,7 +465,7 @@ void Simulator::power_off(bool save_position) {
 
 Result<void> Simulator::power_off(std::span<const std::uint16_t> ids, bool save_position) {
   AXON_TRY(robots, lookup(state_->by_id, ids));
-  const SimTime t = now();
+  const SimTime t = state_->event_time();
   for (auto* r : robots) {
     r->model.power_off(t, save_position);
     while (r->bus->try_receive()) {
@@ -460,20 +476,20 @@ Result<void> Simulator::power_off(std::span<const std::uint16_t> ids, bool save_
 
 Result<void> Simulator::power_on(std::span<const std::uint16_t> ids, bool sync_line_low) {
   AXON_TRY(robots, lookup(state_->by_id, ids));
-  const SimTime t = now();
+  const SimTime t = state_->event_time();
   for (auto* r : robots) r->model.power_on(t, sync_line_low);
   return ok();
 }
 
 Result<void> Simulator::sync_pulse(std::span<const std::uint16_t> ids) {
   AXON_TRY(robots, lookup(state_->by_id, ids));
-  const SimTime t = now();
+  const SimTime t = state_->event_time();  // one edge, one instant for every robot it reaches
   for (auto* r : robots) state_->emit(*r, r->model.sync_pulse(t), true);
   return ok();
 }
 
 void Simulator::power_on(bool sync_line_low) {
-  const SimTime t = now();
+  const SimTime t = state_->event_time();
   for (auto& r : state_->robots) r->model.power_on(t, sync_line_low);
 }
 
@@ -483,7 +499,7 @@ void Simulator::power_cycle(bool sync_line_low) {
 }
 
 void Simulator::sync_pulse() {
-  const SimTime t = now();
+  const SimTime t = state_->event_time();
   for (auto& r : state_->robots) state_->emit(*r, r->model.sync_pulse(t), true);
 }
 
@@ -492,7 +508,7 @@ Result<void> Simulator::force_collision(std::uint16_t id, Arm arm) {
   if (it == state_->by_id.end()) {
     return make_error(CoreErrc::invalid_argument, fmt::format("simulator: no positioner {}", id));
   }
-  state_->emit(*it->second, it->second->model.inject_collision(arm, now()));
+  state_->emit(*it->second, it->second->model.inject_collision(arm, state_->event_time()));
   return ok();
 }
 

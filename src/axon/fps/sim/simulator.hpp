@@ -11,7 +11,10 @@
 // Time: simulated time = real time elapsed since construction x time_scale (e.g. 50: a 40-minute
 // cogging calibration takes under a minute). A steady_timer tick moves every model to the current
 // simulated time, sends what they report on their own (collision frames) and checks neighbours
-// for collisions in steps of at most collision_step of simulated time. The protocol is unchanged
+// for collisions in steps of at most collision_step of simulated time. While anything moves only
+// that step moves time on: frames, the sync edge and power switches happen at the instant of the
+// last step, so every robot is at the same instant when the check compares them (with nothing
+// moving, time jumps to the present first). The protocol is unchanged
 // by the scale; only durations of physical processes shrink. Unless scale_protocol_timeouts is
 // set, the robots' boot time, bootloader wait and watchdog are stretched by the scale so that
 // they keep their real-time length for the host.
