@@ -193,7 +193,7 @@ struct Session {
 };
 
 asio::awaitable<std::unique_ptr<Session>> open_session(Blmc& cli, asio::io_context& io,
-                                                       const std::function<void(std::function<void()>)>& on_signal,
+                                                       const SignalHook& on_signal,
                                                        bool signal_ends_normally) {
   const auto& o = cli.o;
   auto s = std::make_unique<Session>();
@@ -216,8 +216,8 @@ asio::awaitable<std::unique_ptr<Session>> open_session(Blmc& cli, asio::io_conte
   }
   Session* raw = s.get();
   // A stop request ends the waits on the board at once (an enable waiting for the alignment).
-  on_signal([raw] {
-    if (raw->signal_ends_normally) signal_is_normal_end().store(true);
+  on_signal([raw, on_signal] {
+    if (raw->signal_ends_normally) on_signal.signal_ends_normally();
     raw->stop = true;
     raw->board->interrupt();
   });
@@ -526,17 +526,17 @@ void check_loop_options(const BlmcOptions& o) {
     throw Exception(usage(fmt::format("--rate {:g} / --recv-timeout-ms {}: {}", o.rate_hz, o.recv_timeout_ms, v.error().detail)));
 }
 
-CLI::App* add(CLI::App* parent, const std::shared_ptr<Blmc>& cli, const char* name, const char* help, Kind kind, Body body) {
+CLI::App* add(CLI::App* parent, GlobalOptions& global, const std::shared_ptr<Blmc>& cli, const char* name, const char* help, Kind kind, Body body) {
   auto* c = parent->add_subcommand(name, help);
-  c->callback([cli, body = std::move(body), kind] {
+  c->callback([cli, body = std::move(body), kind, &global] {
     if (kind == Kind::motion) check_loop_options(cli->o);
-    exit_code() = run_blmc(*cli, kind == Kind::observe, body);
+    global.exit_code = run_blmc(*cli, kind == Kind::observe, body);
   });
   return c;
 }
 
-CLI::App* add_motion(CLI::App* parent, const std::shared_ptr<Blmc>& cli, const char* name, const char* help, Work work) {
-  return add(parent, cli, name, help, Kind::motion, [name, work](Session& s) -> asio::awaitable<int> {
+CLI::App* add_motion(CLI::App* parent, GlobalOptions& global, const std::shared_ptr<Blmc>& cli, const char* name, const char* help, Work work) {
+  return add(parent, global, cli, name, help, Kind::motion, [name, work](Session& s) -> asio::awaitable<int> {
     const int rc = co_await with_motors(s, name, work);
     co_return rc;
   });
@@ -577,22 +577,22 @@ void add_board_options(CLI::App* b, BlmcOptions& o) {
   b->add_flag("--json", o.json, "stdout: JSON Lines (one object per line: status, sample, report, sent)");
 }
 
-void add_motion_commands(CLI::App* b, const std::shared_ptr<Blmc>& cli) {
+void add_motion_commands(CLI::App* b, GlobalOptions& global, const std::shared_ptr<Blmc>& cli) {
   auto& o = cli->o;
-  auto* cur = add_motion(b, cli, "current", "apply a constant current to one motor for a while (safety limits apply)",
+  auto* cur = add_motion(b, global, cli, "current", "apply a constant current to one motor for a while (safety limits apply)",
                          current_work);
   cur->add_option("motor", o.current_motor, "1 or 2")->required()->check(CLI::Range(1, 2));
   cur->add_option("amperes", o.current_amps, "current, A (clamped to --max-current)")->required()->check(amperes());
   cur->add_option("--duration", o.current_duration_s, "seconds (default 1)")->check(positive());
 
-  auto* pd = add_motion(b, cli, "pd", "host-side PD: hold the start position, or track a sine around it", pd_work);
+  auto* pd = add_motion(b, global, cli, "pd", "host-side PD: hold the start position, or track a sine around it", pd_work);
   pd->add_option("--kp", o.pd_gains.kp, "A per motor revolution (default 5)")->check(non_negative());
   pd->add_option("--kd", o.pd_gains.kd, "A per rev/s (default 0.05)")->check(non_negative());
   pd->add_option("--amplitude", o.pd_amplitude, "sine amplitude, motor rev (default 0: hold)")->check(non_negative());
   pd->add_option("--frequency", o.pd_frequency, "sine frequency, Hz (default 0.5)")->check(non_negative());
   pd->add_option("--duration", o.pd_duration_s, "seconds (default 5)")->check(positive());
 
-  auto* home = add_motion(b, cli, "home", "find the encoder index of each motor and report its position (the offset)",
+  auto* home = add_motion(b, global, cli, "home", "find the encoder index of each motor and report its position (the offset)",
                           home_work);
   home->add_option("--speed", o.home.speed_rev_s, "motor rev/s, sign gives the direction (default 0.5)")->check(nonzero());
   home->add_option("--kp", o.home.kp, "A per rev (default 2)")->check(positive());
@@ -604,30 +604,30 @@ void add_motion_commands(CLI::App* b, const std::shared_ptr<Blmc>& cli) {
 
 }  // namespace
 
-void add_blmc_commands(CLI::App& app, GlobalOptions& /*global*/) {
+void add_blmc_commands(CLI::App& app, GlobalOptions& global) {
   auto cli = std::make_shared<Blmc>();
   auto& o = cli->o;
   auto* b = app.add_subcommand("blmc", "motor driver board: status, monitor, enable, current, PD, homing, record, raw");
   b->require_subcommand(1);
   add_board_options(b, o);
 
-  add(b, cli, "status", "decoded status frames (one, or live with --duration)", Kind::plain, cmd_status)
+  add(b, global, cli, "status", "decoded status frames (one, or live with --duration)", Kind::plain, cmd_status)
       ->add_option("--duration", o.duration_s, "seconds to keep printing (default 0: one)")
       ->check(non_negative());
-  add(b, cli, "monitor", "live table of currents, positions, velocities, ADC", Kind::observe, cmd_monitor)
+  add(b, global, cli, "monitor", "live table of currents, positions, velocities, ADC", Kind::observe, cmd_monitor)
       ->add_option("--duration", o.duration_s, "seconds (default 0: until Ctrl-C)")
       ->check(non_negative());
-  add(b, cli, "enable", "enable the system and motors, wait until they are aligned, and leave them enabled", Kind::plain,
+  add(b, global, cli, "enable", "enable the system and motors, wait until they are aligned, and leave them enabled", Kind::plain,
       cmd_enable);
-  add(b, cli, "disable", "zero currents, disable the motors and the system", Kind::plain, cmd_disable);
-  add_motion_commands(b, cli);
+  add(b, global, cli, "disable", "zero currents, disable the motors and the system", Kind::plain, cmd_disable);
+  add_motion_commands(b, global, cli);
 
-  auto* rec = add(b, cli, "record", "write a candump log of the bus (everything the board sends and receives)",
+  auto* rec = add(b, global, cli, "record", "write a candump log of the bus (everything the board sends and receives)",
                   Kind::observe, cmd_record);
   rec->add_option("file", o.record_file, "candump log file")->required();
   rec->add_option("--duration", o.duration_s, "seconds (default 0: until Ctrl-C)")->check(non_negative());
 
-  add(b, cli, "raw", "send one frame (ID#DATA) or command (NAME=value)", Kind::plain, cmd_raw)
+  add(b, global, cli, "raw", "send one frame (ID#DATA) or command (NAME=value)", Kind::plain, cmd_raw)
       ->add_option("frame", o.raw_text, "e.g. 000#0000000100000001 or ENABLE_SYS=1")
       ->required();
 }

@@ -248,7 +248,7 @@ asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) 
   co_return motion_exit_code(rep.completed, fpa.array());
 }
 
-using SetOnSignal = std::function<void(std::function<void()>)>;
+using SetOnSignal = SignalHook;
 
 // Correction iterations: each round reads the next --measured file (waiting for it to appear),
 // corrects the robots outside tolerance and waits for them to arrive.
@@ -309,8 +309,8 @@ asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a
     // Once, or every period until a signal (or --for): the settings go out only when they change.
     host::ColdControl cold(fpa);
     bool stop = false;
-    set_on_signal([&stop] {
-      signal_is_normal_end().store(true);  // --watch runs until a signal: its normal end
+    set_on_signal([&stop, set_on_signal] {
+      set_on_signal.signal_ends_normally();  // --watch runs until a signal: its normal end
       stop = true;
     });
     const auto t0 = std::chrono::steady_clock::now();
@@ -393,7 +393,7 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
 
 }  // namespace
 
-void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
+void add_fps_plane_commands(CLI::App& app, GlobalOptions& global) {
   CLI::App* fps_cmd = app.get_subcommand("fps");
   const auto args = std::make_shared<PlaneArgs>();  // shared with the callbacks
   auto& a = *args;
@@ -403,13 +403,13 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   p->add_option("--plc", a.plc, "the PLC at HOST[:PORT] (needed for --sync)");
   p->add_flag("--json", a.json, "check, status, move: one JSON document on stdout and nothing else");
   p->fallthrough();  // --json may also follow the action
-  p->add_subcommand("check", "GET_ID on every bus at once, compared with the layout")->callback([args] {
-    exit_code() = run_plane(*args, "check");
+  p->add_subcommand("check", "GET_ID on every bus at once, compared with the layout")->callback([args, &global] {
+    global.exit_code = run_plane(*args, "check");
   });
   auto* ck = p->get_subcommand("check");
   ck->add_option("--window", a.window_s, "seconds to collect GET_ID answers (default 0.5)")->check(positive());
-  p->add_subcommand("status", "discovery: firmware and status of every robot")->callback([args] {
-    exit_code() = run_plane(*args, "status");
+  p->add_subcommand("status", "discovery: firmware and status of every robot")->callback([args, &global] {
+    global.exit_code = run_plane(*args, "status");
   });
   auto* mv = p->add_subcommand("move", "every robot straight to one (alpha, beta) by a trajectory, all at once");
   mv->add_option("--alpha", a.alpha, "degrees (default 0)");
@@ -422,7 +422,7 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   mv->add_option("--gear-ratio", a.gear_ratio, "motor turns per arm turn (default 1000)")->check(positive());
   mv->add_option("--points", a.points, "points per arm (default 20)")->check(CLI::Range(1, 1000));
   mv->add_flag("--sync", a.sync, "start with the PLC's sync line instead of the START_TRAJECTORY broadcast");
-  mv->callback([args] { exit_code() = run_plane(*args, "move"); });
+  mv->callback([args, &global] { global.exit_code = run_plane(*args, "move"); });
   auto* up = p->add_subcommand("upgrade",
                                "firmware of every robot, sextant by sextant: power-cycled into the bootloader by the PLC, "
                                "upgraded (one retry), powered back, version checked (needs --plc)");
@@ -438,9 +438,9 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   cd->add_flag("--watch", a.watch, "keep going: read every --period, send only when the decision changes");
   cd->add_option("--period", a.period_s, "seconds between readings with --watch (default 60)")->check(CLI::Range(0.05, 86400.0));
   cd->add_option("--for", a.for_s, "with --watch: stop after this many seconds (default: at a signal)")->check(non_negative());
-  cd->callback([args] {
+  cd->callback([args, &global] {
     if (args->plc.empty()) throw Exception(usage("fps plane cold needs --plc"));
-    exit_code() = run_plane(*args, "cold");
+    global.exit_code = run_plane(*args, "cold");
   });
   auto* cr = p->add_subcommand("correct",
                                "correction iterations: robots whose measured fibre is outside tolerance get a correction "
@@ -455,10 +455,10 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   cr->add_option("--iterations", a.iterations, "most rounds that send corrections (default 3)")->check(CLI::Range(1, 100));
   cr->add_option("--wait", a.wait_s, "seconds to wait for each later --measured file to appear (default 600)")
       ->check(CLI::Range(0.0, 86400.0));
-  cr->callback([args] { exit_code() = run_plane(*args, "correct"); });
-  up->callback([args] {
+  cr->callback([args, &global] { global.exit_code = run_plane(*args, "correct"); });
+  up->callback([args, &global] {
     if (args->plc.empty()) throw Exception(usage("fps plane upgrade needs --plc"));
-    exit_code() = run_plane(*args, "upgrade");
+    global.exit_code = run_plane(*args, "upgrade");
   });
 }
 
