@@ -10,6 +10,7 @@
 #include "axon/blmc/host/control_run.hpp"
 #include "axon/blmc/host/error.hpp"
 #include "axon/blmc/host/motor_session.hpp"
+#include "axon/blmc/host/observe.hpp"
 #include "axon/blmc/host/session_log.hpp"
 #include "axon/blmc/protocol/command.hpp"
 #include "axon/blmc/protocol/frames.hpp"
@@ -18,7 +19,6 @@
 #include "axon/can/open.hpp"
 #include "checks.hpp"
 #include "commands.hpp"
-#include "axon/core/wakeup.hpp"
 #include "run.hpp"
 
 #include <fmt/format.h>
@@ -368,34 +368,20 @@ asio::awaitable<int> with_motors(Session& s, const char* command, Work work) {
 // ---- subcommands ------------------------------------------------------------------------------
 
 asio::awaitable<int> cmd_status(Session& s) {
-  const auto& o = s.o();
-  const auto t0 = core::SteadyClock::instance().now();
-  int printed = 0;
-  while (!s.stop) {
-    auto st = co_await s.board->wait_status(s.board->options().status_timeout);
-    if (!st) {
-      if (st.error() == bh::HostErrc::interrupted) break;
-      spdlog::error("blmc: {}", st.error().message());
-      co_return exit_code_value::failed;
-    }
-    if (!s.out().status(st.value())) co_return exit_code_value::failed;
-    ++printed;
-    if (o.duration_s <= 0 && printed >= 1) break;
-    if (o.duration_s > 0 && core::SteadyClock::instance().now() - t0 >= seconds(o.duration_s)) break;
+  auto r = co_await bh::watch_status(*s.board, seconds(s.o().duration_s), [&s](const bp::Status& st) { return s.out().status(st); });
+  if (!r) {
+    spdlog::error("blmc: {}", r.error().message());
+    co_return exit_code_value::failed;
   }
-  co_return exit_code_value::ok;
+  co_return s.out().ok() ? exit_code_value::ok : exit_code_value::failed;
 }
 
 asio::awaitable<int> cmd_monitor(Session& s) {
   const auto& o = s.o();
-  const auto t0 = core::SteadyClock::instance().now();
   bool writing = s.out().table_header();
-  while (!s.stop && !s.board->closed() && writing) {
-    co_await core::sleep_for(seconds(1.0 / o.refresh_hz));
-    const double t = std::chrono::duration<double>(core::SteadyClock::instance().now() - t0).count();
-    writing = s.out().row(t, s.board->latest());
-    if (o.duration_s > 0 && t >= o.duration_s) break;
-  }
+  if (writing)
+    writing = co_await bh::monitor(*s.board, seconds(1.0 / o.refresh_hz), seconds(o.duration_s),
+                                   [&s](double t, const bh::Measurements& m) { return s.out().row(t, m); });
   const auto& m = s.board->latest();
   spdlog::info("blmc: {} board frames, {} rejected, {} foreign", m.frames, m.rejected, m.foreign);
   co_return writing ? exit_code_value::ok : exit_code_value::failed;
@@ -487,15 +473,7 @@ asio::awaitable<Outcome> home_work(Session& s) {
 asio::awaitable<int> cmd_record(Session& s) {
   const auto& o = s.o();
   auto w = need(can::CandumpWriter::create(o.record_file));
-  std::uint64_t n = 0;
-  s.board->set_tap(bh::candump_tap(w, s.iface, &n));
-  const auto t0 = core::SteadyClock::instance().now();
-  while (!s.stop && !s.board->closed()) {
-    co_await core::sleep_for(100ms);
-    if (o.duration_s > 0 && core::SteadyClock::instance().now() - t0 >= seconds(o.duration_s)) break;
-  }
-  s.board->set_tap({});
-  (void)w.flush();
+  const auto n = co_await bh::record(*s.board, w, s.iface, seconds(o.duration_s));
   spdlog::info("blmc: {} frames to {}", n, o.record_file);
   co_return exit_code_value::ok;
 }

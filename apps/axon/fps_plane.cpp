@@ -102,9 +102,11 @@ std::vector<std::uint8_t> read_image(const std::string& path) {
   return image;
 }
 
+core::Duration to_duration(double s) { return std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(s)); }
+
 host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
   host::FocalPlaneArrayOptions o;
-  o.check_window = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(a.window_s));
+  o.check_window = to_duration(a.window_s);
   if (!a.plc.empty()) o.plc = need(net::parse_endpoint(a.plc, 502));
   return o;
 }
@@ -287,6 +289,37 @@ asio::awaitable<int> plane_correct(host::FocalPlaneArray& fpa, const PlaneArgs& 
   co_return motion_exit_code(run.ok(), fpa.array());
 }
 
+// `fps plane cold`: the cold policy once, or with --watch every period until a signal (its normal
+// end) or --for. A report is printed when settings went out (and always without --watch).
+asio::awaitable<int> plane_cold(host::FocalPlaneArray& fpa, const PlaneArgs& a, const SetOnSignal& set_on_signal) {
+  host::ColdControl cold(fpa);
+  int rc = 0;
+  const auto print = [&rc, watch = a.watch](const Result<host::ColdApplyReport>& r) {
+    if (!r) {
+      std::printf("cold policy: %s\n", r.error().message().c_str());
+      rc = 1;
+    } else if (r.value().sent || !watch) {
+      std::fputs(r.value().to_text().c_str(), stdout);
+      rc = r.value().failed.empty() ? 0 : 1;
+    }
+    std::fflush(stdout);
+  };
+  bool stop = false;
+  set_on_signal([&stop, set_on_signal] {
+    set_on_signal.signal_ends_normally();  // --watch runs until a signal: its normal end
+    stop = true;
+  });
+  if (a.watch) {
+    auto watching = cold.watch(to_duration(a.period_s), &stop, print, to_duration(a.for_s));
+    co_await std::move(watching);
+  } else {
+    auto r = co_await cold.step(true);
+    print(r);
+  }
+  set_on_signal([] {});
+  co_return rc;
+}
+
 // One `fps plane` action on the connected plane; returns the exit code.
 asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a, const std::string& action,
                                   const fps::FocalPlane& plane, const SetOnSignal& set_on_signal,
@@ -305,36 +338,7 @@ asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a
     stop_robots_on_signal(set_on_signal, fpa.array());
     rc = co_await plane_move(fpa, a);
   }
-  if (action == "cold") {
-    // Once, or every period until a signal (or --for): the settings go out only when they change.
-    host::ColdControl cold(fpa);
-    bool stop = false;
-    set_on_signal([&stop, set_on_signal] {
-      set_on_signal.signal_ends_normally();  // --watch runs until a signal: its normal end
-      stop = true;
-    });
-    const auto t0 = std::chrono::steady_clock::now();
-    bool first = true;
-    while (!stop) {
-      auto r = co_await cold.step(first);
-      first = false;
-      if (!r) {
-        std::printf("cold policy: %s\n", r.error().message().c_str());
-        rc = 1;
-      } else if (r.value().sent || !a.watch) {
-        std::fputs(r.value().to_text().c_str(), stdout);
-        rc = r.value().failed.empty() ? 0 : 1;
-      }
-      std::fflush(stdout);
-      if (!a.watch) break;
-      const auto next = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.period_s);
-      while (!stop && std::chrono::steady_clock::now() < next) {
-        co_await core::sleep_for(std::chrono::milliseconds(50));
-        if (a.for_s > 0 && std::chrono::steady_clock::now() - t0 >= std::chrono::duration<double>(a.for_s)) stop = true;
-      }
-    }
-    set_on_signal([] {});
-  }
+  if (action == "cold") rc = co_await plane_cold(fpa, a, set_on_signal);
   if (action == "correct") rc = co_await plane_correct(fpa, a, plane, set_on_signal);
   if (action == "upgrade") {
     if (!uo.expected_version) std::printf("no --version given: versions are reported, not checked\n");
