@@ -16,7 +16,7 @@ namespace {
 
 using namespace testing;
 
-BoardOptions slack() {
+BoardOptions watching_board() {
   BoardOptions o;
   o.recv_timeout_ms = 500;
   return o;
@@ -25,7 +25,7 @@ BoardOptions slack() {
 TEST(BlmcObserve, WatchStatusWithNoDurationHandsOverTheFirstStatusOnly) {
   SimRig rig;
   rig.run([&]() -> asio::awaitable<void> {
-    Board board(*rig.host, slack());
+    Board board(*rig.host, watching_board());
     std::vector<protocol::Status> seen;
     auto r = co_await watch_status(board, 0s, [&](const protocol::Status& s) {
       seen.push_back(s);
@@ -41,7 +41,7 @@ TEST(BlmcObserve, WatchStatusWithNoDurationHandsOverTheFirstStatusOnly) {
 TEST(BlmcObserve, WatchStatusStopsWhenTheCallbackRefuses) {
   SimRig rig;
   rig.run([&]() -> asio::awaitable<void> {
-    Board board(*rig.host, slack());
+    Board board(*rig.host, watching_board());
     int calls = 0;
     auto r = co_await watch_status(board, 30s, [&](const protocol::Status&) { return ++calls < 2; });
     CO_ASSERT(r);
@@ -53,7 +53,7 @@ TEST(BlmcObserve, WatchStatusStopsWhenTheCallbackRefuses) {
 TEST(BlmcObserve, AnInterruptedWatchEndsWithoutAnError) {
   SimRig rig;
   rig.run([&]() -> asio::awaitable<void> {
-    Board board(*rig.host, slack());
+    Board board(*rig.host, watching_board());
     board.interrupt();
     int calls = 0;
     auto r = co_await watch_status(board, 30s, [&](const protocol::Status&) { return ++calls > 0; });
@@ -68,7 +68,7 @@ TEST(BlmcObserve, AnInterruptedWatchEndsWithoutAnError) {
 TEST(BlmcObserve, MonitorSamplesTheMeasurementsOfAnEnabledBoardForItsDuration) {
   SimRig rig;
   rig.run([&]() -> asio::awaitable<void> {
-    Board board(*rig.host, slack());
+    Board board(*rig.host, watching_board());
     auto enabled = co_await board.enable();
     CO_ASSERT(enabled);
     std::vector<double> times;
@@ -91,7 +91,7 @@ TEST(BlmcObserve, MonitorSamplesTheMeasurementsOfAnEnabledBoardForItsDuration) {
 TEST(BlmcObserve, MonitorStopsWhenTheCallbackRefuses) {
   SimRig rig;
   rig.run([&]() -> asio::awaitable<void> {
-    Board board(*rig.host, slack());
+    Board board(*rig.host, watching_board());
     int calls = 0;
     const bool ok = co_await monitor(board, 10ms, 30s, [&](double, const Measurements&) {
       ++calls;
@@ -105,7 +105,7 @@ TEST(BlmcObserve, MonitorStopsWhenTheCallbackRefuses) {
 TEST(BlmcObserve, RecordWritesEveryFrameForItsDurationAndRemovesItsTap) {
   SimRig rig;
   rig.run([&]() -> asio::awaitable<void> {
-    Board board(*rig.host, slack());
+    Board board(*rig.host, watching_board());
     auto enabled = co_await board.enable();
     CO_ASSERT(enabled);
     std::ostringstream out;
