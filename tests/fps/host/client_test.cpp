@@ -126,7 +126,7 @@ TEST_F(ClientOnPlane, GoToDatumsDrivesIntoTheHardStopsAndReportsWhereTheRobotSta
 
 TEST_F(ClientOnPlane, CalibrateRunsMotorsAndDatumsAndSaves) {
   fps.set_call_timeout(120);
-  const auto out = fps.calibrate(2);
+  const auto out = fps.calibrate(3);
   EXPECT_TRUE(out.saved);
   EXPECT_TRUE(out.motor_error.has_value());
   EXPECT_TRUE(out.datum_error.has_value());
@@ -134,7 +134,7 @@ TEST_F(ClientOnPlane, CalibrateRunsMotorsAndDatumsAndSaves) {
   CalibrationSteps only_motors;
   only_motors.datums = false;
   only_motors.save = false;
-  const auto motors = fps.calibrate(2, only_motors);
+  const auto motors = fps.calibrate(3, only_motors);
   EXPECT_FALSE(motors.saved);
   EXPECT_TRUE(motors.motor_error.has_value());
   EXPECT_FALSE(motors.datum_error.has_value());
@@ -151,7 +151,7 @@ TEST_F(ClientOnPlane, DatumAndCalibrationAreRefusedWhileLocked) {
     }
   }
   fps.unlock();
-  EXPECT_NO_THROW(fps.go_to_datums(1));
+  EXPECT_NO_THROW(fps.go_to_datums(3));
 }
 
 TEST_F(ClientOnPlane, BadTargetsAreRefusedWhenNotParked) {
