@@ -10,6 +10,7 @@
 #include "axon/blmc/host/control_run.hpp"
 #include "axon/blmc/host/error.hpp"
 #include "axon/blmc/host/motor_session.hpp"
+#include "axon/blmc/host/observe.hpp"
 #include "axon/blmc/host/session_log.hpp"
 #include "axon/blmc/protocol/command.hpp"
 #include "axon/blmc/protocol/frames.hpp"
@@ -18,7 +19,6 @@
 #include "axon/can/open.hpp"
 #include "checks.hpp"
 #include "commands.hpp"
-#include "axon/core/wakeup.hpp"
 #include "run.hpp"
 
 #include <fmt/format.h>
@@ -193,7 +193,7 @@ struct Session {
 };
 
 asio::awaitable<std::unique_ptr<Session>> open_session(Blmc& cli, asio::io_context& io,
-                                                       const std::function<void(std::function<void()>)>& on_signal,
+                                                       const SignalHook& on_signal,
                                                        bool signal_ends_normally) {
   const auto& o = cli.o;
   auto s = std::make_unique<Session>();
@@ -216,8 +216,8 @@ asio::awaitable<std::unique_ptr<Session>> open_session(Blmc& cli, asio::io_conte
   }
   Session* raw = s.get();
   // A stop request ends the waits on the board at once (an enable waiting for the alignment).
-  on_signal([raw] {
-    if (raw->signal_ends_normally) signal_is_normal_end().store(true);
+  on_signal([raw, on_signal] {
+    if (raw->signal_ends_normally) on_signal.signal_ends_normally();
     raw->stop = true;
     raw->board->interrupt();
   });
@@ -368,34 +368,20 @@ asio::awaitable<int> with_motors(Session& s, const char* command, Work work) {
 // ---- subcommands ------------------------------------------------------------------------------
 
 asio::awaitable<int> cmd_status(Session& s) {
-  const auto& o = s.o();
-  const auto t0 = core::SteadyClock::instance().now();
-  int printed = 0;
-  while (!s.stop) {
-    auto st = co_await s.board->wait_status(s.board->options().status_timeout);
-    if (!st) {
-      if (st.error() == bh::HostErrc::interrupted) break;
-      spdlog::error("blmc: {}", st.error().message());
-      co_return exit_code_value::failed;
-    }
-    if (!s.out().status(st.value())) co_return exit_code_value::failed;
-    ++printed;
-    if (o.duration_s <= 0 && printed >= 1) break;
-    if (o.duration_s > 0 && core::SteadyClock::instance().now() - t0 >= seconds(o.duration_s)) break;
+  auto r = co_await bh::watch_status(*s.board, seconds(s.o().duration_s), [&s](const bp::Status& st) { return s.out().status(st); });
+  if (!r) {
+    spdlog::error("blmc: {}", r.error().message());
+    co_return exit_code_value::failed;
   }
-  co_return exit_code_value::ok;
+  co_return s.out().ok() ? exit_code_value::ok : exit_code_value::failed;
 }
 
 asio::awaitable<int> cmd_monitor(Session& s) {
   const auto& o = s.o();
-  const auto t0 = core::SteadyClock::instance().now();
   bool writing = s.out().table_header();
-  while (!s.stop && !s.board->closed() && writing) {
-    co_await core::sleep_for(seconds(1.0 / o.refresh_hz));
-    const double t = std::chrono::duration<double>(core::SteadyClock::instance().now() - t0).count();
-    writing = s.out().row(t, s.board->latest());
-    if (o.duration_s > 0 && t >= o.duration_s) break;
-  }
+  if (writing)
+    writing = co_await bh::monitor(*s.board, seconds(1.0 / o.refresh_hz), seconds(o.duration_s),
+                                   [&s](double t, const bh::Measurements& m) { return s.out().row(t, m); });
   const auto& m = s.board->latest();
   spdlog::info("blmc: {} board frames, {} rejected, {} foreign", m.frames, m.rejected, m.foreign);
   co_return writing ? exit_code_value::ok : exit_code_value::failed;
@@ -487,15 +473,7 @@ asio::awaitable<Outcome> home_work(Session& s) {
 asio::awaitable<int> cmd_record(Session& s) {
   const auto& o = s.o();
   auto w = need(can::CandumpWriter::create(o.record_file));
-  std::uint64_t n = 0;
-  s.board->set_tap(bh::candump_tap(w, s.iface, &n));
-  const auto t0 = core::SteadyClock::instance().now();
-  while (!s.stop && !s.board->closed()) {
-    co_await core::sleep_for(100ms);
-    if (o.duration_s > 0 && core::SteadyClock::instance().now() - t0 >= seconds(o.duration_s)) break;
-  }
-  s.board->set_tap({});
-  (void)w.flush();
+  const auto n = co_await bh::record(*s.board, w, s.iface, seconds(o.duration_s));
   spdlog::info("blmc: {} frames to {}", n, o.record_file);
   co_return exit_code_value::ok;
 }
@@ -526,17 +504,17 @@ void check_loop_options(const BlmcOptions& o) {
     throw Exception(usage(fmt::format("--rate {:g} / --recv-timeout-ms {}: {}", o.rate_hz, o.recv_timeout_ms, v.error().detail)));
 }
 
-CLI::App* add(CLI::App* parent, const std::shared_ptr<Blmc>& cli, const char* name, const char* help, Kind kind, Body body) {
+CLI::App* add(CLI::App* parent, GlobalOptions& global, const std::shared_ptr<Blmc>& cli, const char* name, const char* help, Kind kind, Body body) {
   auto* c = parent->add_subcommand(name, help);
-  c->callback([cli, body = std::move(body), kind] {
+  c->callback([cli, body = std::move(body), kind, &global] {
     if (kind == Kind::motion) check_loop_options(cli->o);
-    exit_code() = run_blmc(*cli, kind == Kind::observe, body);
+    global.exit_code = run_blmc(*cli, kind == Kind::observe, body);
   });
   return c;
 }
 
-CLI::App* add_motion(CLI::App* parent, const std::shared_ptr<Blmc>& cli, const char* name, const char* help, Work work) {
-  return add(parent, cli, name, help, Kind::motion, [name, work](Session& s) -> asio::awaitable<int> {
+CLI::App* add_motion(CLI::App* parent, GlobalOptions& global, const std::shared_ptr<Blmc>& cli, const char* name, const char* help, Work work) {
+  return add(parent, global, cli, name, help, Kind::motion, [name, work](Session& s) -> asio::awaitable<int> {
     const int rc = co_await with_motors(s, name, work);
     co_return rc;
   });
@@ -577,22 +555,22 @@ void add_board_options(CLI::App* b, BlmcOptions& o) {
   b->add_flag("--json", o.json, "stdout: JSON Lines (one object per line: status, sample, report, sent)");
 }
 
-void add_motion_commands(CLI::App* b, const std::shared_ptr<Blmc>& cli) {
+void add_motion_commands(CLI::App* b, GlobalOptions& global, const std::shared_ptr<Blmc>& cli) {
   auto& o = cli->o;
-  auto* cur = add_motion(b, cli, "current", "apply a constant current to one motor for a while (safety limits apply)",
+  auto* cur = add_motion(b, global, cli, "current", "apply a constant current to one motor for a while (safety limits apply)",
                          current_work);
   cur->add_option("motor", o.current_motor, "1 or 2")->required()->check(CLI::Range(1, 2));
   cur->add_option("amperes", o.current_amps, "current, A (clamped to --max-current)")->required()->check(amperes());
   cur->add_option("--duration", o.current_duration_s, "seconds (default 1)")->check(positive());
 
-  auto* pd = add_motion(b, cli, "pd", "host-side PD: hold the start position, or track a sine around it", pd_work);
+  auto* pd = add_motion(b, global, cli, "pd", "host-side PD: hold the start position, or track a sine around it", pd_work);
   pd->add_option("--kp", o.pd_gains.kp, "A per motor revolution (default 5)")->check(non_negative());
   pd->add_option("--kd", o.pd_gains.kd, "A per rev/s (default 0.05)")->check(non_negative());
   pd->add_option("--amplitude", o.pd_amplitude, "sine amplitude, motor rev (default 0: hold)")->check(non_negative());
   pd->add_option("--frequency", o.pd_frequency, "sine frequency, Hz (default 0.5)")->check(non_negative());
   pd->add_option("--duration", o.pd_duration_s, "seconds (default 5)")->check(positive());
 
-  auto* home = add_motion(b, cli, "home", "find the encoder index of each motor and report its position (the offset)",
+  auto* home = add_motion(b, global, cli, "home", "find the encoder index of each motor and report its position (the offset)",
                           home_work);
   home->add_option("--speed", o.home.speed_rev_s, "motor rev/s, sign gives the direction (default 0.5)")->check(nonzero());
   home->add_option("--kp", o.home.kp, "A per rev (default 2)")->check(positive());
@@ -604,30 +582,30 @@ void add_motion_commands(CLI::App* b, const std::shared_ptr<Blmc>& cli) {
 
 }  // namespace
 
-void add_blmc_commands(CLI::App& app, GlobalOptions& /*global*/) {
+void add_blmc_commands(CLI::App& app, GlobalOptions& global) {
   auto cli = std::make_shared<Blmc>();
   auto& o = cli->o;
   auto* b = app.add_subcommand("blmc", "motor driver board: status, monitor, enable, current, PD, homing, record, raw");
   b->require_subcommand(1);
   add_board_options(b, o);
 
-  add(b, cli, "status", "decoded status frames (one, or live with --duration)", Kind::plain, cmd_status)
+  add(b, global, cli, "status", "decoded status frames (one, or live with --duration)", Kind::plain, cmd_status)
       ->add_option("--duration", o.duration_s, "seconds to keep printing (default 0: one)")
       ->check(non_negative());
-  add(b, cli, "monitor", "live table of currents, positions, velocities, ADC", Kind::observe, cmd_monitor)
+  add(b, global, cli, "monitor", "live table of currents, positions, velocities, ADC", Kind::observe, cmd_monitor)
       ->add_option("--duration", o.duration_s, "seconds (default 0: until Ctrl-C)")
       ->check(non_negative());
-  add(b, cli, "enable", "enable the system and motors, wait until they are aligned, and leave them enabled", Kind::plain,
+  add(b, global, cli, "enable", "enable the system and motors, wait until they are aligned, and leave them enabled", Kind::plain,
       cmd_enable);
-  add(b, cli, "disable", "zero currents, disable the motors and the system", Kind::plain, cmd_disable);
-  add_motion_commands(b, cli);
+  add(b, global, cli, "disable", "zero currents, disable the motors and the system", Kind::plain, cmd_disable);
+  add_motion_commands(b, global, cli);
 
-  auto* rec = add(b, cli, "record", "write a candump log of the bus (everything the board sends and receives)",
+  auto* rec = add(b, global, cli, "record", "write a candump log of the bus (everything the board sends and receives)",
                   Kind::observe, cmd_record);
   rec->add_option("file", o.record_file, "candump log file")->required();
   rec->add_option("--duration", o.duration_s, "seconds (default 0: until Ctrl-C)")->check(non_negative());
 
-  add(b, cli, "raw", "send one frame (ID#DATA) or command (NAME=value)", Kind::plain, cmd_raw)
+  add(b, global, cli, "raw", "send one frame (ID#DATA) or command (NAME=value)", Kind::plain, cmd_raw)
       ->add_option("frame", o.raw_text, "e.g. 000#0000000100000001 or ENABLE_SYS=1")
       ->required();
 }

@@ -215,7 +215,7 @@ int run_init_info(const InitInfoArgs& a) {
   return 0;
 }
 
-void add_serve(CLI::App* c4g) {
+void add_serve(CLI::App* c4g, GlobalOptions& global) {
   auto o = std::make_shared<ServeArgs>();
   auto* s = c4g->add_subcommand("serve", "serve the controller's packets with a built-in application (docs/c4g-cli.md)");
   s->add_option("--listen", o->listen, "HOST[:PORT] to serve on (default 127.0.0.1:11000; the manual's: 10.2.12.149:1000; a host alone: port 1000; port 0: any free)");
@@ -270,25 +270,25 @@ void add_serve(CLI::App* c4g) {
   s->add_flag("--json", o->json, "print the final report as one JSON document on stdout (the other lines go to stderr)");
   s->add_option("--freeze-at", o->freeze_at_s, "active freezing (500) from this many seconds after start (also: SIGUSR1 freezes, SIGUSR2 releases)")->check(non_negative());
   s->add_option("--freeze-for", o->freeze_for_s, "release an active freezing this many seconds after the controller shows 500 (0: on SIGUSR2)")->check(non_negative());
-  s->callback([o] { exit_code() = run_serve(*o); });
+  s->callback([o, &global] { global.exit_code = run_serve(*o); });
 }
 
-void add_init_info(CLI::App* c4g) {
+void add_init_info(CLI::App* c4g, GlobalOptions& global) {
   auto a = std::make_shared<InitInfoArgs>();
   auto* i = c4g->add_subcommand("init-info", "print an initialization packet (1200-byte file, or the first one in a pcap)");
   i->add_option("file", a->file, "the file")->required();
   i->add_flag("--from-pcap", a->from_pcap, "the file is a capture: use its first 1200-byte UDP payload");
   i->add_flag("--json", a->json, "print the packet as one JSON document");
-  i->callback([a] { exit_code() = run_init_info(*a); });
+  i->callback([a, &global] { global.exit_code = run_init_info(*a); });
 }
 
 }  // namespace
 
-void add_c4g_commands(CLI::App& app, GlobalOptions&) {
+void add_c4g_commands(CLI::App& app, GlobalOptions& global) {
   auto* c4g = app.add_subcommand("c4g", "robot controller open interface: the PC-side real-time server");
   c4g->require_subcommand(1);
-  add_serve(c4g);
-  add_init_info(c4g);
+  add_serve(c4g, global);
+  add_init_info(c4g, global);
 }
 
 }  // namespace axon::app

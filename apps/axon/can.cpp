@@ -63,8 +63,8 @@ int run_dump(const DumpOptions& o) {
     bus->set_filters(filters);
     std::optional<can::CandumpWriter> log;
     if (!o.log.empty()) log.emplace(need(can::CandumpWriter::create(o.log, o.rotation.limits())));
-    set_on_signal([&] {
-      signal_is_normal_end().store(true);  // a dump runs until Ctrl-C: that is its normal end
+    set_on_signal([&, set_on_signal] {
+      set_on_signal.signal_ends_normally();  // a dump runs until Ctrl-C: that is its normal end
       bus->close();
     });
     spdlog::info("dump: receiving on {}{}", spec.to_string(), o.log.empty() ? "" : " (logging to " + o.log + ")");
@@ -326,7 +326,7 @@ const char* const kBusHelp =
 
 }  // namespace
 
-void add_can_commands(CLI::App& app, GlobalOptions&) {
+void add_can_commands(CLI::App& app, GlobalOptions& global) {
   auto* can_cmd = app.add_subcommand("can", "CAN buses: dump, send, bridge, replay");
   can_cmd->require_subcommand(1);
 
@@ -339,7 +339,7 @@ void add_can_commands(CLI::App& app, GlobalOptions&) {
   d->add_option("-t,--timeout", dump->timeout_s, "seconds; with --count: fail (exit 1) if not reached, else run this long");
   d->add_flag("--no-print", dump->quiet_frames, "do not print frames (log only)");
   add_rotation_options(d, dump->rotation, "log", "--log");
-  d->callback([dump] { exit_code() = run_dump(*dump); });
+  d->callback([dump, &global] { global.exit_code = run_dump(*dump); });
 
   auto send = std::make_shared<SendOptions>();
   auto* s = can_cmd->add_subcommand("send", "send frames given as ID#DATA (cansend notation)");
@@ -347,7 +347,7 @@ void add_can_commands(CLI::App& app, GlobalOptions&) {
   s->add_option("frames", send->frames, "frames: 123#DEADBEEF, 12345678#00.11, 123#R, 123#R4")->required();
   s->add_option("-r,--repeat", send->repeat, "send the list this many times")->check(positive());
   s->add_option("-i,--interval", send->interval_ms, "milliseconds between frames")->check(non_negative());
-  s->callback([send] { exit_code() = run_send(*send); });
+  s->callback([send, &global] { global.exit_code = run_send(*send); });
 
   auto bridge = std::make_shared<BridgeOptions>();
   auto* b = can_cmd->add_subcommand("bridge", "serve buses over socketcand and/or as a CAN@net gateway emulator");
@@ -358,7 +358,7 @@ void add_can_commands(CLI::App& app, GlobalOptions&) {
   b->add_option("--bitrate", bridge->bitrate, "bit rate of the virtual buses")->check(CLI::Range(10'000u, 1'000'000u));
   b->add_option("--duration", bridge->duration_s, "stop after this many seconds (default: until Ctrl-C)");
   b->add_option("--fault-plan", bridge->fault_plan, "YAML fault plan applied to every virtual bus (docs/can-virtual.md)");
-  b->callback([bridge] { exit_code() = run_bridge(*bridge); });
+  b->callback([bridge, &global] { global.exit_code = run_bridge(*bridge); });
 
   auto replay = std::make_shared<ReplayOptions>();
   auto* r = can_cmd->add_subcommand("replay", "play a candump log onto a bus, keeping its timing");
@@ -369,7 +369,7 @@ void add_can_commands(CLI::App& app, GlobalOptions&) {
   r->add_option("--loop", replay->loops, "play the file this many times")->check(positive());
   r->add_option("--only", replay->only_iface, "only frames logged on this interface");
   r->add_flag("--skip-bad", replay->skip_bad, "skip malformed lines (counted) instead of stopping at the first");
-  r->callback([replay] { exit_code() = run_replay(*replay); });
+  r->callback([replay, &global] { global.exit_code = run_replay(*replay); });
 }
 
 }  // namespace axon::app

@@ -152,9 +152,9 @@ int run_can_fps_blmc() {
 
 }  // namespace
 
-void add_demo_command(CLI::App& app, GlobalOptions&) {
+void add_demo_command(CLI::App& app, GlobalOptions& global) {
   auto* cmd = app.add_subcommand("demo", "run what axon can do today against the embedded simulators");
-  cmd->callback([] { exit_code() = run_demo(); });
+  cmd->callback([&global] { global.exit_code = run_demo(); });
 }
 
 }  // namespace axon::app

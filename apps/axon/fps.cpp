@@ -435,9 +435,9 @@ asio::awaitable<int> job_raw(const FpsOptions& o, const RawArgs& a, host::Array&
 
 // A subcommand's callback: runs `job` (a member of the shared options struct `Args`) on the array.
 template <class Args, class JobFn>
-std::function<void()> on_array(std::shared_ptr<FpsOptions> o, std::shared_ptr<Args> args, JobFn job, bool moves = false) {
-  return [o, args, job, moves] {
-    exit_code() = with_array(*o, [&](host::Array& a, const host::DiscoveryReport& r) { return job(*o, *args, a, r); }, moves);
+std::function<void()> on_array(GlobalOptions& global, std::shared_ptr<FpsOptions> o, std::shared_ptr<Args> args, JobFn job, bool moves = false) {
+  return [&global, o, args, job, moves] {
+    global.exit_code = with_array(*o, [&](host::Array& a, const host::DiscoveryReport& r) { return job(*o, *args, a, r); }, moves);
   };
 }
 
@@ -475,38 +475,38 @@ void add_bus_options(CLI::App& fps, FpsOptions& o) {
   fps.add_option("--timeout", b.timeout_s, "seconds to wait for each reply (default 1)")->check(non_negative());
 }
 
-void add_read_commands(CLI::App& fps, const std::shared_ptr<FpsOptions>& o) {
+void add_read_commands(CLI::App& fps, GlobalOptions& global, const std::shared_ptr<FpsOptions>& o) {
   const auto none = std::make_shared<NoArgs>();
   fps.add_subcommand("discover", "robots per bus and their firmware")
-      ->callback(on_array(o, none, [](const FpsOptions& f, NoArgs&, host::Array& a, const host::DiscoveryReport& r) {
+      ->callback(on_array(global, o, none, [](const FpsOptions& f, NoArgs&, host::Array& a, const host::DiscoveryReport& r) {
         return job_discover(f, a, r);
       }));
   fps.add_subcommand("status", "status table: state, flags, position")
-      ->callback(on_array(o, none, [](const FpsOptions& f, NoArgs&, host::Array& a, const host::DiscoveryReport& r) {
+      ->callback(on_array(global, o, none, [](const FpsOptions& f, NoArgs&, host::Array& a, const host::DiscoveryReport& r) {
         return job_status(f, a, r);
       }));
   const auto pos = std::make_shared<IdsArgs>();
   auto* p = fps.add_subcommand("position", "arm angles of the listed robots (default all)");
   p->add_option("ids", pos->ids, "robot ids: 3, 1-6, 1,4,9");
-  p->callback(on_array(o, pos, [](const FpsOptions& f, IdsArgs& x, host::Array& a, const host::DiscoveryReport& r) {
+  p->callback(on_array(global, o, pos, [](const FpsOptions& f, IdsArgs& x, host::Array& a, const host::DiscoveryReport& r) {
     return job_position(f, x.ids, a, r);
   }));
 }
 
-void add_motion_commands(CLI::App& fps, const std::shared_ptr<FpsOptions>& o) {
+void add_motion_commands(CLI::App& fps, GlobalOptions& global, const std::shared_ptr<FpsOptions>& o) {
   const auto go = std::make_shared<GotoArgs>();
   auto* g = fps.add_subcommand("goto", "move one robot's arms (degrees) and wait");
   g->add_option("id", go->id, "robot id")->required()->check(CLI::Range(1, 2047));
   g->add_option("alpha", go->alpha, "alpha angle, degrees")->required();
   g->add_option("beta", go->beta, "beta angle, degrees")->required();
   g->add_flag("--relative", go->relative, "move by ALPHA and BETA instead of to them");
-  g->callback(on_array(o, go, job_goto, true));
+  g->callback(on_array(global, o, go, job_goto, true));
 
   const auto mv = std::make_shared<MoveArgs>();
   auto* m = fps.add_subcommand("move", "run trajectories from a file on several robots at once");
   m->add_option("-t,--trajectory", mv->file, "YAML/JSON: {ID: {alpha: [[deg, s], ...], beta: [...]}}")->required();
   m->add_flag("--load-only", mv->load_only, "upload and validate, do not start");
-  const auto run_move = on_array(o, mv, [](const FpsOptions& f, MoveArgs& x, host::Array& a, const host::DiscoveryReport& r) {
+  const auto run_move = on_array(global, o, mv, [](const FpsOptions& f, MoveArgs& x, host::Array& a, const host::DiscoveryReport& r) {
     return job_move(f, x.trajectories, x.load_only, a, r);
   }, true);
   m->callback([mv, run_move] {
@@ -517,17 +517,17 @@ void add_motion_commands(CLI::App& fps, const std::shared_ptr<FpsOptions>& o) {
   const auto st = std::make_shared<StopArgs>();
   auto* s = fps.add_subcommand("stop", "stop every robot on every bus (TRAJECTORY_ABORT broadcast)");
   s->add_flag("--clear-flags", st->clear_flags, "send STOP_TRAJECTORY instead, which also clears collision flags");
-  s->callback(on_array(o, st, [](const FpsOptions& f, StopArgs& x, host::Array& a, const host::DiscoveryReport& r) {
+  s->callback(on_array(global, o, st, [](const FpsOptions& f, StopArgs& x, host::Array& a, const host::DiscoveryReport& r) {
     return job_stop(f, x.clear_flags, a, r);
   }));
   fps.add_subcommand("unlock", "clear collision flags on every bus (STOP_TRAJECTORY) and report who answered")
-      ->callback(on_array(o, std::make_shared<NoArgs>(),
+      ->callback(on_array(global, o, std::make_shared<NoArgs>(),
                           [](const FpsOptions& f, NoArgs&, host::Array& a, const host::DiscoveryReport& r) {
                             return job_unlock(f, a, r);
                           }));
 }
 
-void add_robot_commands(CLI::App& fps, const std::shared_ptr<FpsOptions>& o) {
+void add_robot_commands(CLI::App& fps, GlobalOptions& global, const std::shared_ptr<FpsOptions>& o) {
   const auto cal = std::make_shared<CalibrateArgs>();
   auto* c = fps.add_subcommand("calibrate", "calibration sequence (default: motors, datums, save)");
   c->add_option("id", cal->id, "robot id")->required()->check(CLI::Range(1, 2047));
@@ -535,12 +535,12 @@ void add_robot_commands(CLI::App& fps, const std::shared_ptr<FpsOptions>& o) {
   c->add_flag("--datum", cal->datum, "calibrate the datums");
   c->add_flag("--cogging", cal->cogging, "calibrate cogging (long: up to 40 min)");
   c->add_flag("--save", cal->save, "save the calibration to flash");
-  c->callback(on_array(o, cal, job_calibrate, true));
+  c->callback(on_array(global, o, cal, job_calibrate, true));
 
   const auto dt = std::make_shared<DatumArgs>();
   auto* d = fps.add_subcommand("datum", "datum search: both arms into their hard stops");
   d->add_option("id", dt->id, "robot id")->required()->check(CLI::Range(1, 2047));
-  d->callback(on_array(o, dt, [](const FpsOptions& f, DatumArgs& x, host::Array& a, const host::DiscoveryReport& r) {
+  d->callback(on_array(global, o, dt, [](const FpsOptions& f, DatumArgs& x, host::Array& a, const host::DiscoveryReport& r) {
     return job_datum(f, x.id, a, r);
   }, true));
 
@@ -548,12 +548,12 @@ void add_robot_commands(CLI::App& fps, const std::shared_ptr<FpsOptions>& o) {
   auto* u = fps.add_subcommand("upgrade", "firmware upgrade of robots running their bootloader");
   u->add_option("--firmware", up->firmware, "firmware image file")->required()->check(CLI::ExistingFile);
   u->add_option("ids", up->ids, "robot ids: 3, 1-6, 1,4,9")->required();
-  u->callback([o, up] {
+  u->callback([o, up, &global] {
     const auto ids = need(parse_id_lists(up->ids));
     std::ifstream in(up->firmware, std::ios::binary);
     const std::vector<std::uint8_t> image((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (!in.good() && !in.eof()) throw Exception(usage(fmt::format("cannot read {}", up->firmware)));
-    exit_code() = with_array(*o, [&](host::Array& a, const host::DiscoveryReport& r) { return job_upgrade(*o, image, ids, a, r); });
+    global.exit_code = with_array(*o, [&](host::Array& a, const host::DiscoveryReport& r) { return job_upgrade(*o, image, ids, a, r); });
   });
 
   const auto raw = std::make_shared<RawArgs>();
@@ -561,21 +561,21 @@ void add_robot_commands(CLI::App& fps, const std::shared_ptr<FpsOptions>& o) {
   rw->add_option("id", raw->id, "robot id")->required()->check(CLI::Range(1, 2047));
   rw->add_option("command", raw->command, "command number or name (GET_STATUS, 3, ...)")->required();
   rw->add_option("data", raw->data, "payload in hex, e.g. 0000803F");
-  rw->callback(on_array(o, raw, job_raw));
+  rw->callback(on_array(global, o, raw, job_raw));
 }
 
 }  // namespace
 
-void add_fps_commands(CLI::App& app, GlobalOptions&) {
+void add_fps_commands(CLI::App& app, GlobalOptions& global) {
   const auto o = std::make_shared<FpsOptions>();  // shared with every subcommand's callback
   auto* fps = app.add_subcommand("fps", "fiber positioners: discover, status, moves, trajectories, calibration, firmware");
   fps->require_subcommand(1);
   fps->fallthrough();  // bus options and --json may also follow the subcommand
   add_bus_options(*fps, *o);
-  add_read_commands(*fps, o);
-  add_motion_commands(*fps, o);
-  add_robot_commands(*fps, o);
-  add_fps_plan_commands(*fps, [o](const FpsArrayJob& job, bool moves) {
+  add_read_commands(*fps, global, o);
+  add_motion_commands(*fps, global, o);
+  add_robot_commands(*fps, global, o);
+  add_fps_plan_commands(*fps, global, [o](const FpsArrayJob& job, bool moves) {
     return with_array(*o, [&job](host::Array& a, const host::DiscoveryReport&) { return job(a); }, moves);
   });
 }

@@ -2,6 +2,7 @@
 // options (--gateway, --socketcand, --bus, --config, --timeout) select, after discovery.
 #pragma once
 
+#include "commands.hpp"
 #include "axon/fps/host/array.hpp"
 
 #include <CLI/CLI.hpp>
@@ -18,6 +19,6 @@ using FpsArrayRunner = std::function<int(const FpsArrayJob& job, bool moves)>;
 
 // `fps plan`, `fps plot`, `fps goto-all` (fps_plan.cpp), under the `fps` group, whose options
 // `with_array` uses (add_fps_commands calls this).
-void add_fps_plan_commands(CLI::App& fps_cmd, FpsArrayRunner with_array);
+void add_fps_plan_commands(CLI::App& fps_cmd, GlobalOptions& global, FpsArrayRunner with_array);
 
 }  // namespace axon::app

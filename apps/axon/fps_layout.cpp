@@ -204,7 +204,7 @@ int check(const LayoutArgs& a, CLI::App& fps_cmd) {
 
 }  // namespace
 
-void add_fps_layout_commands(CLI::App& app, GlobalOptions&) {
+void add_fps_layout_commands(CLI::App& app, GlobalOptions& global) {
   CLI::App* fps_cmd = app.get_subcommand("fps");
   const auto args = std::make_shared<LayoutArgs>();  // shared with the callbacks
   auto& a = *args;
@@ -216,13 +216,13 @@ void add_fps_layout_commands(CLI::App& app, GlobalOptions&) {
   gen->add_option("--name", a.generator.name, "layout name (default 'default')");
   gen->add_option("--fiducials-per-sextant", a.generator.fiducials_per_sextant, "fiducials per sextant (default 10, plus the centre)");
   gen->add_option("--gateway-address", a.generator.gateway_address, "gateway address pattern, {} = sextant");
-  gen->callback([args] { exit_code() = generate(*args); });
+  gen->callback([args, &global] { global.exit_code = generate(*args); });
   auto* sh = layout->add_subcommand("show", "summary: robots per sextant, gateway and bus; fibres; neighbours");
   sh->add_option("file", a.file, "layout YAML")->required();
   sh->add_flag("--json", a.json, "machine-readable output");
-  sh->callback([fps_cmd, args] {
+  sh->callback([fps_cmd, args, &global] {
     args->json = args->json || fps_cmd->get_option("--json")->as<bool>();
-    exit_code() = show(*args);
+    global.exit_code = show(*args);
   });
   auto* ck = layout->add_subcommand(
       "check", "GET_ID broadcast on every bus of the layout; report missing, unexpected, wrong-bus robots (exit 1 if any)");
@@ -230,9 +230,9 @@ void add_fps_layout_commands(CLI::App& app, GlobalOptions&) {
   ck->add_option("--as-gateway", a.as_gateway, "the layout gateway that `axon fps --gateway` is (default: the only one)");
   ck->add_option("--window", a.window_s, "seconds each broadcast collects replies (default 0.5)");
   ck->add_flag("--json", a.json, "machine-readable output");
-  ck->callback([fps_cmd, args] {
+  ck->callback([fps_cmd, args, &global] {
     args->json = args->json || fps_cmd->get_option("--json")->as<bool>();
-    exit_code() = check(*args, *fps_cmd);
+    global.exit_code = check(*args, *fps_cmd);
   });
 }
 

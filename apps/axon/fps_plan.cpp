@@ -185,7 +185,7 @@ asio::awaitable<int> job_goto_all(const PlanArgs& a, host::Array& array) {
 
 }  // namespace
 
-void add_fps_plan_commands(CLI::App& fps_cmd, FpsArrayRunner with_array) {
+void add_fps_plan_commands(CLI::App& fps_cmd, GlobalOptions& global, FpsArrayRunner with_array) {
   const auto args = std::make_shared<PlanArgs>();  // shared with the callbacks
   auto& a = *args;
   auto common = [&a](CLI::App* c) {
@@ -205,7 +205,7 @@ void add_fps_plan_commands(CLI::App& fps_cmd, FpsArrayRunner with_array) {
   pl->add_option("--speed", a.speed, "arm speed, deg/s (default 12: 2000 rpm at the motor, 1000:1)")->check(positive());
   pl->add_flag("--reject", a.reject, "fail on bad targets instead of parking those robots");
   pl->add_flag("--allow-partial", a.allow_partial, "exit 0 even when some robots cannot reach their targets");
-  pl->callback([args] { exit_code() = run_plan(*args); });
+  pl->callback([args, &global] { global.exit_code = run_plan(*args); });
 
   auto* pt = fps_cmd.add_subcommand("plot", "draw the focal plane as SVG: poses, a plan at an instant, or its paths");
   common(pt);
@@ -214,7 +214,7 @@ void add_fps_plan_commands(CLI::App& fps_cmd, FpsArrayRunner with_array) {
   pt->add_option("--at", a.at_s, "seconds into the plan");
   pt->add_flag("--paths", a.paths, "draw the metrology fibre's path of every robot");
   pt->add_option("-o,--output", a.output, "SVG file (default stdout)");
-  pt->callback([args] { exit_code() = run_plot(*args); });
+  pt->callback([args, &global] { global.exit_code = run_plot(*args); });
 
   auto* ga = fps_cmd.add_subcommand("goto-all", "plan from the robots' current positions to targets, then run it");
   common(ga);
@@ -223,8 +223,8 @@ void add_fps_plan_commands(CLI::App& fps_cmd, FpsArrayRunner with_array) {
   ga->add_option("--save-plan", a.output, "also write the plan.json");
   ga->add_flag("--reject", a.reject, "fail on bad targets instead of parking those robots");
   ga->add_flag("--allow-partial", a.allow_partial, "move the others when some robots cannot reach their targets");
-  ga->callback([args, with_array] {
-    exit_code() = with_array([args](host::Array& array) { return job_goto_all(*args, array); }, true);
+  ga->callback([args, with_array, &global] {
+    global.exit_code = with_array([args](host::Array& array) { return job_goto_all(*args, array); }, true);
   });
 }
 

@@ -102,9 +102,11 @@ std::vector<std::uint8_t> read_image(const std::string& path) {
   return image;
 }
 
+core::Duration to_duration(double s) { return std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(s)); }
+
 host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
   host::FocalPlaneArrayOptions o;
-  o.check_window = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(a.window_s));
+  o.check_window = to_duration(a.window_s);
   if (!a.plc.empty()) o.plc = need(net::parse_endpoint(a.plc, 502));
   return o;
 }
@@ -248,7 +250,7 @@ asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) 
   co_return motion_exit_code(rep.completed, fpa.array());
 }
 
-using SetOnSignal = std::function<void(std::function<void()>)>;
+using SetOnSignal = SignalHook;
 
 // Correction iterations: each round reads the next --measured file (waiting for it to appear),
 // corrects the robots outside tolerance and waits for them to arrive.
@@ -287,6 +289,37 @@ asio::awaitable<int> plane_correct(host::FocalPlaneArray& fpa, const PlaneArgs& 
   co_return motion_exit_code(run.ok(), fpa.array());
 }
 
+// `fps plane cold`: the cold policy once, or with --watch every period until a signal (its normal
+// end) or --for. A report is printed when settings went out (and always without --watch).
+asio::awaitable<int> plane_cold(host::FocalPlaneArray& fpa, const PlaneArgs& a, const SetOnSignal& set_on_signal) {
+  host::ColdControl cold(fpa);
+  int rc = 0;
+  const auto print = [&rc, watch = a.watch](const Result<host::ColdApplyReport>& r) {
+    if (!r) {
+      std::printf("cold policy: %s\n", r.error().message().c_str());
+      rc = 1;
+    } else if (r.value().sent || !watch) {
+      std::fputs(r.value().to_text().c_str(), stdout);
+      rc = r.value().failed.empty() ? 0 : 1;
+    }
+    std::fflush(stdout);
+  };
+  bool stop = false;
+  set_on_signal([&stop, set_on_signal] {
+    set_on_signal.signal_ends_normally();  // --watch runs until a signal: its normal end
+    stop = true;
+  });
+  if (a.watch) {
+    auto watching = cold.watch(to_duration(a.period_s), &stop, print, to_duration(a.for_s));
+    co_await std::move(watching);
+  } else {
+    auto r = co_await cold.step(true);
+    print(r);
+  }
+  set_on_signal([] {});
+  co_return rc;
+}
+
 // One `fps plane` action on the connected plane; returns the exit code.
 asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a, const std::string& action,
                                   const fps::FocalPlane& plane, const SetOnSignal& set_on_signal,
@@ -305,36 +338,7 @@ asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a
     stop_robots_on_signal(set_on_signal, fpa.array());
     rc = co_await plane_move(fpa, a);
   }
-  if (action == "cold") {
-    // Once, or every period until a signal (or --for): the settings go out only when they change.
-    host::ColdControl cold(fpa);
-    bool stop = false;
-    set_on_signal([&stop] {
-      signal_is_normal_end().store(true);  // --watch runs until a signal: its normal end
-      stop = true;
-    });
-    const auto t0 = std::chrono::steady_clock::now();
-    bool first = true;
-    while (!stop) {
-      auto r = co_await cold.step(first);
-      first = false;
-      if (!r) {
-        std::printf("cold policy: %s\n", r.error().message().c_str());
-        rc = 1;
-      } else if (r.value().sent || !a.watch) {
-        std::fputs(r.value().to_text().c_str(), stdout);
-        rc = r.value().failed.empty() ? 0 : 1;
-      }
-      std::fflush(stdout);
-      if (!a.watch) break;
-      const auto next = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.period_s);
-      while (!stop && std::chrono::steady_clock::now() < next) {
-        co_await core::sleep_for(std::chrono::milliseconds(50));
-        if (a.for_s > 0 && std::chrono::steady_clock::now() - t0 >= std::chrono::duration<double>(a.for_s)) stop = true;
-      }
-    }
-    set_on_signal([] {});
-  }
+  if (action == "cold") rc = co_await plane_cold(fpa, a, set_on_signal);
   if (action == "correct") rc = co_await plane_correct(fpa, a, plane, set_on_signal);
   if (action == "upgrade") {
     if (!uo.expected_version) std::printf("no --version given: versions are reported, not checked\n");
@@ -393,7 +397,7 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
 
 }  // namespace
 
-void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
+void add_fps_plane_commands(CLI::App& app, GlobalOptions& global) {
   CLI::App* fps_cmd = app.get_subcommand("fps");
   const auto args = std::make_shared<PlaneArgs>();  // shared with the callbacks
   auto& a = *args;
@@ -403,13 +407,13 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   p->add_option("--plc", a.plc, "the PLC at HOST[:PORT] (needed for --sync)");
   p->add_flag("--json", a.json, "check, status, move: one JSON document on stdout and nothing else");
   p->fallthrough();  // --json may also follow the action
-  p->add_subcommand("check", "GET_ID on every bus at once, compared with the layout")->callback([args] {
-    exit_code() = run_plane(*args, "check");
+  p->add_subcommand("check", "GET_ID on every bus at once, compared with the layout")->callback([args, &global] {
+    global.exit_code = run_plane(*args, "check");
   });
   auto* ck = p->get_subcommand("check");
   ck->add_option("--window", a.window_s, "seconds to collect GET_ID answers (default 0.5)")->check(positive());
-  p->add_subcommand("status", "discovery: firmware and status of every robot")->callback([args] {
-    exit_code() = run_plane(*args, "status");
+  p->add_subcommand("status", "discovery: firmware and status of every robot")->callback([args, &global] {
+    global.exit_code = run_plane(*args, "status");
   });
   auto* mv = p->add_subcommand("move", "every robot straight to one (alpha, beta) by a trajectory, all at once");
   mv->add_option("--alpha", a.alpha, "degrees (default 0)");
@@ -422,7 +426,7 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   mv->add_option("--gear-ratio", a.gear_ratio, "motor turns per arm turn (default 1000)")->check(positive());
   mv->add_option("--points", a.points, "points per arm (default 20)")->check(CLI::Range(1, 1000));
   mv->add_flag("--sync", a.sync, "start with the PLC's sync line instead of the START_TRAJECTORY broadcast");
-  mv->callback([args] { exit_code() = run_plane(*args, "move"); });
+  mv->callback([args, &global] { global.exit_code = run_plane(*args, "move"); });
   auto* up = p->add_subcommand("upgrade",
                                "firmware of every robot, sextant by sextant: power-cycled into the bootloader by the PLC, "
                                "upgraded (one retry), powered back, version checked (needs --plc)");
@@ -438,9 +442,9 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   cd->add_flag("--watch", a.watch, "keep going: read every --period, send only when the decision changes");
   cd->add_option("--period", a.period_s, "seconds between readings with --watch (default 60)")->check(CLI::Range(0.05, 86400.0));
   cd->add_option("--for", a.for_s, "with --watch: stop after this many seconds (default: at a signal)")->check(non_negative());
-  cd->callback([args] {
+  cd->callback([args, &global] {
     if (args->plc.empty()) throw Exception(usage("fps plane cold needs --plc"));
-    exit_code() = run_plane(*args, "cold");
+    global.exit_code = run_plane(*args, "cold");
   });
   auto* cr = p->add_subcommand("correct",
                                "correction iterations: robots whose measured fibre is outside tolerance get a correction "
@@ -455,10 +459,10 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions&) {
   cr->add_option("--iterations", a.iterations, "most rounds that send corrections (default 3)")->check(CLI::Range(1, 100));
   cr->add_option("--wait", a.wait_s, "seconds to wait for each later --measured file to appear (default 600)")
       ->check(CLI::Range(0.0, 86400.0));
-  cr->callback([args] { exit_code() = run_plane(*args, "correct"); });
-  up->callback([args] {
+  cr->callback([args, &global] { global.exit_code = run_plane(*args, "correct"); });
+  up->callback([args, &global] {
     if (args->plc.empty()) throw Exception(usage("fps plane upgrade needs --plc"));
-    exit_code() = run_plane(*args, "upgrade");
+    global.exit_code = run_plane(*args, "upgrade");
   });
 }
 

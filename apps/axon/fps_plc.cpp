@@ -118,7 +118,7 @@ int cold(const PlcArgs& a) {
 
 }  // namespace
 
-void add_fps_plc_commands(CLI::App& app, GlobalOptions&) {
+void add_fps_plc_commands(CLI::App& app, GlobalOptions& global) {
   CLI::App* fps_cmd = app.get_subcommand("fps");
   const auto args = std::make_shared<PlcArgs>();  // shared with the callbacks
   auto& a = *args;
@@ -130,27 +130,27 @@ void add_fps_plc_commands(CLI::App& app, GlobalOptions&) {
   p->add_option("--plc-timeout", a.timeout_s, "seconds to wait for each answer (default 1)");
   p->add_flag("--json", a.json, "machine-readable output");
   auto json_flag = [fps_cmd, args] { args->json = args->json || fps_cmd->get_option("--json")->as<bool>(); };
-  p->add_subcommand("status", "every relay and sensor")->callback([json_flag, args] {
+  p->add_subcommand("status", "every relay and sensor")->callback([json_flag, args, &global] {
     json_flag();
-    exit_code() = status(*args);
+    global.exit_code = status(*args);
   });
   auto* pw = p->add_subcommand("power", "24 V to the positioners of one sextant");
   pw->add_option("sextant", a.sextant, "sextant 1..6")->required()->check(CLI::Range(1, 6));
   pw->add_option("state", a.state, "on or off")->required()->check(CLI::IsMember({"on", "off"}));
-  pw->callback([args] { exit_code() = power(*args, plc::RelayKind::positioner_power); });
+  pw->callback([args, &global] { global.exit_code = power(*args, plc::RelayKind::positioner_power); });
   auto* gw = p->add_subcommand("gateway", "power of one sextant's Ethernet-CAN gateway");
   gw->add_option("sextant", a.sextant, "sextant 1..6")->required()->check(CLI::Range(1, 6));
   gw->add_option("state", a.state, "on or off")->required()->check(CLI::IsMember({"on", "off"}));
-  gw->callback([args] { exit_code() = power(*args, plc::RelayKind::gateway_power); });
+  gw->callback([args, &global] { global.exit_code = power(*args, plc::RelayKind::gateway_power); });
   auto* sy = p->add_subcommand("sync", "the sync line: pulse (high, hold, low), high or low");
   sy->add_option("action", a.sync_action, "pulse, high or low")->required()->check(CLI::IsMember({"pulse", "high", "low"}));
   sy->add_option("--hold", a.hold_s, "seconds a pulse stays high (default 0.5)");
-  sy->callback([args] { exit_code() = sync(*args); });
+  sy->callback([args, &global] { global.exit_code = sync(*args); });
   auto* co = p->add_subcommand("cold", "the cold-temperature settings the current temperatures call for");
   co->add_option("--policy", a.cold_file, "cold policy YAML (thresholds, speeds, holding currents, sensors)");
-  co->callback([json_flag, args] {
+  co->callback([json_flag, args, &global] {
     json_flag();
-    exit_code() = cold(*args);
+    global.exit_code = cold(*args);
   });
 }
 

@@ -11,10 +11,6 @@
 #include <exception>
 
 namespace axon::app {
-int& exit_code() {
-  static int code = 0;
-  return code;
-}
 // Errors that mean "the input was wrong" (option values, files): nothing was done. Each layer's
 // error category maps its bad-input codes to std::errc::invalid_argument.
 bool is_usage_error(std::error_code ec) { return ec == std::errc::invalid_argument; }
@@ -59,5 +55,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "axon: internal error: %s\n", e.what());
     return exit_code_value::internal;
   }
-  return exit_code();
+  return global.exit_code;
 }

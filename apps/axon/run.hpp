@@ -11,7 +11,6 @@
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/use_awaitable.hpp>
 
-#include <atomic>
 #include <chrono>
 
 #include <csignal>
@@ -30,23 +29,33 @@ inline Error usage(std::string text) { return Error(CoreErrc::invalid_argument, 
 // How long a second stop signal lets the first one's stop of the devices finish (run_command).
 inline constexpr std::chrono::milliseconds kSecondSignalGrace{500};
 
-// Set by a command whose normal end is a stop signal (servers, simulators, monitors that run until
-// Ctrl-C): its exit code stays the body's own instead of 128+N.
-inline std::atomic<bool>& signal_is_normal_end() noexcept {
-  static std::atomic<bool> normal{false};
-  return normal;
-}
+// The body's hold on run_command's signal handling (its second argument; cheap to copy, valid while
+// run_command runs). Called with a function, it makes that function what the next stop signal does
+// (stop the robots, zero the current). signal_ends_normally() marks a stop signal as the command's
+// normal end (servers, simulators, monitors that run until Ctrl-C): its exit code then stays the
+// body's own instead of 128+N. Both run on the command's event loop, never in a signal handler.
+class SignalHook {
+ public:
+  SignalHook(std::function<void()>& on_signal, bool& normal_end) : on_signal_(&on_signal), normal_end_(&normal_end) {}
+  void operator()(std::function<void()> f) const { *on_signal_ = std::move(f); }
+  void signal_ends_normally() const { *normal_end_ = true; }
+
+ private:
+  std::function<void()>* on_signal_;
+  bool* normal_end_;
+};
 
 // Runs `body` to completion and returns its exit code; exceptions thrown inside are rethrown here
 // (axon::Exception becomes "axon: error: ..." in main). SIGINT/SIGTERM/SIGHUP call `on_signal`, which
 // a command that drives devices sets to make them safe (stop the robots, zero the current) so that
 // the body finishes normally and prints what it stopped; without one, the first signal stops the
 // event loop. A second signal stops it within kSecondSignalGrace, a third at once. A command ended by a signal exits 128+N (see
-// exit_codes.hpp) unless its normal end is a signal (signal_is_normal_end()).
-inline int run_command(const std::function<asio::awaitable<int>(asio::io_context&, std::function<void(std::function<void()>)>)>& body) {
+// exit_codes.hpp) unless its normal end is a signal (SignalHook::signal_ends_normally()).
+inline int run_command(const std::function<asio::awaitable<int>(asio::io_context&, SignalHook)>& body) {
   asio::io_context io;
   asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);
   std::function<void()> on_signal = [&io] { io.stop(); };
+  bool normal_end = false;
   int signalled = 0;
   // A second signal (an impatient double Ctrl-C, `timeout` signalling the process and its group)
   // still lets the first one's stop go out: the loop runs on for at most kSecondSignalGrace (the
@@ -71,7 +80,7 @@ inline int run_command(const std::function<asio::awaitable<int>(asio::io_context
   signals.async_wait(handler);
   int rc = 0;
   std::exception_ptr failure;
-  asio::co_spawn(io, body(io, [&](std::function<void()> f) { on_signal = std::move(f); }),
+  asio::co_spawn(io, body(io, SignalHook(on_signal, normal_end)),
                  [&](std::exception_ptr e, int r) {
                    failure = e;
                    rc = r;
@@ -81,7 +90,7 @@ inline int run_command(const std::function<asio::awaitable<int>(asio::io_context
                  });
   io.run();
   const int signo = received_stop_signal().load();
-  if (failure && signo != 0 && !signal_is_normal_end().load()) {
+  if (failure && signo != 0 && !normal_end) {
     // The signal's stop made the body fail (a move refused because the devices were stopped): the
     // error is told, the exit code stays the signal's.
     try {
@@ -92,7 +101,7 @@ inline int run_command(const std::function<asio::awaitable<int>(asio::io_context
     }
   }
   if (failure) std::rethrow_exception(failure);
-  if (signo != 0 && !signal_is_normal_end().load()) return signal_exit_code(signo);
+  if (signo != 0 && !normal_end) return signal_exit_code(signo);
   return rc;
 }
 
@@ -105,8 +114,8 @@ asio::awaitable<void> wait_for_stop(asio::io_context& io, double duration_s, Set
   asio::steady_timer until(io, std::chrono::steady_clock::time_point::max());
   if (duration_s > 0) until.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                           std::chrono::duration<double>(duration_s)));
-  set_on_signal([&until] {
-    signal_is_normal_end().store(true);
+  set_on_signal([&until, set_on_signal] {
+    set_on_signal.signal_ends_normally();
     until.cancel();
   });
   boost::system::error_code ec;

@@ -215,7 +215,7 @@ int run_sim_fps(const SimFpsOptions& o) {
 
 }  // namespace
 
-void add_sim_commands(CLI::App& app, GlobalOptions&) {
+void add_sim_commands(CLI::App& app, GlobalOptions& global) {
   auto* sim_cmd = app.add_subcommand("sim", "device simulators served over CAN@net / socketcand");
   sim_cmd->require_subcommand(1);
   const auto fps_args = std::make_shared<SimFpsOptions>();  // shared with the callback
@@ -254,10 +254,10 @@ void add_sim_commands(CLI::App& app, GlobalOptions&) {
   f->get_option("--config")->excludes("--robots")->excludes("--buses");
   f->get_option("--port")->excludes("--base-port");
   f->get_option("--layout")->excludes("--robots")->excludes("--buses")->excludes("--config")->excludes("--gateway")->excludes("--socketcand");
-  f->callback([fps_args] { exit_code() = run_sim_fps(*fps_args); });
+  f->callback([fps_args, &global] { global.exit_code = run_sim_fps(*fps_args); });
 
-  add_sim_blmc_command(*sim_cmd);
-  add_sim_c4g_command(*sim_cmd);
+  add_sim_blmc_command(*sim_cmd, global);
+  add_sim_c4g_command(*sim_cmd, global);
 }
 
 }  // namespace axon::app

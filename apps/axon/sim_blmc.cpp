@@ -62,7 +62,7 @@ int run_sim_blmc(const SimBlmcOptions& o) {
 
 }  // namespace
 
-void add_sim_blmc_command(CLI::App& sim_cmd) {
+void add_sim_blmc_command(CLI::App& sim_cmd, GlobalOptions& global) {
   auto o = std::make_shared<SimBlmcOptions>();
   auto* b = sim_cmd.add_subcommand("blmc", "simulated blmc motor driver boards, one per bus (can0, can1 ...)");
   b->add_option("--boards", o->boards, "number of boards (default 1)")->check(CLI::Range(1u, 64u));
@@ -70,7 +70,7 @@ void add_sim_blmc_command(CLI::App& sim_cmd) {
   b->add_option("--config", o->config, "board/motor parameters YAML (docs/blmc-simulator.md)");
   b->add_option("--fault-plan", o->fault_plan, "fault plan YAML (docs/blmc-simulator.md)");
   b->add_option("--duration", o->duration_s, "stop after this many seconds (default: until Ctrl-C)")->check(non_negative());
-  b->callback([o] { exit_code() = run_sim_blmc(*o); });
+  b->callback([o, &global] { global.exit_code = run_sim_blmc(*o); });
 }
 
 }  // namespace axon::app

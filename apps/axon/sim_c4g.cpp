@@ -113,7 +113,7 @@ int run_sim_c4g(const SimC4gArgs& o) {
 
 }  // namespace
 
-void add_sim_c4g_command(CLI::App& sim_cmd) {
+void add_sim_c4g_command(CLI::App& sim_cmd, GlobalOptions& global) {
   auto o = std::make_shared<SimC4gArgs>();
   auto* c = sim_cmd.add_subcommand("c4g", "simulated C4G controller (open interface client) playing a robot program");
   c->add_option("--robot", o->robot, "robot: six-axis (the manual's example), or a file: a captured 1200-byte initialization packet or its fields in YAML (docs/c4g-simulator.md)");
@@ -132,7 +132,7 @@ void add_sim_c4g_command(CLI::App& sim_cmd) {
   c->add_option("--switch-t3-ms", o->switch_t3_ms, "soft switching post-switching interval T3 [ms] (default 50)")->check(CLI::Range(0.0, 60000.0));
   c->add_option("--switch-tolerance", o->switch_tolerance, "motor turns the robot may move during T1..T3 (default 0.02)")->check(CLI::Range(0.0, 1e6));
   c->add_option("--switch-reducer", o->switch_reducer, "who scales the PC's current while switching: controller (default) or pc");
-  c->callback([o] { exit_code() = run_sim_c4g(*o); });
+  c->callback([o, &global] { global.exit_code = run_sim_c4g(*o); });
 }
 
 }  // namespace axon::app

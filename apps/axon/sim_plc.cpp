@@ -58,7 +58,7 @@ int run_sim_plc(const SimPlcOptions& o) {
 
 }  // namespace
 
-void add_sim_plc_command(CLI::App& app, GlobalOptions&) {
+void add_sim_plc_command(CLI::App& app, GlobalOptions& global) {
   CLI::App* sim_cmd = app.get_subcommand("sim");
   auto o = std::make_shared<SimPlcOptions>();
   auto* p = sim_cmd->add_subcommand("plc", "PLC emulator (Modbus TCP): power and sync relays, sensors");
@@ -68,7 +68,7 @@ void add_sim_plc_command(CLI::App& app, GlobalOptions&) {
   p->add_option("--time-scale", o->time_scale, "script seconds per real second (default 1)");
   p->add_option("--temperature", o->temperature_c, "initial temperature of every sensor, degC (default 15)");
   p->add_option("--duration", o->duration_s, "stop after this many seconds (default: until Ctrl-C)");
-  p->callback([o] { exit_code() = run_sim_plc(*o); });
+  p->callback([o, &global] { global.exit_code = run_sim_plc(*o); });
 }
 
 }  // namespace axon::app

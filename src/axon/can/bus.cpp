@@ -49,7 +49,21 @@ Bus::Bus(executor_type ex, std::string name, BusOptions options)
   stats_.opened = core::SteadyClock::instance().now();
 }
 
-Bus::~Bus() = default;
+// Whoever still waits in receive() or flush() wakes up and finds the bus gone.
+Bus::~Bus() {
+  waiters_->bus_gone = true;
+  wake_receivers();
+}
+
+Bus::WaiterRegistration::WaiterRegistration(std::shared_ptr<Waiters> w, asio::steady_timer& t)
+    : waiters(std::move(w)), timer(&t) {
+  waiters->timers.push_back(timer);
+}
+
+Bus::WaiterRegistration::~WaiterRegistration() {
+  auto& v = waiters->timers;
+  v.erase(std::remove(v.begin(), v.end(), timer), v.end());
+}
 
 void Bus::set_filters(std::vector<Filter> filters) { filters_ = std::move(filters); }
 
@@ -85,7 +99,7 @@ void Bus::set_state(BusState s) noexcept {
 void Bus::close() { set_state(BusState::closed); }
 
 void Bus::wake_receivers() noexcept {
-  for (auto* t : *waiters_) t->cancel();
+  for (auto* t : waiters_->timers) t->cancel();
 }
 
 std::optional<Frame> Bus::try_receive() {
@@ -97,7 +111,9 @@ std::optional<Frame> Bus::try_receive() {
 
 asio::awaitable<Result<void>> Bus::flush(core::Duration timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
+  const auto waiters = waiters_;  // `this` may be gone when the timer fires: see ~Bus
   asio::steady_timer timer(executor_);
+  const WaiterRegistration registered(waiters, timer);
   while (tx_pending() > 0) {
     if (state_ == BusState::closed) co_return Error(CanErrc::closed, fmt::format("bus {}: closed while flushing", name_));
     if (std::chrono::steady_clock::now() >= deadline)
@@ -105,6 +121,7 @@ asio::awaitable<Result<void>> Bus::flush(core::Duration timeout) {
     timer.expires_after(std::chrono::microseconds(200));
     boost::system::error_code ec;
     co_await timer.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+    if (waiters->bus_gone) co_return Error(CanErrc::closed, "the bus was destroyed while flushing");
   }
   co_return ok();
 }
@@ -116,20 +133,17 @@ asio::awaitable<Result<Frame>> Bus::receive(core::Duration timeout) {
 }
 
 asio::awaitable<Result<Frame>> Bus::receive_until(std::optional<core::TimePoint> deadline) {
+  const auto waiters = waiters_;  // `this` may be gone when the timer fires: see ~Bus
   for (;;) {
     if (auto f = try_receive()) co_return *f;
     if (state_ == BusState::closed) co_return Error(CanErrc::closed, fmt::format("bus {}", name_));
     if (deadline && std::chrono::steady_clock::now() >= *deadline)
       co_return Error(CanErrc::timeout, fmt::format("bus {}", name_));
     asio::steady_timer timer(executor_, deadline ? *deadline : core::TimePoint::max());
-    waiters_->push_back(&timer);
-    struct Unregister {
-      std::shared_ptr<std::vector<asio::steady_timer*>> list;
-      asio::steady_timer* t;
-      ~Unregister() { list->erase(std::remove(list->begin(), list->end(), t), list->end()); }
-    } guard{waiters_, &timer};
+    const WaiterRegistration registered(waiters, timer);
     boost::system::error_code ec;
     co_await timer.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+    if (waiters->bus_gone) co_return Error(CanErrc::closed, "the bus was destroyed while a receive() waited");
   }
 }
 

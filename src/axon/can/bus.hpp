@@ -108,6 +108,11 @@ class Bus {
 
   // Closes the transport; pending and future receive() calls complete with CanErrc::closed
   // once the queued frames are read. Safe to call twice.
+  //
+  // Lifetime: a bus may be destroyed while receive() or flush() calls are still in progress or
+  // already woken and queued on the executor (a reader parked in receive() whose owner drops the
+  // bus right after close()). They then complete with CanErrc::closed without touching the
+  // destroyed bus. A send() still waiting for room on SocketCAN must end before the bus goes.
   virtual void close();
 
  protected:
@@ -122,6 +127,27 @@ class Bus {
   void set_state(BusState s) noexcept;
   BusStats& mutable_stats() noexcept { return stats_; }
 
+  // The timers of receive() and flush() calls in progress, and whether the bus is gone; shared with
+  // those calls, which outlive the bus in two ways: resumed after it was destroyed (woken by close()
+  // or by the destructor, they see `bus_gone` and end without touching it), or destroyed unresumed
+  // after it (an io_context torn down with work pending: they unregister from this, not the bus).
+  struct Waiters {
+    std::vector<asio::steady_timer*> timers;
+    bool bus_gone = false;
+  };
+  // Registers a timer of a call in progress for the time it lives.
+  struct WaiterRegistration {
+    WaiterRegistration(std::shared_ptr<Waiters> w, asio::steady_timer& t);
+    ~WaiterRegistration();
+    WaiterRegistration(const WaiterRegistration&) = delete;
+    WaiterRegistration& operator=(const WaiterRegistration&) = delete;
+    std::shared_ptr<Waiters> waiters;
+    asio::steady_timer* timer;
+  };
+  // For a transport's coroutine that suspends inside a member (a send waiting for room): hold this
+  // before the suspension and check `bus_gone` after it before touching the bus.
+  [[nodiscard]] std::shared_ptr<const Waiters> waiters() const noexcept { return waiters_; }
+
  private:
   asio::awaitable<Result<Frame>> receive_until(std::optional<core::TimePoint> deadline);
   void wake_receivers() noexcept;
@@ -131,9 +157,7 @@ class Bus {
   BusOptions options_;
   std::vector<Filter> filters_;
   std::deque<Frame> rx_;
-  // Timers of receive() calls in progress. Shared with those calls, so that a receive coroutine
-  // destroyed after its bus (an io_context torn down with work pending) unregisters safely.
-  std::shared_ptr<std::vector<asio::steady_timer*>> waiters_ = std::make_shared<std::vector<asio::steady_timer*>>();
+  std::shared_ptr<Waiters> waiters_ = std::make_shared<Waiters>();
   BusStats stats_;
   BusState state_ = BusState::active;
 };

@@ -163,7 +163,9 @@ class CanNetBus final : public Bus {
     if (impl_->room_now()) {
       impl_->queue_line(line);
     } else {
+      const auto waiters = this->waiters();  // the bus may be destroyed while the line waits
       auto r = co_await impl_->queue_in_turn(line);
+      if (waiters->bus_gone) co_return Error(CanErrc::closed, "the bus was destroyed while a send() waited");
       if (!r) co_return r.error();
     }
     count_sent(frame);

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <thread>
 
 namespace axon::fps {
@@ -108,6 +109,49 @@ TEST_F(ClientOnPlane, EmergencyStopLocksAndReachesEveryBus) {
   EXPECT_TRUE(fps.locked());
   fps.unlock();
   EXPECT_FALSE(fps.locked());
+}
+
+TEST_F(ClientOnPlane, GoToDatumsDrivesIntoTheHardStopsAndReportsWhereTheRobotStands) {
+  ASSERT_TRUE(fps.goto_absolute({{3, {30, 150}}}).completed);
+  const Angles at = fps.go_to_datums(3);
+  const auto truth = plane.arms(3);
+  ASSERT_TRUE(truth.has_value());
+  EXPECT_LT(error_deg(at, *truth), 0.1);
+  EXPECT_GT(error_deg(at, {30, 150}), 1.0) << "the arms did not leave where they stood";
+  const auto table = fps.status();
+  const auto row = std::find_if(table.begin(), table.end(), [](const RobotStatus& r) { return r.id == 3; });
+  ASSERT_NE(row, table.end());
+  EXPECT_TRUE(row->ready) << row->state;
+}
+
+TEST_F(ClientOnPlane, CalibrateRunsMotorsAndDatumsAndSaves) {
+  fps.set_call_timeout(120);
+  const auto out = fps.calibrate(3);
+  EXPECT_TRUE(out.saved);
+  EXPECT_TRUE(out.motor_error.has_value());
+  EXPECT_TRUE(out.datum_error.has_value());
+  EXPECT_FALSE(out.flags.empty());
+  CalibrationSteps only_motors;
+  only_motors.datums = false;
+  only_motors.save = false;
+  const auto motors = fps.calibrate(3, only_motors);
+  EXPECT_FALSE(motors.saved);
+  EXPECT_TRUE(motors.motor_error.has_value());
+  EXPECT_FALSE(motors.datum_error.has_value());
+}
+
+TEST_F(ClientOnPlane, DatumAndCalibrationAreRefusedWhileLocked) {
+  fps.emergency_stop("test");
+  for (const auto& call : {std::function<void()>([&] { fps.go_to_datums(1); }), std::function<void()>([&] { fps.calibrate(1); })}) {
+    try {
+      call();
+      ADD_FAILURE() << "a datum or calibration went out while the array was locked";
+    } catch (const Exception& e) {
+      EXPECT_EQ(e.code(), host::HostErrc::locked) << e.what();
+    }
+  }
+  fps.unlock();
+  EXPECT_NO_THROW(fps.go_to_datums(3));
 }
 
 TEST_F(ClientOnPlane, BadTargetsAreRefusedWhenNotParked) {

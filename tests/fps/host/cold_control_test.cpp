@@ -106,3 +106,54 @@ TEST(ColdControl, WatchFollowsAScriptAndRetriesARobotThatMissedIt) {
     EXPECT_TRUE(cold.applied().has_value() && cold.applied()->heating);
   });
 }
+
+// The loop under `fps plane cold --watch --for S`: it ends by itself at its time limit, having sent
+// the settings once (forced at the first step) and then only read the unchanged temperature.
+TEST(ColdControl, WatchEndsAtItsTimeLimitAndSendsOnlyWhatChanged) {
+  PlaneRig rig;
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    ColdControl cold(*rig.fpa);
+    std::vector<ColdApplyReport> reports;
+    auto watching = cold.watch(50ms, nullptr,
+                               [&](const Result<ColdApplyReport>& r) {
+                                 EXPECT_TRUE(r.has_value());
+                                 if (r) reports.push_back(r.value());
+                               },
+                               400ms);
+    co_await std::move(watching);  // returns: no stop flag, only the limit ends it
+    if (reports.size() < 2u) {
+      ADD_FAILURE() << "only " << reports.size() << " steps before the limit";
+      co_return;
+    }
+    EXPECT_TRUE(reports.front().sent);
+    EXPECT_EQ(reports.front().applied.size(), 12u);
+    EXPECT_TRUE(std::none_of(reports.begin() + 1, reports.end(), [](const ColdApplyReport& r) { return r.sent; }));
+  });
+}
+
+// A stop set while the loop waits for its next period ends it before that period is over.
+TEST(ColdControl, WatchStopsBetweenStepsWithoutWaitingOutThePeriod) {
+  PlaneRig rig;
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    ColdControl cold(*rig.fpa);
+    bool stop = false;
+    int steps = 0;
+    bool ended = false;
+    asio::co_spawn(
+        rig.runner.io,
+        [&]() -> asio::awaitable<void> {
+          auto watching = cold.watch(std::chrono::hours(1), &stop, [&](const Result<ColdApplyReport>&) { ++steps; });
+          co_await std::move(watching);
+          ended = true;
+        },
+        asio::detached);
+    EXPECT_TRUE(co_await eventually([&] { return steps == 1; }, 20000));
+    stop = true;
+    EXPECT_TRUE(co_await eventually([&] { return ended; }, 20000)) << "the hour-long wait was not cut short";
+    EXPECT_EQ(steps, 1);
+  });
+}

@@ -3,9 +3,9 @@
 #include "axon/blmc/host/board.hpp"
 #include "axon/blmc/host/control_run.hpp"
 #include "axon/blmc/host/error.hpp"
-#include "axon/blmc/host/loop_await.hpp"
 #include "axon/blmc/host/session_log.hpp"
 #include "axon/can/open.hpp"
+#include "axon/core/loop_thread.hpp"
 #include "axon/core/wakeup.hpp"
 
 #include <fmt/format.h>
@@ -13,6 +13,8 @@
 
 #include <condition_variable>
 #include <mutex>
+#include <optional>
+#include <type_traits>
 
 namespace axon::blmc {
 
@@ -91,21 +93,30 @@ struct MotorBoard::Impl {
   // constructor failed).
   ~Impl() { loop.stop(); }
 
-  // A call that overstays its time limit is interrupted (the board's waits end at once); the
-  // interrupt is then taken back so that later calls work.
-  template <class T, class Make>
-  T wait(Make make, core::Duration timeout, const char* what) {
-    bool interrupted = false;
-    const core::OnExit clear{[&] {
-      if (interrupted) boost::asio::post(loop.executor(), [b = board.get()] { b->clear_interrupt(); });
-    }};
-    return detail::await_on<T>(
-        loop, std::move(make), timeout,
-        [&] {
-          interrupted = true;
-          interrupt();
-        },
-        Error(HostErrc::timeout, fmt::format("{}: {}: no result within {:.1f} s", options.name, what, seconds_of(timeout))));
+  // Runs a board coroutine (it returns a Result) on the loop and waits for it (core::LoopThread::run).
+  // A call that overstays its time limit is interrupted (the board's waits end at once, so the
+  // coroutine ends soon), the interrupt is then taken back so that later calls work, and the call
+  // throws HostErrc::timeout naming `what`.
+  template <class Make>
+  auto wait(Make make, core::Duration timeout, const char* what) {
+    using R = typename std::invoke_result_t<Make&>::value_type;
+    try {
+      // LoopThread::run hands back a default-constructible value: the Result travels in an optional.
+      auto r = loop.run(
+          [make = std::move(make)]() -> boost::asio::awaitable<std::optional<R>> {
+            auto result = co_await make();
+            co_return std::optional<R>(std::move(result));
+          },
+          timeout, [b = board.get()] {
+            if (b) b->interrupt();
+          });
+      return std::move(*r);
+    } catch (const Exception& e) {
+      if (e.code() != CoreErrc::timeout) throw;
+      // Queued after the interrupt (the loop runs its work in order).
+      if (board) boost::asio::post(loop.executor(), [b = board.get()] { b->clear_interrupt(); });
+      throw Exception(Error(HostErrc::timeout, fmt::format("{}: {}: no result within {:.1f} s", options.name, what, seconds_of(timeout))));
+    }
   }
   void interrupt() {
     boost::asio::post(loop.executor(), [b = board.get()] { b->interrupt(); });
@@ -122,10 +133,9 @@ void MotorBoard::Impl::open(const std::string& spec_text) {
   const auto spec = can::parse_bus_spec(spec_text).value();
   can::OpenOptions oo;
   oo.connect_timeout = options.connect_timeout;
-  bus = detail::await_on<Result<std::unique_ptr<can::Bus>>>(
-            loop, [ex = loop.executor(), spec, oo] { return can::open_bus(ex, spec, oo); },
-            options.connect_timeout + std::chrono::seconds(1), {},
-            Error(HostErrc::timeout, fmt::format("{}: {} did not open", options.name, spec_text)))
+  // open_bus gives up after the connect timeout itself.
+  bus = wait([ex = loop.executor(), spec, oo] { return can::open_bus(ex, spec, oo); },
+             options.connect_timeout + std::chrono::seconds(1), "open")
             .value();
   host::BoardOptions bo;
   bo.name = options.name;
@@ -229,7 +239,7 @@ void MotorBoard::Impl::disable() {
       spdlog::error("{}: stopping control before the disable: {}", options.name, e.what());
     }
   }
-  auto r = wait<Result<void>>([b = board.get()] { return b->disable(); }, std::chrono::seconds(5), "disable");
+  auto r = wait([b = board.get()] { return b->disable(); }, std::chrono::seconds(5), "disable");
   enabled = false;
   r.value();
 }
@@ -243,9 +253,7 @@ void MotorBoard::Impl::close() noexcept {
   try {
     // What the disable queued goes out before the connection closes.
     if (bus) {
-      auto flushed = detail::await_on<Result<void>>(
-          loop, [b = bus.get()] { return b->flush(std::chrono::seconds(1)); }, std::chrono::seconds(2), {},
-          Error(HostErrc::timeout, "flush"));
+      auto flushed = wait([b = bus.get()] { return b->flush(std::chrono::seconds(1)); }, std::chrono::seconds(2), "flush");
       (void)flushed;
     }
     loop.call([this] {
@@ -278,7 +286,7 @@ MotorBoard& MotorBoard::operator=(MotorBoard&& other) noexcept {
 void MotorBoard::enable() {
   auto& i = *impl_;
   const auto limit = i.options.ready_timeout + std::chrono::seconds(2);
-  auto r = i.wait<Result<void>>([b = i.board.get()] { return b->enable(); }, limit, "enable");
+  auto r = i.wait([b = i.board.get()] { return b->enable(); }, limit, "enable");
   if (!r) {
     try {
       i.disable();
@@ -297,13 +305,13 @@ void MotorBoard::recover() {
   if (i.run) throw Exception(Error(HostErrc::cyclic_active, fmt::format("{}: recover: stop_control first", i.options.name)));
   i.enabled = true;  // the recovery enables: whatever happens next, the way out disables
   const auto limit = i.options.ready_timeout + std::chrono::seconds(2);
-  i.wait<Result<void>>([b = i.board.get()] { return b->recover(); }, limit, "recover").value();
+  i.wait([b = i.board.get()] { return b->recover(); }, limit, "recover").value();
 }
 bool MotorBoard::enabled() const noexcept { return impl_->enabled; }
 
 protocol::Status MotorBoard::wait_status() {
   auto& i = *impl_;
-  return i.wait<Result<protocol::Status>>([b = i.board.get(), t = i.options.status_timeout] { return b->wait_status(t); },
+  return i.wait([b = i.board.get(), t = i.options.status_timeout] { return b->wait_status(t); },
                                           i.options.status_timeout + std::chrono::seconds(1), "wait_status")
       .value();
 }
@@ -345,7 +353,7 @@ HomingReport MotorBoard::home(host::HomingOptions options, ControlSettings setti
   auto opts = i.control_options(settings);
   opts.duration = std::chrono::duration_cast<core::Duration>(timeout);
   for (std::size_t k = 0; k < 2; ++k) options.motors[k] = options.motors[k] && i.options.motors[k];
-  auto r = i.wait<Result<host::HomingRun>>(
+  auto r = i.wait(
       [b = i.board.get(), options, opts] { return host::run_homing(*b, options, opts); },
       opts.duration + std::chrono::seconds(3), "home");
   const auto run = std::move(r).value();

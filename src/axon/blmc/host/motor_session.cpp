@@ -44,9 +44,6 @@ Result<void> disable_over_new_connection(const can::BusSpec& spec, core::Duratio
   Result<void> result = Error(HostErrc::timeout, fmt::format("{}: no way to the board within {:.1f} s", spec.to_string(),
                                                              std::chrono::duration<double>(timeout).count()));
   asio::io_context io;  // after `result`: the coroutine's frame goes first
-  // The bus outlives the coroutine: its own reader ends on `io` after close(), and must still find
-  // the bus there (destroying it inside the coroutine freed it under that reader).
-  std::unique_ptr<can::Bus> bus;
   asio::co_spawn(
       io,
       [&]() -> asio::awaitable<void> {
@@ -55,23 +52,18 @@ Result<void> disable_over_new_connection(const can::BusSpec& spec, core::Duratio
           result = b.error();
           co_return;
         }
-        bus = std::move(b).value();
+        auto bus = std::move(b).value();
         {
           Board board(*bus);
           result = co_await board.disable();
         }
         auto f = co_await bus->flush(std::chrono::seconds(1));
         (void)f;
+        // The board's reader, woken by the close, resumes after the bus is gone: can::Bus allows it.
         bus->close();
       },
       [](std::exception_ptr) {});
   io.run_for(timeout);
-  if (bus) {  // let the closed bus's pending work finish before it goes
-    bus->close();
-    io.restart();
-    io.run_for(std::chrono::milliseconds(200));
-    bus.reset();
-  }
   return result;
 }
 

@@ -236,6 +236,35 @@ MoveOutcome Client::run_trajectories(const std::map<std::uint16_t, ArmPath>& pat
   });
 }
 
+Angles Client::go_to_datums(std::uint16_t id) {
+  auto& array = impl_->open_array();
+  return impl_->run([&array, id]() -> asio::awaitable<Angles> {
+    auto* p = need(array.positioner(id));
+    auto done = co_await p->go_to_datums(host::Arm::both);
+    need(std::move(done));
+    auto at = co_await p->read_position();
+    co_return angles(need(std::move(at)));
+  });
+}
+
+CalibrationOutcome Client::calibrate(std::uint16_t id, const CalibrationSteps& steps) {
+  auto& array = impl_->open_array();
+  host::CalibrationPlan plan;
+  plan.motors = steps.motors;
+  plan.datums = steps.datums;
+  plan.cogging = steps.cogging;
+  plan.save = steps.save;
+  return impl_->run([&array, id, plan]() -> asio::awaitable<CalibrationOutcome> {
+    auto* p = need(array.positioner(id));
+    auto r = co_await p->calibrate(plan);
+    const auto rep = need(std::move(r));
+    const auto arms = [](const std::optional<protocol::ArmValues>& v) {
+      return v ? std::optional<Angles>(Angles{static_cast<double>(v->alpha), static_cast<double>(v->beta)}) : std::nullopt;
+    };
+    co_return CalibrationOutcome{arms(rep.motor_error), arms(rep.datum_error), rep.saved, rep.final_status.names()};
+  });
+}
+
 namespace {
 
 PlanAndMoveOutcome plan_and_move_on(Client::Impl& impl, const std::vector<plan::Target>& targets, const PlanSettings& s);

@@ -119,6 +119,21 @@ struct StopOutcome {
   std::string text;                // StopReport::to_text()
 };
 
+// The steps of calibrate(), run in the order of the document's calibration chapter.
+struct CalibrationSteps {
+  bool motors = true;
+  bool datums = true;
+  bool cogging = false;  // long (up to 40 minutes) and not essential
+  bool save = true;      // write the results to the robot's flash
+};
+
+struct CalibrationOutcome {
+  std::optional<Angles> motor_error;  // degrees (whole), after the motor calibration
+  std::optional<Angles> datum_error;  // degrees (whole: the spread of the hard-stop hits)
+  bool saved = false;
+  std::vector<std::string> flags;     // the robot's status flags at the end
+};
+
 struct UnlockOutcome {
   std::vector<std::uint16_t> acknowledged;
   std::vector<std::uint16_t> silent;
@@ -158,6 +173,16 @@ class Client {
   PlanAndMoveOutcome plan_and_move(const std::map<std::uint16_t, Angles>& targets, const PlanSettings& settings = {});
   // The same with a target file (YAML or CSV: robot, alpha/beta or x/y and fibre).
   PlanAndMoveOutcome plan_and_move(const std::string& target_file, const PlanSettings& settings = {});
+
+  // Datum search of one robot found by discover(): both arms drive into their hard stops (the arms
+  // move; nothing checks for neighbours on the way). Waits for the end and returns where the robot
+  // then stands. Refused while locked (HostErrc::locked); a robot that does not finish within the
+  // positioner's datum timeout is aborted and the call throws.
+  Angles go_to_datums(std::uint16_t id);
+  // The calibration sequence of one robot found by discover() (motors, datums, cogging, save, as
+  // `steps` says; the arms move). Takes minutes, cogging up to 40: raise set_call_timeout() first
+  // when needed. Refused while locked (HostErrc::locked).
+  CalibrationOutcome calibrate(std::uint16_t id, const CalibrationSteps& steps = {});
 
   // Locks the array and aborts every robot on every bus; moves are refused until unlock().
   StopOutcome emergency_stop(const std::string& reason = "emergency stop");

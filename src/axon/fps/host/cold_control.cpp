@@ -80,13 +80,21 @@ asio::awaitable<Result<ColdApplyReport>> ColdControl::step(bool force) {
 }
 
 asio::awaitable<void> ColdControl::watch(core::Duration period, const bool* stop,
-                                         std::function<void(const Result<ColdApplyReport>&)> on_report) {
+                                         std::function<void(const Result<ColdApplyReport>&)> on_report,
+                                         core::Duration limit) {
+  using Clock = std::chrono::steady_clock;
+  constexpr auto kStopCheck = std::chrono::milliseconds(50);
+  const auto t0 = Clock::now();
+  auto stopped = [&] {
+    return (stop != nullptr && *stop) || (limit > core::Duration::zero() && Clock::now() - t0 >= limit);
+  };
   bool first = true;
-  while (stop == nullptr || !*stop) {
+  while (!stopped()) {
     auto r = co_await step(first);
     first = false;
     if (on_report) on_report(r);
-    co_await core::sleep_for(period);
+    const auto next = Clock::now() + period;
+    while (!stopped() && Clock::now() < next) co_await core::sleep_for(kStopCheck);
   }
 }
 

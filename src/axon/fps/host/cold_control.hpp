@@ -42,10 +42,12 @@ class ColdControl {
 
   // One round. Errors: no PLC (HostErrc::invalid_argument), the PLC's read failing (PlcErrc).
   boost::asio::awaitable<Result<ColdApplyReport>> step(bool force = false);
-  // step(true), then step() every `period` until *stop becomes true (checked every period); each
-  // report (or error) goes to `on_report`.
+  // step(true), then step() every `period` until *stop becomes true (set on the array's executor) or
+  // `limit` has passed since the start (zero: no limit); both are checked every 50 ms between
+  // steps, so a stop takes effect within that. Each report (or error) goes to `on_report`.
   boost::asio::awaitable<void> watch(core::Duration period, const bool* stop,
-                                     std::function<void(const Result<ColdApplyReport>&)> on_report);
+                                     std::function<void(const Result<ColdApplyReport>&)> on_report,
+                                     core::Duration limit = core::Duration::zero());
 
   // What the robots were last told (nullopt before the first step that sent anything).
   [[nodiscard]] const std::optional<plc::ColdSettings>& applied() const noexcept { return applied_; }
