@@ -32,7 +32,9 @@ asio::awaitable<void> load_robot_10(PlaneRig& rig) {
   t.emplace(10, fold_to({90, 120}));
   auto r = co_await rig.fpa->array().run_trajectories(std::move(t), load);
   EXPECT_TRUE(r.has_value());
-  if (r) EXPECT_EQ(r.value().find(10)->state, RobotState::loaded) << r.value().summary();
+  if (r) {
+    EXPECT_EQ(r.value().find(10)->state, RobotState::loaded) << r.value().summary();
+  }
 }
 
 }  // namespace
@@ -48,7 +50,9 @@ TEST(SyncStartOutsideTheRun, RobotOnAnotherBusHoldingATrajectoryDoesNotMove) {
 
     auto r = co_await rig.fpa->run_trajectories(first_bus_run(), {}, /*by_sync_line=*/true);
     EXPECT_TRUE(r.has_value()) << r.error().message();
-    if (r) EXPECT_TRUE(r.value().completed) << r.value().summary();
+    if (r) {
+      EXPECT_TRUE(r.value().completed) << r.value().summary();
+    }
     EXPECT_EQ(rig.sim->counters().sync_edges, 1u);
     EXPECT_NEAR(rig.sim->simulator().find(1)->physical_deg(sim::Arm::alpha), 30.0, 0.1);
     EXPECT_FALSE(m10->moving());
@@ -86,7 +90,9 @@ TEST(SyncStartOutsideTheRun, BroadcastStartLeavesOtherBusesAlone) {
     co_await load_robot_10(rig);
     auto r = co_await rig.fpa->run_trajectories(first_bus_run(), {}, /*by_sync_line=*/false);
     EXPECT_TRUE(r.has_value());
-    if (r) EXPECT_TRUE(r.value().completed) << r.value().summary();
+    if (r) {
+      EXPECT_TRUE(r.value().completed) << r.value().summary();
+    }
     // The START_TRAJECTORY broadcast went to bus 1 only: robot 10 kept its trajectory, unstarted.
     EXPECT_FALSE(rig.sim->simulator().find(10)->moving());
     EXPECT_NEAR(rig.sim->simulator().find(10)->physical_deg(sim::Arm::alpha), 0.0, 1e-6);
