@@ -12,8 +12,9 @@ using namespace axon::fps::host::testing;
 
 namespace {
 
+// From the fold to `to` in 4 s, well within the arms' speed limit.
 protocol::Trajectory fold_to(ArmAngles to) {
-  std::vector<protocol::ArmPoint> a{{to.alpha, 2.0}}, b{{to.beta, 2.0}};
+  std::vector<protocol::ArmPoint> a{{to.alpha, 4.0}}, b{{to.beta, 4.0}};
   return protocol::Trajectory::from_physical(a, b).value();
 }
 
@@ -29,7 +30,7 @@ asio::awaitable<void> load_robot_10(PlaneRig& rig) {
   TrajectoryOptions load;
   load.start = false;
   std::map<std::uint16_t, protocol::Trajectory> t;
-  t.emplace(10, fold_to({90, 120}));
+  t.emplace(10, fold_to({40, 160}));
   auto r = co_await rig.fpa->array().run_trajectories(std::move(t), load);
   EXPECT_TRUE(r.has_value());
   if (r) {
