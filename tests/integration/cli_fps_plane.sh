@@ -2,7 +2,7 @@
 # The focal plane at scale, over real TCP between processes: `axon sim fps --layout` (one CAN@net
 # emulator per gateway plus the PLC emulator) driven by `axon fps plane` and `axon fps plc`.
 #   1. discovery against the layout finds a missing robot and an extra one;
-#   2. a move started by the sync line reaches every bus;
+#   2. a move by the sync line is refused while a robot it reaches is silent, and otherwise reaches every bus;
 #   3. a sextant powered off and on through the PLC mid-session: silent, then in the bootloader;
 #   4. a collision on one bus stops the robots of every bus.
 source "$(dirname "$0")/lib.sh"
@@ -50,15 +50,28 @@ grep -q '^missing *robot 5 ' "$TMP/check.out" || fail "robot 5 not reported miss
 grep -q '^unexpected *robot 900 ' "$TMP/check.out" || fail "robot 900 not reported unexpected"
 grep -q '11 matched' "$TMP/check.out" || fail "11 robots should match (12 in the layout, robot 5 absent)"
 
-# 2. A move started by the sync line reaches every bus (robot 5 is absent: left out).
+# 2. The sync line reaches every robot: with robot 5 silent (absent) it could start a trajectory
+#    robot 5 may hold, so a move by the sync line is refused, naming it, and the line stays low.
+set +e
 "$AXON" fps plane --layout "$TMP/a.yaml" --plc "$PLC" move --alpha 20 --beta 170 --duration 4 --sync \
+  >"$TMP/refused.out" 2>"$TMP/refused.err"
+rc=$?
+set -e
+[ $rc != 0 ] || fail "a sync move with a silent robot must be refused"
+grep -q 'start by the sync line refused.*: 5 (no acknowledgement)' "$TMP/refused.err" || fail "refusal does not name robot 5"
+grep -q 'sync line rising edge: ' "$TMP/a.err" && fail "the sync line was pulsed despite the refusal"
+# With every robot answering, a move started by the sync line reaches every bus.
+PLC_A=$PLC
+plane c
+"$AXON" fps plane --layout "$TMP/c.yaml" --plc "$PLC" move --alpha 20 --beta 170 --duration 4 --sync \
   >"$TMP/move.out" 2>"$TMP/move.err" || fail "sync move failed"
 for bus in gw1/1 gw1/2 gw2/1 gw2/2; do
   grep -Eq "^bus $bus: ([0-9]+) of \1 robots started" "$TMP/move.out" || fail "not every robot on $bus started"
 done
 grep -q 'start by the sync line' "$TMP/move.out" || fail "not started by the sync line"
-grep -q '^completed: 11 robots' "$TMP/move.out" || fail "move did not complete"
-grep -q 'sync line rising edge: ' "$TMP/a.err" || fail "the simulator saw no sync edge"
+grep -q '^completed: 12 robots' "$TMP/move.out" || fail "move did not complete"
+grep -q 'sync line rising edge: ' "$TMP/c.err" || fail "the simulator saw no sync edge"
+PLC=$PLC_A
 
 # 3. Sextant 2 powered off, then on through the PLC, while the host keeps working.
 "$AXON" fps plc --host "$PLC" power 2 off >/dev/null || fail "power off"

@@ -40,6 +40,31 @@ std::vector<std::size_t> buses_of(const TrajectoryReport& rep) {
   return {s.begin(), s.end()};
 }
 
+// Robots outside the run on `buses` that the pre-upload abort did not confirm: neither an
+// acknowledgement nor the bootloader's refusal (a robot in its bootloader holds no trajectory).
+// One line each, for the error that refuses the start.
+std::vector<std::string> unconfirmed_outside(const std::vector<std::pair<std::size_t, std::vector<std::uint16_t>>>& buses,
+                                             const TrajectoryReport& rep, const auto& results) {
+  std::vector<std::string> out;
+  for (const auto& [bus, ids] : buses) {
+    for (const auto& b : results) {
+      if (b.bus != bus) continue;
+      for (auto id : ids) {
+        if (rep.find(id) != nullptr) continue;
+        const Reply* reply = b.result ? b.result.value().from(id) : nullptr;
+        if (!b.result) {
+          out.push_back(fmt::format("{} (the abort broadcast failed: {})", id, b.result.error().message()));
+        } else if (reply == nullptr) {
+          out.push_back(fmt::format("{} (no acknowledgement)", id));
+        } else if (!reply->accepted() && reply->code != protocol::ResponseCode::invalid_bootloader_command) {
+          out.push_back(fmt::format("{} ({})", id, reply->error().message()));
+        }
+      }
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::uint16_t, protocol::Trajectory> trajectories,
@@ -77,12 +102,27 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
     r.detail = std::move(why);
   };
 
-  // 1. Stop whatever runs on the buses involved and drop old trajectories (the start broadcast
-  //    reaches every robot on those buses), then let the robots settle.
+  // 1. Stop whatever runs and drop old trajectories wherever the start will reach (a START_TRAJECTORY
+  //    broadcast: the buses involved; the sync line: every bus of the array), then let the robots
+  //    settle. Collision flags are cleared (STOP_TRAJECTORY) only on the buses involved.
+  const bool by_sync = o.start && o.sync_line;
+  const auto reached = by_sync ? all_buses() : involved;
   std::vector<CommandId> pre{CommandId::trajectory_abort};
   if (o.clear_collision_flags) pre.push_back(CommandId::stop_trajectory);
   for (auto c : pre) {
-    auto results = co_await broadcast_on(involved, c);
+    auto results = co_await broadcast_on(c == CommandId::trajectory_abort ? reached : involved, c);
+    if (c == CommandId::trajectory_abort && by_sync) {
+      // Never pulse the line while a robot nobody watches may hold a trajectory.
+      std::vector<std::pair<std::size_t, std::vector<std::uint16_t>>> others;
+      for (auto b : reached) others.emplace_back(b, ids_on(b));
+      if (auto silent = unconfirmed_outside(others, rep, results); !silent.empty()) {
+        co_return Error(HostErrc::not_ready,
+                        fmt::format("start by the sync line refused: it reaches every bus, and {} robot(s) outside the "
+                                    "run could not be confirmed to hold no trajectory (they would move unwatched): "
+                                    "{}; nothing was uploaded",
+                                    silent.size(), fmt::join(silent, ", ")));
+      }
+    }
     for (auto& r : rep.robots) {
       if (r.state != RobotState::pending) continue;
       for (const auto& b : results) {

@@ -48,18 +48,18 @@ struct RobotRun {
 struct TrajectoryOptions {
   bool start = true;  // false: load and validate only
   bool wait = true;   // wait for the end and check the final positions
-  // Before the upload every bus that carries one of the robots gets a TRAJECTORY_ABORT broadcast
-  // (the start broadcast reaches every robot there, so none may keep an old trajectory). Abort
-  // keeps collision flags, so a robot with a flag is reported not ready; with
-  // clear_collision_flags a STOP_TRAJECTORY broadcast follows, as the host in service does.
+  // Before the upload TRAJECTORY_ABORT goes to every bus the start reaches (the robots' buses; every
+  // bus for the sync line). Abort keeps collision flags (a flagged robot is not ready); with
+  // clear_collision_flags STOP_TRAJECTORY follows on the robots' buses, as the host in service does.
   bool clear_collision_flags = false;
   core::Duration settle = 100ms;        // after the abort/stop, before the next command
   // Collecting start acknowledgements. The robots that did start keep moving while the host waits
   // for one that does not answer, so keep this short (acknowledgements take milliseconds).
   core::Duration start_window = 250ms;
   core::Duration end_margin = 10s;      // beyond the trajectory's duration
-  // Starts with the sync line instead of a START_TRAJECTORY broadcast: called once every bus
-  // listens for the acknowledgements (uid 0). Must drive the line high long enough (about 0.5 s).
+  // Starts by the sync line, not a START_TRAJECTORY broadcast, once every bus listens (uid-0 acks);
+  // refused (not_ready, before any upload) when a robot outside the run does not ack the abort.
+  // Hold the line high about 0.5 s.
   std::function<asio::awaitable<Result<void>>()> sync_line;
   // When given, a robot whose trajectory drives an arm faster than this (from where it stands) is
   // not ready, with the duration it would need (trajectory_speed.hpp): nothing is uploaded, instead
