@@ -20,7 +20,7 @@ namespace {
 using axon::can::test::F;
 
 // Runs `body` as a coroutine on `io`, then runs `io` until nothing is left to do.
-void run(asio::io_context& io, std::function<asio::awaitable<void>()> body) {
+void run_to_end(asio::io_context& io, std::function<asio::awaitable<void>()> body) {
   asio::co_spawn(io, std::move(body), [](std::exception_ptr e) {
     if (e) std::rethrow_exception(e);
   });
@@ -43,7 +43,7 @@ TEST(VirtualBus, DeliversToEveryOtherNodeButNotTheSender) {
   auto medium = VirtualBus::create(io.get_executor(), "vcan0");
   auto a = medium->attach("a"), b = medium->attach("b"), c = medium->attach("c");
   EXPECT_EQ(medium->node_count(), 3u);
-  run(io, [&]() -> asio::awaitable<void> {
+  run_to_end(io, [&]() -> asio::awaitable<void> {
     EXPECT_TRUE((co_await a->send(F("123#01"))).has_value());
     EXPECT_TRUE((co_await b->send(F("456#02"))).has_value());
   });
@@ -73,7 +73,7 @@ TEST(VirtualBus, TimestampsDeliveredFrames) {
   asio::io_context io;
   auto medium = VirtualBus::create(io.get_executor(), "vcan0");
   auto a = medium->attach(), b = medium->attach();
-  run(io, [&]() -> asio::awaitable<void> { (void)co_await a->send(F("100#")); });
+  run_to_end(io, [&]() -> asio::awaitable<void> { (void)co_await a->send(F("100#")); });
   auto f = b->try_receive();
   ASSERT_TRUE(f);
   EXPECT_GT(f->timestamp().count(), 0);
@@ -84,7 +84,7 @@ TEST(VirtualBus, ReceiverFiltersApply) {
   auto medium = VirtualBus::create(io.get_executor(), "vcan0");
   auto a = medium->attach(), b = medium->attach();
   b->set_filters({Filter{0x100, 0x700}});
-  run(io, [&]() -> asio::awaitable<void> {
+  run_to_end(io, [&]() -> asio::awaitable<void> {
     for (const char* t : {"100#", "1FF#01", "200#", "000#"}) (void)co_await a->send(F(t));
   });
   EXPECT_EQ(drain(*b), (Strings{"100#", "1FF#01"}));
@@ -97,7 +97,7 @@ TEST(VirtualBus, ArbitrationPicksLowestHeadAndKeepsEachNodesOrder) {
   auto a = medium->attach("a"), b = medium->attach("b"), rx = medium->attach("rx");
   // All four are queued before the medium runs. Only queue heads compete: a's 0x100 waits behind
   // its own 0x300 although it would beat everything.
-  run(io, [&]() -> asio::awaitable<void> {
+  run_to_end(io, [&]() -> asio::awaitable<void> {
     (void)co_await a->send(F("300#"));
     (void)co_await a->send(F("100#"));
     (void)co_await b->send(F("200#"));
@@ -114,7 +114,7 @@ TEST(VirtualBus, ArbitrationStandardBeatsExtendedAndDataBeatsRemote) {
   asio::io_context io;
   auto medium = VirtualBus::create(io.get_executor(), "vcan0");
   auto a = medium->attach(), b = medium->attach(), c = medium->attach(), rx = medium->attach();
-  run(io, [&]() -> asio::awaitable<void> {
+  run_to_end(io, [&]() -> asio::awaitable<void> {
     (void)co_await a->send(F("04000000#"));  // extended, same base id as 0x010
     (void)co_await b->send(F("010#R"));
     (void)co_await c->send(F("010#"));
@@ -126,7 +126,7 @@ TEST(VirtualBus, EqualKeysGoInQueueingOrder) {
   asio::io_context io;
   auto medium = VirtualBus::create(io.get_executor(), "vcan0");
   auto a = medium->attach(), b = medium->attach(), rx = medium->attach();
-  run(io, [&]() -> asio::awaitable<void> {
+  run_to_end(io, [&]() -> asio::awaitable<void> {
     (void)co_await b->send(F("123#0B"));
     (void)co_await a->send(F("123#0A"));
   });
@@ -138,7 +138,7 @@ TEST(VirtualBus, SingleNodeKeepsItsOrder) {
   auto medium = VirtualBus::create(io.get_executor(), "vcan0");
   auto a = medium->attach(), rx = medium->attach();
   Strings sent;
-  run(io, [&]() -> asio::awaitable<void> {
+  run_to_end(io, [&]() -> asio::awaitable<void> {
     for (int i = 0; i < 50; ++i) {
       auto f = Frame::standard(static_cast<std::uint32_t>((i * 37) % 0x800), {}).value();
       sent.push_back(f.to_string());
@@ -154,7 +154,7 @@ TEST(VirtualBus, TransmitQueueOverflow) {
   BusOptions small;
   small.tx_capacity = 2;
   auto a = medium->attach("a", small), rx = medium->attach();
-  run(io, [&]() -> asio::awaitable<void> {
+  run_to_end(io, [&]() -> asio::awaitable<void> {
     EXPECT_TRUE((co_await a->send(F("001#"))).has_value());
     EXPECT_TRUE((co_await a->send(F("002#"))).has_value());
     auto r = co_await a->send(F("003#"));
@@ -168,7 +168,7 @@ TEST(VirtualBus, TransmitQueueOverflow) {
   EXPECT_EQ(a->stats().frames_out, 2u);
   EXPECT_EQ(drain(*rx), (Strings{"001#", "002#"}));
   // Once the medium has taken the frames there is room again.
-  run(io, [&]() -> asio::awaitable<void> { EXPECT_TRUE((co_await a->send(F("004#"))).has_value()); });
+  run_to_end(io, [&]() -> asio::awaitable<void> { EXPECT_TRUE((co_await a->send(F("004#"))).has_value()); });
   EXPECT_EQ(drain(*rx), (Strings{"004#"}));
 }
 
@@ -176,7 +176,7 @@ TEST(VirtualBus, ClosedNodeDropsItsQueueAndRefusesToSend) {
   asio::io_context io;
   auto medium = VirtualBus::create(io.get_executor(), "vcan0");
   auto a = medium->attach(), b = medium->attach(), c = medium->attach();
-  run(io, [&]() -> asio::awaitable<void> {
+  run_to_end(io, [&]() -> asio::awaitable<void> {
     (void)co_await a->send(F("001#"));
     (void)co_await a->send(F("002#"));
     (void)co_await b->send(F("003#"));
@@ -193,7 +193,7 @@ TEST(VirtualBus, ClosedNodeDropsItsQueueAndRefusesToSend) {
   EXPECT_EQ(a->state(), BusState::closed);
   a->close();  // twice is fine
   // The rest of the bus keeps working.
-  run(io, [&]() -> asio::awaitable<void> { (void)co_await c->send(F("005#")); });
+  run_to_end(io, [&]() -> asio::awaitable<void> { (void)co_await c->send(F("005#")); });
   EXPECT_EQ(drain(*b), (Strings{"005#"}));
 }
 
@@ -223,7 +223,7 @@ TEST(VirtualBus, DestroyedNodeDetaches) {
     EXPECT_EQ(medium->node_count(), 3u);
   }
   EXPECT_EQ(medium->node_count(), 2u);
-  run(io, [&]() -> asio::awaitable<void> { (void)co_await a->send(F("001#")); });
+  run_to_end(io, [&]() -> asio::awaitable<void> { (void)co_await a->send(F("001#")); });
   EXPECT_EQ(drain(*b), (Strings{"001#"}));
 }
 
@@ -234,7 +234,7 @@ TEST(VirtualBus, NodesKeepTheMediumAlive) {
   auto a = medium->attach(), b = medium->attach();
   medium.reset();
   ASSERT_FALSE(weak.expired());
-  run(io, [&]() -> asio::awaitable<void> { (void)co_await a->send(F("001#")); });
+  run_to_end(io, [&]() -> asio::awaitable<void> { (void)co_await a->send(F("001#")); });
   EXPECT_EQ(drain(*b), (Strings{"001#"}));
   a.reset();
   b.reset();
@@ -266,7 +266,7 @@ TEST(VirtualBusRegistry, AddFindOpen) {
   auto b = reg.open("vcan0").value();
   auto other = reg.open("vcan1").value();
   EXPECT_EQ(reg.find("vcan0")->node_count(), 2u);
-  run(io, [&]() -> asio::awaitable<void> { (void)co_await a->send(F("123#")); });
+  run_to_end(io, [&]() -> asio::awaitable<void> { (void)co_await a->send(F("123#")); });
   EXPECT_EQ(drain(*b), (Strings{"123#"}));
   EXPECT_TRUE(drain(*other).empty());
 }

@@ -24,6 +24,7 @@ constexpr std::size_t kMaxLine = 4096;
 
 using core::is_space;
 using core::trim;
+using core::hex_value;
 
 // Splits off the next white-space separated field.
 std::string_view next_field(std::string_view& s) noexcept {
@@ -33,13 +34,6 @@ std::string_view next_field(std::string_view& s) noexcept {
   const std::string_view field = s.substr(0, end);
   s.remove_prefix(end);
   return field;
-}
-
-int hex_value(char c) noexcept {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-  return -1;
 }
 
 bool all_digits(std::string_view s) noexcept {

@@ -1,4 +1,5 @@
 #include "axon/can/frame.hpp"
+#include "axon/core/text.hpp"
 
 #include <fmt/format.h>
 
@@ -38,14 +39,7 @@ Result<Frame> Frame::remote(std::uint32_t id, IdFormat fmt, std::uint8_t dlc) {
   return f;
 }
 
-namespace {
-int hex_value(char c) {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-  return -1;
-}
-}  // namespace
+using core::hex_value;
 
 Result<Frame> Frame::parse(std::string_view text) {
   auto bad = [&](std::string_view why) {

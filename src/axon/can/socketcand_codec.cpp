@@ -1,4 +1,5 @@
 #include "axon/can/socketcand_codec.hpp"
+#include "axon/core/text.hpp"
 
 #include <fmt/format.h>
 
@@ -15,16 +16,9 @@ constexpr std::size_t kMaxFields = 16;  // the longest message (send, 8 bytes) h
 bool is_space(char c) noexcept { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 bool is_printable(char c) noexcept { return c >= 0x20 && c <= 0x7E; }
 
-int hex_digit(char c) noexcept {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-  return -1;
-}
-
 bool all_hex(std::string_view s) noexcept {
   for (char c : s)
-    if (hex_digit(c) < 0) return false;
+    if (core::hex_value(c) < 0) return false;
   return !s.empty();
 }
 
@@ -216,7 +210,7 @@ Result<Message> parse_fields(const Fields& f) {
       if (!all_hex(d) || d.size() % 2 != 0) return bad(fmt::format("data '{}' is not whole hex bytes", excerpt(d)));
       for (std::size_t k = 0; k < d.size(); k += 2) {
         if (n == Frame::kMaxData) return bad("more than 8 data bytes");
-        bytes[n++] = static_cast<std::uint8_t>(hex_digit(d[k]) << 4 | hex_digit(d[k + 1]));
+        bytes[n++] = static_cast<std::uint8_t>(core::hex_value(d[k]) << 4 | core::hex_value(d[k + 1]));
       }
     }
     auto frame = Frame::data(id.value, id.format, std::span<const std::uint8_t>(bytes.data(), n));

@@ -11,16 +11,6 @@ using namespace axon::c4g::apps::test;
 using protocol::code;
 using protocol::Mode;
 
-namespace {
-
-// Motor-side correction (linear part) of a link-side correction on axis `axis` only.
-double motor_of(const Harness& h, std::size_t axis, double link_rad, std::size_t motor_axis) {
-  protocol::ArmTransform::Vector q = protocol::ArmTransform::Vector::Zero(6);
-  q[static_cast<Eigen::Index>(axis)] = link_rad;
-  return h.transform().motor_velocity(q)[static_cast<Eigen::Index>(motor_axis)];
-}
-}  // namespace
-
 TEST(CorrectApp, SineIncrementsAddUpToTheCorrection) {
   CorrectOptions o;
   o.amplitude_rad = {0, 0, 0, 2 * kDeg};  // axis 4 only: it also moves motors 5 and 6 (wrist coupling)

@@ -94,4 +94,12 @@ inline bool contains(const std::vector<std::string>& lines, std::string_view nee
   return false;
 }
 
+// Motor-side correction (linear part) on motor axis `motor_axis` of a link-side correction of
+// `link_rad` on link axis `axis` only.
+inline double motor_of(const Harness& h, std::size_t axis, double link_rad, std::size_t motor_axis) {
+  protocol::ArmTransform::Vector q = protocol::ArmTransform::Vector::Zero(6);
+  q[static_cast<Eigen::Index>(axis)] = link_rad;
+  return h.transform().motor_velocity(q)[static_cast<Eigen::Index>(motor_axis)];
+}
+
 }  // namespace axon::c4g::apps::test

@@ -115,13 +115,6 @@ TEST(SensorFeed, RejectsImpossibleAxisCounts) {
   EXPECT_FALSE(SensorFeed::open(o));
 }
 
-// Motor-side correction of axis `motor_axis` for a link-side correction on `axis`.
-double motor_of(const Harness& h, std::size_t axis, double link_rad, std::size_t motor_axis) {
-  protocol::ArmTransform::Vector q = protocol::ArmTransform::Vector::Zero(6);
-  q[static_cast<Eigen::Index>(axis)] = link_rad;
-  return h.transform().motor_velocity(q)[static_cast<Eigen::Index>(motor_axis)];
-}
-
 TEST(CorrectFeed, SlewsToTheSensorValuesWithinTheSpeedLimit) {
   std::shared_ptr<SensorFeed> feed = open_feed();
   Sender tx(feed->port());

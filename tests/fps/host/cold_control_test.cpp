@@ -14,20 +14,6 @@ using namespace axon::fps;
 using namespace axon::fps::host;
 using namespace axon::fps::host::testing;
 
-namespace {
-
-// Every simulated robot runs `rpm` on both arms and holds with (alpha, beta) percent.
-bool robots_at(sim::FocalPlaneSimulator& s, std::uint32_t rpm, std::uint32_t alpha, std::uint32_t beta) {
-  for (auto* m : s.simulator().robots()) {
-    if (m->speed_rpm(sim::Arm::alpha) != rpm || m->speed_rpm(sim::Arm::beta) != rpm) return false;
-    if (m->calibration().holding_current[sim::Arm::alpha] != alpha) return false;
-    if (m->calibration().holding_current[sim::Arm::beta] != beta) return false;
-  }
-  return true;
-}
-
-}  // namespace
-
 TEST(ColdControl, FollowsThePlcTemperatureAcrossBothThresholds) {
   PlaneRig rig;
   rig.runner.run([&]() -> asio::awaitable<void> {

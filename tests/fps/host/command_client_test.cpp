@@ -47,10 +47,6 @@ FakeDevice::Script accept_all(std::set<std::uint16_t> ids) {
   };
 }
 
-FakeDevice::Script silent() {
-  return [](const protocol::Message&) { return std::vector<Outgoing>{}; };
-}
-
 class CommandClientTest : public ::testing::Test {
  protected:
   void make(FakeDevice::Script script, ClientOptions options = {}) {

@@ -96,4 +96,9 @@ class FakeDevice {
   bool done_ = false;
 };
 
+// A device that never answers.
+inline FakeDevice::Script silent() {
+  return [](const protocol::Message&) { return std::vector<Outgoing>{}; };
+}
+
 }  // namespace axon::fps::host::testing

@@ -57,10 +57,6 @@ asio::awaitable<Result<BroadcastResult>> start_by_trigger(CommandClient& client,
   co_return co_await client.broadcast(CommandId::start_trajectory, {}, std::move(by_sync));
 }
 
-FakeDevice::Script silent() {
-  return [](const protocol::Message&) { return std::vector<Outgoing>{}; };
-}
-
 // Two buses, robot 3 on bus 0 and robot 5 on bus 1, a listener on each bus.
 struct LockRig {
   LockRig() : rig(2) {

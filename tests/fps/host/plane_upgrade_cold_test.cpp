@@ -16,15 +16,6 @@ using protocol::FirmwareVersion;
 
 namespace {
 
-bool robots_at(sim::FocalPlaneSimulator& s, std::uint32_t rpm, std::uint32_t alpha, std::uint32_t beta) {
-  for (auto* m : s.simulator().robots()) {
-    if (m->speed_rpm(sim::Arm::alpha) != rpm || m->speed_rpm(sim::Arm::beta) != rpm) return false;
-    if (m->calibration().holding_current[sim::Arm::alpha] != alpha) return false;
-    if (m->calibration().holding_current[sim::Arm::beta] != beta) return false;
-  }
-  return true;
-}
-
 PlaneUpgradeOptions quick(bool reapply) {
   PlaneUpgradeOptions o;
   o.expected_version = FirmwareVersion{4, 2, 0};
