@@ -115,6 +115,13 @@ class Bus {
   // destroyed bus. A send() still waiting for room on SocketCAN must end before the bus goes.
   virtual void close();
 
+  // True once the bus is destroyed; shared with whoever holds it. For work queued on the bus's
+  // executor that may run after the owner dropped the bus (frames a destructor sends on its way
+  // out): check it before touching the bus.
+  [[nodiscard]] std::shared_ptr<const bool> destroyed_flag() const noexcept {
+    return {waiters_, &waiters_->bus_gone};
+  }
+
  protected:
   // For transports: a frame came in from the wire (filters, statistics, queue; drops counted).
   void deliver(Frame frame) { deliver(frame, frame_bits(frame).total); }

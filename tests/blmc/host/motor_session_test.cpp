@@ -157,5 +157,22 @@ TEST(BlmcMotorSession, AbandonedSessionQueuesTheDisable) {
   expect_board_off(*rig.sim);
 }
 
+// A board dropped with its motors on queues the disable on the bus's executor; when the owner
+// then drops the bus too before the loop runs that work, the queued disable must end without
+// touching the destroyed bus (before: heap-use-after-free under AddressSanitizer).
+TEST(BlmcMotorSession, DisableQueuedByADroppedBoardOutlivesTheBus) {
+  SimRig rig;
+  rig.run([&]() -> asio::awaitable<void> {
+    auto board = std::make_unique<Board>(*rig.host);
+    auto e = co_await board->enable();
+    CO_ASSERT(e);
+    board.reset();      // queues the disable frames
+    rig.host.reset();   // the bus goes before they are sent
+  });
+  rig.io.restart();
+  rig.io.run_for(std::chrono::milliseconds(200));  // runs the queued disable
+  SUCCEED();
+}
+
 }  // namespace
 }  // namespace axon::blmc::host

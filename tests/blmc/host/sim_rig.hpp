@@ -41,7 +41,7 @@ struct SimRig {
           }
           finished = true;
           runner.stop();
-          host->close();
+          if (host) host->close();  // a test may have dropped the bus
           io.stop();
         },
         [](std::exception_ptr) {});

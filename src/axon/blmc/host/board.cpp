@@ -63,8 +63,11 @@ std::vector<can::Frame> disable_frames() {
           flag_frame(CommandCode::enable_mtr2, false), flag_frame(CommandCode::enable_sys, false)};
 }
 
-asio::awaitable<void> send_all(can::Bus* bus, std::vector<can::Frame> frames) {
+// Sends `frames` in order; ends early when the bus was destroyed before a frame's turn.
+asio::awaitable<void> send_all(can::Bus* bus, std::shared_ptr<const bool> bus_destroyed,
+                               std::vector<can::Frame> frames) {
   for (const auto& f : frames) {
+    if (*bus_destroyed) co_return;
     auto r = co_await bus->send(f);
     if (!r) co_return;
   }
@@ -129,7 +132,7 @@ Board::~Board() {
 
 void Board::queue_disable() {
   if (closed_ || !bus_->is_open()) return;
-  asio::co_spawn(bus_->get_executor(), send_all(bus_, disable_frames()), asio::detached);
+  asio::co_spawn(bus_->get_executor(), send_all(bus_, bus_->destroyed_flag(), disable_frames()), asio::detached);
 }
 
 void Board::interrupt() noexcept {
