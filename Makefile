@@ -30,10 +30,11 @@ test: release
 bench: release
 	@bash bench/run-all.sh build/release
 
-# The sanitizer builds compile only the unit tests (and the libraries they use).
+# The sanitizer builds (clang) compile only the unit tests, the libraries they use and, in the
+# asan build, the libFuzzer targets: one instrumented build serves both.
 asan: deps
 	@cmake --preset asan $(CMAKE_EXTRA) >/dev/null
-	@cmake --build --preset asan -j $(JOBS) --target axon_unit_tests_all
+	@cmake --build --preset asan -j $(JOBS) --target axon_unit_tests_all axon_fuzz_all
 
 test-asan: asan
 	ctest --preset asan -j $(JOBS) -L unit
@@ -46,13 +47,13 @@ test-tsan: tsan
 	ctest --preset tsan -j $(JOBS) -L unit
 
 fuzz: deps
-	@cmake --preset fuzz $(CMAKE_EXTRA) >/dev/null
-	@cmake --build --preset fuzz -j $(JOBS) --target axon_fuzz_all
+	@cmake --preset asan $(CMAKE_EXTRA) >/dev/null
+	@cmake --build --preset asan -j $(JOBS) --target axon_fuzz_all
 
 # A short run of every fuzz target (CI); FUZZ_SECONDS per target.
 FUZZ_SECONDS ?= 10
 fuzz-smoke: fuzz
-	@bash fuzz/smoke.sh build/fuzz $(FUZZ_SECONDS)
+	@bash fuzz/smoke.sh build/asan $(FUZZ_SECONDS)
 
 clean:
 	rm -rf build

@@ -3,7 +3,7 @@
 # fails. Targets run side by side, JOBS at a time (default: the number of cores), each with its own
 # copy of the seeds; their reports are printed in the order of the targets.
 set -euo pipefail
-build=${1:-build/fuzz}
+build=${1:-build/asan}
 seconds=${2:-10}
 jobs=${JOBS:-$(nproc)}
 here=$(cd "$(dirname "$0")" && pwd)
