@@ -146,9 +146,9 @@ function draw() {
 function drawFiducials(ctx) {
   const s = view.scale;
   ctx.strokeStyle = '#8d6e63';
-  ctx.lineWidth = Math.max(1, 0.6 * s);
+  ctx.lineWidth = Math.max(1.5, 0.6 * s);
   for (const f of fps.info.fiducials) {
-    const x = view.px(f.x), y = view.py(f.y), d = 1.5 * s;
+    const x = view.px(f.x), y = view.py(f.y), d = Math.max(4, 3 * s);
     ctx.beginPath();
     ctx.moveTo(x - d, y); ctx.lineTo(x + d, y);
     ctx.moveTo(x, y - d); ctx.lineTo(x, y + d);

@@ -30,10 +30,12 @@ state = json.load(open(sys.argv[1]))["fps"]
 assert len(state["robots"]) == 500, len(state["robots"])
 assert state["lock"]["locked"] is False, state["lock"]
 PY
-curl -sSf "$URL/api/fps/info" | grep -q '"layout":"default"' || fail "GET /api/fps/info"
-curl -sSf "$URL/" | grep -q 'href="/fps.html"' || fail "the index does not list the fps page"
-curl -sSf "$URL/fps.html" | grep -q '<canvas id="plane"' || fail "GET /fps.html"
-curl -sSf "$URL/fps.js" >/dev/null || fail "GET /fps.js"
+# get PATH: the body of GET PATH in $TMP/body (grep -q must not read from curl's pipe: pipefail).
+get() { curl -sSf "$URL$1" >"$TMP/body" || fail "GET $1"; }
+get /api/fps/info && grep -q '"layout":"default"' "$TMP/body" || fail "/api/fps/info has not the layout"
+get / && grep -q 'href="/fps.html"' "$TMP/body" || fail "the index does not list the fps page"
+get /fps.html && grep -q '<canvas id="plane"' "$TMP/body" || fail "/fps.html is not the page"
+get /fps.js
 
 # 3. Malformed input: 400, counted.
 HOSTPORT=${URL#http://}
@@ -42,5 +44,5 @@ printf 'GARBAGE\x01 / HTTP/9\r\n\r\n' >&3
 status=$(head -n1 <&3 | tr -d '\r')
 exec 3<&-
 [ "$status" = "HTTP/1.1 400 Bad Request" ] || fail "a malformed request should get 400 (got '$status')"
-curl -sSf "$URL/metrics" | grep -q '^axon_web_http_bad_requests_total 1$' || fail "the malformed request was not counted"
+get /metrics && grep -q '^axon_web_http_bad_requests_total 1$' "$TMP/body" || fail "the malformed request was not counted"
 echo PASS

@@ -56,7 +56,7 @@ def start_sim(tmp):
     with open(scenario, 'w') as f:
         f.write('collide_on_move: [%d]\n' % COLLIDER)
     err = open(os.path.join(tmp, 'sim.err'), 'w')
-    sim = subprocess.Popen([AXON, 'sim', 'fps', '--layout', 'default', '--http', '127.0.0.1:0', '--scenario', scenario,
+    sim = subprocess.Popen([AXON, 'sim', 'fps', '--layout', 'default', '--folded', '--http', '127.0.0.1:0', '--scenario', scenario,
                             '--write-layout', os.path.join(tmp, 'live.yaml')], stdout=subprocess.PIPE, stderr=err, text=True)
     url = None
     for line in sim.stdout:
