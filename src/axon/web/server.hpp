@@ -9,6 +9,7 @@
 // Malformed requests are answered 400 and counted; requests are limited in size; connections
 // that say nothing are closed after idle_timeout.
 //
+// Threading: add() from any thread; stats() and stop() from the thread that owns the server.
 // Errors: the constructor throws axon::Exception (CoreErrc::invalid_argument for an address that
 // does not parse, CoreErrc::io when it cannot listen). The destructor stops the server and never throws.
 #pragma once
