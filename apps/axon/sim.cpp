@@ -164,7 +164,9 @@ int run_sim_layout(const SimFpsOptions& o) {
                   g.endpoint.to_string().c_str(), chans.c_str(), g.robots, g.sextant);
     }
     if (auto* p = fp->plc()) std::printf("listening plc %s\n", p->endpoint().to_string().c_str());
+    // The page's publishing reads *fp: it stops when this scope ends, however it ends.
     const auto web_alive = std::make_shared<bool>(true);
+    const std::unique_ptr<bool, void (*)(bool*)> stop_publishing(web_alive.get(), [](bool* alive) { *alive = false; });
     const auto web = o.http.empty() ? nullptr : serve_plane_page(io, o.http, plane, *fp, web_alive);
     if (!o.write_layout.empty()) {
       std::ofstream out(o.write_layout);
@@ -188,7 +190,6 @@ int run_sim_layout(const SimFpsOptions& o) {
                  s.frames_processed, s.frames_sent, s.unsolicited, fp->simulator().receive_overflows(),
                  s.neighbour_collisions + s.obstacle_collisions, s.neighbour_collisions, s.obstacle_collisions,
                  c.sync_edges, c.sextant_power_changes, c.gateway_power_changes);
-    *web_alive = false;
     fp->stop();
     co_return 0;
   });
