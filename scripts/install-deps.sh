@@ -7,13 +7,16 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   clang libclang-rt-dev            # libFuzzer targets and clang sanitizer runtimes
-  libboost-dev                    # Asio (C++20 coroutines), Outcome, lockfree
+  libboost-dev                    # Asio (C++20 coroutines), Beast (the web server), Outcome, lockfree
   libfmt-dev libspdlog-dev libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
   libeigen3-dev zlib1g-dev libmodbus-dev libpcap-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-can             # interoperability tests against python-can
   pybind11-dev python3-dev python3-pytest python3-numpy   # the Python module axon and its tests
   tcpdump                         # checks that pcap captures decode
+  chromium chromium-driver python3-selenium   # the pages tested in headless Chromium (tests/integration/web_*.py)
+  prometheus                      # promtool checks /metrics (docs/dashboard.md)
+  libjs-chart.js                  # charts of the blmc and c4g pages, served from /usr/share/javascript
 )
 
 missing=()

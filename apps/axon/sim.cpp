@@ -15,7 +15,12 @@
 #include "id_list.hpp"
 #include "layout_name.hpp"
 #include "axon/net/endpoint.hpp"
+#include "axon/web/fps_sim_view.hpp"
+#include "axon/web/server.hpp"
 #include "run.hpp"
+
+#include <boost/asio/detached.hpp>
+#include <boost/asio/this_coro.hpp>
 
 #include <boost/asio/redirect_error.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -52,6 +57,7 @@ struct SimFpsOptions {
   std::uint64_t seed = 1;
   bool folded = false;
   std::string write_layout;
+  std::string http;  // with --layout: the web page of the plane on HOST:PORT
   // Every robot (both modes; over the config file's own settings when given).
   std::string firmware;
   std::string firmware_history;
@@ -92,6 +98,39 @@ sim::SimulatorConfig build_config(const SimFpsOptions& o) {
   return config;
 }
 
+// How often the simulator's loop hands its state to the web page (the server pushes at this rate too).
+constexpr auto kWebPublishPeriod = std::chrono::milliseconds(100);
+
+asio::awaitable<void> publish_plane(std::shared_ptr<web::FpsSimView> view, std::shared_ptr<web::Source> source,
+                                    std::shared_ptr<const bool> alive) {
+  asio::steady_timer timer(co_await asio::this_coro::executor);
+  while (*alive) {
+    view->publish(*source);
+    timer.expires_after(kWebPublishPeriod);
+    boost::system::error_code ec;
+    co_await timer.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+  }
+}
+
+// --http: the plane's page on a web server of its own thread (docs/dashboard.md), its state read on
+// the simulator's loop while *alive.
+std::unique_ptr<web::Server> serve_plane_page(asio::io_context& io, const std::string& address, const fps::FocalPlane& plane,
+                                              sim::FocalPlaneSimulator& fp, std::shared_ptr<const bool> alive) {
+  const auto ep = need(net::parse_endpoint(address));
+  web::ServerOptions so;
+  so.address = ep.host;
+  so.port = ep.port;
+  so.push_period = kWebPublishPeriod;
+  auto server = std::make_unique<web::Server>(so);
+  auto source = std::make_shared<web::Source>("fps", fmt::format("fps: simulated focal plane '{}'", plane.name()), "fps");
+  auto view = std::make_shared<web::FpsSimView>(plane, fp);
+  source->set_info(view->info_json());
+  server->add(source);
+  asio::co_spawn(io, publish_plane(std::move(view), std::move(source), std::move(alive)), asio::detached);
+  std::printf("listening http %s:%u\n", server->address().c_str(), unsigned{server->port()});
+  return server;
+}
+
 // `axon sim fps --layout ...`: every robot of a layout behind one CAN@net emulator per gateway,
 // plus the PLC emulator whose relays act on them.
 int run_sim_layout(const SimFpsOptions& o) {
@@ -125,6 +164,10 @@ int run_sim_layout(const SimFpsOptions& o) {
                   g.endpoint.to_string().c_str(), chans.c_str(), g.robots, g.sextant);
     }
     if (auto* p = fp->plc()) std::printf("listening plc %s\n", p->endpoint().to_string().c_str());
+    // The page's publishing reads *fp: it stops when this scope ends, however it ends.
+    const auto web_alive = std::make_shared<bool>(true);
+    const std::unique_ptr<bool, void (*)(bool*)> stop_publishing(web_alive.get(), [](bool* alive) { *alive = false; });
+    const auto web = o.http.empty() ? nullptr : serve_plane_page(io, o.http, plane, *fp, web_alive);
     if (!o.write_layout.empty()) {
       std::ofstream out(o.write_layout);
       std::map<std::uint16_t, std::string> addresses;
@@ -251,6 +294,8 @@ void add_sim_commands(CLI::App& app, GlobalOptions& global) {
                 "default) or refuse (code 2, INVALID_TRAJECTORY)")
       ->check(CLI::IsMember({"accept", "refuse"}));
   f->add_option("--write-layout", fps.write_layout, "with --layout: write the layout with the emulators' addresses to FILE");
+  f->add_option("--http", fps.http, "with --layout: serve the plane's live page, /api/state and /metrics on HOST:PORT "
+                                 "(port 0: any free one; docs/dashboard.md)")->needs("--layout");
   f->get_option("--config")->excludes("--robots")->excludes("--buses");
   f->get_option("--port")->excludes("--base-port");
   f->get_option("--layout")->excludes("--robots")->excludes("--buses")->excludes("--config")->excludes("--gateway")->excludes("--socketcand");
