@@ -14,6 +14,8 @@ packages=(
   python3 python3-can             # interoperability tests against python-can
   pybind11-dev python3-dev python3-pytest python3-numpy   # the Python module axon and its tests
   tcpdump                         # checks that pcap captures decode
+  librabbitmq-dev                 # the AMQP client under `axon actor` and `axon tell` (src/axon/actor)
+  rabbitmq-server python3-pika python3-jsonschema  # the actor tests: a private broker, an independent client, the keyword schema
 )
 
 missing=()
