@@ -55,14 +55,17 @@ TEST_F(FpsActorOnBenchtop, GotoMovesTheRobotAndEndsDoneWithItsResult) {
 }
 
 TEST_F(FpsActorOnBenchtop, BadGotoArgumentsFailWithAReason) {
-  core.handle(command("goto 1 2", "a"));
-  core.handle(command("goto 999 10 10", "b"));
-  core.handle(command(fmt::format("goto {} ten 10", first_robot()), "c"));
-  for (const char* id : {"a", "b", "c"}) {
+  const std::pair<std::string, std::string> cases[] = {{"goto 1 2", "triplets"},
+                                                         {"goto 999 10 10", "robot 999 is not on the buses"},
+                                                         {fmt::format("goto {} ten 10", first_robot()), "not angles"}};
+  int n = 0;
+  for (const auto& [text, reason] : cases) {  // one after the other: goto is exclusive
+    const auto id = std::to_string(n++);
+    core.handle(command(text, id));
     const auto r = out.final_of(id);
-    ASSERT_TRUE(r) << id;
-    EXPECT_EQ(code_of(*r), 'f') << id;
-    EXPECT_FALSE(body_of(*r)["error"].get<std::string>().empty()) << id;
+    ASSERT_TRUE(r) << text;
+    EXPECT_EQ(code_of(*r), 'f') << text;
+    EXPECT_NE(body_of(*r)["error"].get<std::string>().find(reason), std::string::npos) << r->body;
   }
 }
 
@@ -78,6 +81,7 @@ TEST_F(FpsActorOnBenchtop, ACollisionLocksAndEveryListenerGetsTheAlert) {
   const auto r = out.final_of("refused");
   ASSERT_TRUE(r);
   EXPECT_EQ(code_of(*r), 'f');
+  EXPECT_NE(body_of(*r)["error"].get<std::string>().find("locked"), std::string::npos) << r->body;
   core.handle(command("unlock", "u"));
   const auto u = out.final_of("u");
   ASSERT_TRUE(u);

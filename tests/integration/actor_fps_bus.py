@@ -106,6 +106,8 @@ class Commander:
         self.replies = {}    # command id -> [(code, keywords)]
         self.broadcasts = []  # (code, keywords)
         self.checked = 0
+        self.ch.basic_consume(self.queue, lambda ch, method, props, body: self.take(props, body, method.routing_key),
+                              auto_ack=True)
 
     def send(self, text=None, body=None):
         command_id = uuid.uuid4().hex
@@ -135,11 +137,7 @@ class Commander:
     def pump(self, until, timeout):
         end = time.monotonic() + timeout
         while not until() and time.monotonic() < end:
-            method, props, body = self.ch.basic_get(self.queue, auto_ack=True)
-            if method is None:
-                self.conn.sleep(0.002)
-                continue
-            self.take(props, body, method.routing_key)
+            self.conn.process_data_events(time_limit=min(0.05, max(0.0, end - time.monotonic())))
         return until()
 
     def done(self, command_id):
