@@ -158,11 +158,18 @@ void add_actor_commands(CLI::App& app, GlobalOptions& global) {
   auto* t = app.add_subcommand("tell", "send a command to an actor over the bus; print the replies (exit 0 on ':')");
   add_broker_options(*t, ta->bus);
   t->add_option("actor", ta->actor, "the actor's name")->required();
-  t->add_option("command", ta->words, "the command and its arguments (put -- before arguments that start with -)")
-      ->required();
   t->add_flag("--json", ta->json, "one JSON object per reply: sender, message_code, command_id, keywords");
   t->add_option("--timeout", ta->timeout_s, "seconds to wait for the final reply (default 30)");
-  t->callback([ta, &global] { global.exit_code = run_tell(*ta); });
+  // Everything after the actor's name is the command, options of tell included (give those first):
+  // `axon tell fps goto 12 -30 170` needs no `--`.
+  t->prefix_command();
+  t->footer("COMMAND [ARG ...] follows ACTOR; tell's own options go before ACTOR.");
+  t->callback([ta, t, &global] {
+    ta->words = t->remaining();
+    if (!ta->words.empty() && ta->words.front() == "--") ta->words.erase(ta->words.begin());
+    if (ta->words.empty()) throw Exception(usage("tell: give the command after the actor's name"));
+    global.exit_code = run_tell(*ta);
+  });
 }
 
 }  // namespace axon::app

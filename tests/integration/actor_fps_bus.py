@@ -174,10 +174,10 @@ def wait_for_actor(port, timeout):
     raise AssertionError('the actor did not answer ping within %d s' % timeout)
 
 
-def tell(port, *words, json_out=False):
-    args = [AXON, 'tell', '--broker', '127.0.0.1:%d' % port, '--exchange', EXCHANGE, '--timeout', '20']
+def tell(port, *words, json_out=False, actor=ACTOR, timeout_s=20):
+    args = [AXON, 'tell', '--broker', '127.0.0.1:%d' % port, '--exchange', EXCHANGE, '--timeout', str(timeout_s)]
     args += ['--json'] if json_out else []
-    return subprocess.run(args + [ACTOR] + list(words), capture_output=True, text=True, timeout=60)
+    return subprocess.run(args + [actor] + list(words), capture_output=True, text=True, timeout=60)
 
 
 def check_commands(c, port, actor_proc):
@@ -220,6 +220,10 @@ def check_commands(c, port, actor_proc):
         assert not list(VALIDATOR.iter_errors(l['keywords'])), l
     p = tell(port, 'fly')
     assert p.returncode == 1 and 'unknown command' in p.stdout, (p.returncode, p.stdout, p.stderr)
+    p = tell(port, 'goto', str(ids[2]), '-45', '160')  # everything after the actor is the command
+    assert p.returncode == 1 and 'fps f' in p.stdout, (p.returncode, p.stdout, p.stderr)
+    p = tell(port, 'status', actor='nobody')
+    assert p.returncode == 1 and 'no actor "nobody"' in p.stdout, (p.returncode, p.stdout, p.stderr)
 
     # A collision: the alert reaches every listener (this client is one), moves are refused until unlock.
     c.broadcasts.clear()
@@ -256,6 +260,8 @@ def main():
             print('SKIP: rabbitmq-server cannot start here (see %s/server.out)' % tmp)
             return 0
         print('broker up in %.1f s' % up)
+        p = tell(free_port(), 'ping', timeout_s=1)  # no broker there: an error, exit 1
+        assert p.returncode == 1 and 'cannot reach the broker' in p.stderr, (p.returncode, p.stdout, p.stderr)
         actor = subprocess.Popen([AXON, 'actor', 'fps', '--broker', '127.0.0.1:%d' % broker.port, '--exchange', EXCHANGE,
                                   '--name', ACTOR, '--status-period', '1', '--time-scale', '20'],
                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
