@@ -209,6 +209,17 @@ def check_commands(c, port, actor_proc):
     during = c.command('status')
     assert during[-1][0] == ':' and during[-1][1]['moving'] is True, during[-1][1]
     assert c.wait(first)[-1][0] == ':', c.replies[first][-1]
+    assert any('move_progress' in kw for code, kw in c.replies[first] if code == '>'), c.replies[first]
+
+    # stop: idle it only aborts; during a move it cuts the move, which fails, and locks until unlock.
+    r = c.command('stop')
+    assert r[-1][0] == ':' and r[-1][1]['stopped']['while_moving'] is False, r
+    moving = c.send('goto %d 30 170' % ids[0])
+    assert c.pump(lambda: any(code == '>' for code, _ in c.replies[moving]), 10), c.replies[moving]
+    r = c.command('abort')
+    assert r[-1][0] == ':' and r[-1][1]['stopped']['while_moving'] is True, r
+    assert c.wait(moving)[-1][0] == 'f', c.replies[moving][-1]
+    assert c.command('unlock')[-1][0] == ':'
 
     # axon tell: human and --json, exit status from the final code.
     p = tell(port, 'status')
@@ -227,9 +238,11 @@ def check_commands(c, port, actor_proc):
 
     # A collision: the alert reaches every listener (this client is one), moves are refused until unlock.
     c.broadcasts.clear()
+    t0 = time.perf_counter()
     r = c.command('sim-collision %d' % ids[3])
     assert r[-1][0] == ':', r
     assert c.pump(lambda: any('collision_alert' in kw for _, kw in c.broadcasts), 5), c.broadcasts
+    print('collision alert seen %.0f ms after the sim-collision command was sent' % ((time.perf_counter() - t0) * 1e3))
     assert c.command('goto %d 20 170' % ids[0])[-1][0] == 'f'
     r = c.command('unlock')
     assert r[-1][0] == ':' and r[-1][1]['locked'] is False, r
