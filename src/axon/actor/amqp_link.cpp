@@ -226,7 +226,7 @@ struct AmqpLink::Impl {
     drain();
   }
 
-  // What the outbox holds, in order; a message stays queued when the broker refuses it.
+  // What the outbox holds, in order. A message that cannot be written stays first in the outbox.
   void flush() {
     for (;;) {
       Message m;
@@ -236,13 +236,17 @@ struct AmqpLink::Impl {
         m = std::move(outbox.front());
         outbox.pop_front();
       }
-      send(m);  // throws on a broken connection (the message is lost with it: counted as dropped)
+      if (!send(m)) {  // the connection broke: the message goes out again after reconnection
+        std::lock_guard lock(mutex);
+        outbox.push_front(std::move(m));
+        throw std::runtime_error("publish: the connection broke");
+      }
       std::lock_guard lock(mutex);
       ++counts.published;
     }
   }
 
-  void send(const Message& m) {
+  bool send(const Message& m) {
     std::vector<amqp_table_entry_t> entries;
     std::vector<std::string> keys;
     keys.reserve(m.headers.size());
@@ -265,11 +269,8 @@ struct AmqpLink::Impl {
     }
     const int rc = amqp_basic_publish(conn, kChannel, bytes_of(config.exchange), bytes_of(m.routing_key),
                                       config.mandatory ? 1 : 0, 0, &p, bytes_of(m.body));
-    if (rc != AMQP_STATUS_OK) {
-      std::lock_guard lock(mutex);
-      ++counts.dropped;
-      throw std::runtime_error(fmt::format("publish: {}", amqp_error_string2(rc)));
-    }
+    if (rc != AMQP_STATUS_OK) spdlog::debug("amqp: publish: {}", amqp_error_string2(rc));
+    return rc == AMQP_STATUS_OK;
   }
 
   // One delivery (or one other frame) when there is one; returns at once otherwise.

@@ -45,7 +45,7 @@ struct LinkCounters {
   std::uint64_t connect_failures = 0;
   std::uint64_t received = 0;
   std::uint64_t published = 0;
-  std::uint64_t dropped = 0;        // outbox overflow
+  std::uint64_t dropped = 0;        // outbox overflow (the oldest message goes)
   std::uint64_t returned = 0;       // unroutable (mandatory) messages the broker gave back
 };
 
