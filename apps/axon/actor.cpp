@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <charconv>
 #include <cstdio>
 #include <memory>
 
@@ -56,8 +57,12 @@ struct ActorFpsOptions {
 // The simulator's own verb, for tests and demonstrations: a robot reports a collision now.
 void add_simulator_verbs(actor::ActorCore& core, fps::sim::SimulatedPlane& sim) {
   core.add({"sim-collision", "sim-collision ID (embedded simulator only)", false, [&sim](actor::Command& c) {
-              if (c.args().size() != 1) return c.fail("sim-collision takes one robot id");
-              sim.inject_collision(static_cast<std::uint16_t>(std::stoul(c.args()[0])));
+              std::uint16_t id = 0;
+              const auto& arg = c.args().empty() ? std::string() : c.args()[0];
+              const auto [end, ec] = std::from_chars(arg.data(), arg.data() + arg.size(), id);
+              if (c.args().size() != 1 || ec != std::errc() || end != arg.data() + arg.size())
+                return c.fail("sim-collision takes one robot id");
+              sim.inject_collision(id);
               c.finish({{"text", fmt::format("robot {} reports a collision", c.args()[0])}});
             }});
 }

@@ -101,9 +101,9 @@ void ActorCore::handle(const Message& message) {
     if (id.empty()) id = fmt::format("{}-{}", name_, next_id_++);
   }
   auto text = command_string_of(message.body);
-  if (!text) return refuse(commander, id, text.error().message(), &CoreCounters::not_json);
+  if (!text) return refuse(commander, id, text.error().detail, &CoreCounters::not_json);
   auto line = split_command(text.value());
-  if (!line) return refuse(commander, id, fmt::format("{}: {:?}", line.error().message(), text.value()), &CoreCounters::malformed);
+  if (!line) return refuse(commander, id, fmt::format("{}: {:?}", line.error().detail, text.value()), &CoreCounters::malformed);
   std::optional<Verb> verb;
   bool closed = false;
   {
