@@ -44,5 +44,29 @@ TEST(AmqpLink, KeepsTryingWithoutABrokerAndDropsTheOldestBeyondItsOutbox) {
   link.stop();  // while disconnected: returns, the outbox is given up
 }
 
+TEST(AmqpLink, APeerThatNeverAnswersTheLoginIsGivenUpAndRetried) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);  // the kernel accepts; nobody speaks AMQP
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  ASSERT_EQ(::listen(fd, 16), 0);
+  socklen_t len = sizeof a;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  LinkConfig c;
+  c.port = ntohs(a.sin_port);
+  c.connect_timeout_s = 0.1;
+  c.backoff_min_s = 0.01;
+  {
+    AmqpLink link(c, {});
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (link.counters().connect_failures < 2 && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    EXPECT_GE(link.counters().connect_failures, 2u);
+    EXPECT_FALSE(link.connected());
+  }
+  ::close(fd);
+}
+
 }  // namespace
 }  // namespace axon::actor

@@ -180,6 +180,10 @@ struct AmqpLink::Impl {
     amqp_socket_t* socket = amqp_tcp_socket_new(conn);
     if (!socket) throw std::runtime_error("cannot create a socket");
     timeval tv = timeval_of(config.connect_timeout_s);
+    // A peer that accepts the connection but never answers does not hold the thread: the login and
+    // every declaration are bounded too.
+    amqp_set_handshake_timeout(conn, &tv);
+    amqp_set_rpc_timeout(conn, &tv);
     const int rc = amqp_socket_open_noblock(socket, config.host.c_str(), config.port, &tv);
     if (rc != AMQP_STATUS_OK) throw std::runtime_error(fmt::format("connect: {}", amqp_error_string2(rc)));
     check(amqp_login(conn, config.vhost.c_str(), 0, AMQP_DEFAULT_FRAME_SIZE, config.heartbeat_s, AMQP_SASL_METHOD_PLAIN,

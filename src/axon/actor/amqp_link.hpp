@@ -33,7 +33,7 @@ struct LinkConfig {
   std::string queue;                  // empty: publish only
   std::vector<std::string> bindings;  // routing keys the queue is bound to
   int heartbeat_s = 5;
-  double connect_timeout_s = 2.0;
+  double connect_timeout_s = 2.0;    // TCP connect, login, each declaration
   double backoff_min_s = 0.1;
   double backoff_max_s = 2.0;
   std::size_t outbox_limit = 10000;
