@@ -33,7 +33,7 @@ TEST(AmqpLink, KeepsTryingWithoutABrokerAndDropsTheOldestBeyondItsOutbox) {
   c.backoff_max_s = 0.02;
   c.outbox_limit = 2;
   AmqpLink link(c, {});
-  for (int i = 0; i < 3; ++i) link.publish(Message{"reply.broadcast", {}, "", "", "application/json", "{}"});
+  for (int i = 0; i < 3; ++i) link.publish(Message{"reply.broadcast", {}, "", "", "text/json", "{}"});
   EXPECT_EQ(link.counters().dropped, 1u);
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   while (link.counters().connect_failures < 3 && std::chrono::steady_clock::now() < until)

@@ -125,6 +125,7 @@ class Commander:
         code = h.get('message_code')
         assert code in ('>', ':', 'f', 'e', '!', 'i', 'w', 'd'), h
         assert h.get('sender') == ACTOR, h
+        assert props.content_type == 'text/json', props.content_type
         keywords = json.loads(body)
         errors = sorted(VALIDATOR.iter_errors(keywords), key=str)
         assert not errors, 'reply not valid against docs/schema/fps.json: %s\n%s' % (errors[0].message, body[:500])

@@ -57,7 +57,7 @@ struct Message {
   Headers headers;
   std::string correlation_id;
   std::string reply_to;
-  std::string content_type = "application/json";
+  std::string content_type = "text/json";  // what clu sends
   std::string body;
 };
 
