@@ -307,6 +307,14 @@ def main():
         assert 'refused' in err, err
         print('ok: %d replies valid against docs/schema/fps.json, %.1f s in all' % (checked, time.monotonic() - t0))
         return 0
+    except BaseException:
+        if actor is not None and actor.poll() is None:
+            actor.kill()
+        if actor is not None:
+            print('actor stderr (end):\n' + ''.join(actor.communicate()[1].splitlines(True)[-20:]))
+        with open(os.path.join(tmp, 'server.out')) as f:
+            print('broker output (end):\n' + ''.join(f.readlines()[-20:]))
+        raise
     finally:
         if actor is not None and actor.poll() is None:
             actor.kill()
