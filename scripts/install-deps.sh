@@ -17,6 +17,8 @@ packages=(
   chromium chromium-driver python3-selenium   # the pages tested in headless Chromium (tests/integration/web_*.py)
   prometheus                      # promtool checks /metrics (docs/dashboard.md)
   libjs-chart.js                  # charts of the blmc and c4g pages, served from /usr/share/javascript
+  librabbitmq-dev                 # the AMQP client under `axon actor` and `axon tell` (src/axon/actor)
+  rabbitmq-server python3-pika python3-jsonschema  # the actor tests: a private broker, an independent client, the keyword schema
 )
 
 missing=()

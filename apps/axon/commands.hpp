@@ -28,5 +28,7 @@ void add_sim_plc_command(CLI::App& app, GlobalOptions& global);
 void add_blmc_commands(CLI::App& app, GlobalOptions& global);
 // `fps plane` (after add_fps_commands).
 void add_fps_plane_commands(CLI::App& app, GlobalOptions& global);
+// `actor fps` and `tell` (apps/axon/actor.cpp).
+void add_actor_commands(CLI::App& app, GlobalOptions& global);
 
 }  // namespace axon::app

@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   add_blmc_commands(app, global);
   add_fps_plane_commands(app, global);
   add_demo_command(app, global);
+  add_actor_commands(app, global);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

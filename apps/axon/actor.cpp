@@ -1,0 +1,180 @@
+// `axon actor fps`: the focal plane as a long-running actor on a RabbitMQ broker (docs/actor.md);
+// `axon tell ACTOR COMMAND...`: send one command over the bus and print the replies as they come.
+// Parsing and library calls only: the actor is axon::actor::BusActor + FpsActor, the client
+// axon::actor::tell.
+#include "axon/actor/bus_actor.hpp"
+#include "axon/actor/fps_actor.hpp"
+#include "axon/actor/teller.hpp"
+#include "axon/fps/host/client.hpp"
+#include "axon/fps/sim/simulated_plane.hpp"
+#include "axon/net/endpoint.hpp"
+#include "commands.hpp"
+#include "layout_name.hpp"
+#include "run.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <charconv>
+#include <cstdio>
+#include <memory>
+
+namespace axon::app {
+namespace {
+
+// Where the broker is and which exchange: shared by `actor` and `tell`.
+struct BrokerOptions {
+  std::string broker = "127.0.0.1:5672";
+  std::string exchange{actor::kDefaultExchange};
+
+  [[nodiscard]] actor::LinkConfig link() const {
+    const auto ep = need(net::parse_endpoint(broker, 5672));
+    actor::LinkConfig c;
+    c.host = ep.host;
+    c.port = ep.port;
+    c.exchange = exchange;
+    return c;
+  }
+};
+
+void add_broker_options(CLI::App& cmd, BrokerOptions& o) {
+  cmd.add_option("--broker", o.broker, "the AMQP broker, HOST[:PORT] (default 127.0.0.1:5672)");
+  cmd.add_option("--exchange", o.exchange, "the topic exchange (default sdss_exchange, as clu's actors)");
+}
+
+struct ActorFpsOptions {
+  BrokerOptions bus;
+  std::string name = "fps";
+  std::string layout = "benchtop";
+  std::vector<std::string> buses;  // real buses: no simulator
+  bool connect = false;            // the layout's own gateway addresses: no simulator
+  double time_scale = 10.0;
+  std::uint64_t seed = 1;
+  double status_period_s = 10.0;
+  double duration_s = 0;
+};
+
+// The simulator's own verb, for tests and demonstrations: a robot reports a collision now.
+void add_simulator_verbs(actor::ActorCore& core, fps::sim::SimulatedPlane& sim) {
+  core.add({"sim-collision", "sim-collision ID (embedded simulator only)", false, [&sim](actor::Command& c) {
+              std::uint16_t id = 0;
+              const auto& arg = c.args().empty() ? std::string() : c.args()[0];
+              const auto [end, ec] = std::from_chars(arg.data(), arg.data() + arg.size(), id);
+              if (c.args().size() != 1 || ec != std::errc() || end != arg.data() + arg.size())
+                return c.fail("sim-collision takes one robot id");
+              sim.inject_collision(id);
+              c.finish({{"text", fmt::format("robot {} reports a collision", c.args()[0])}});
+            }});
+}
+
+int run_actor_fps(const ActorFpsOptions& o) {
+  const bool simulate = o.buses.empty() && !o.connect;
+  return run_command([&o, simulate](asio::io_context& io, SignalHook hook) -> asio::awaitable<int> {
+    std::unique_ptr<fps::sim::SimulatedPlane> sim;
+    if (simulate) sim = std::make_unique<fps::sim::SimulatedPlane>(need(resolve_layout(o.layout)),
+                                                                   fps::sim::SimulatedPlaneOptions{o.time_scale, o.seed});
+    fps::Client client;
+    if (!o.buses.empty()) client.open(o.buses);
+    else client.open(sim ? sim->plane() : need(resolve_layout(o.layout)));
+    actor::BusActor bus({o.name, o.bus.link()});
+    {
+      actor::FpsActor fps_actor(bus.core(), client, {o.status_period_s});
+      if (sim) add_simulator_verbs(bus.core(), *sim);
+      bus.start();
+      std::fprintf(stderr, "actor %s: %zu robots, commands on %s (exchange %s)\n", o.name.c_str(), client.robots().size(),
+                   o.bus.broker.c_str(), o.bus.exchange.c_str());
+      co_await wait_for_stop(io, o.duration_s, hook);
+      bus.core().close();  // the simulator's verb too: nothing runs once the devices go
+    }
+    const auto c = bus.core().counters();
+    std::fprintf(stderr, "actor %s: %llu commands, %llu refused, %llu not understood\n", o.name.c_str(),
+                 static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.refused),
+                 static_cast<unsigned long long>(c.not_json + c.malformed + c.unknown));
+    co_return 0;
+  });
+}
+
+// ---- tell ---------------------------------------------------------------------------------------
+
+struct TellArgs {
+  BrokerOptions bus;
+  std::string actor;
+  std::vector<std::string> words;
+  bool json = false;
+  double timeout_s = 30;
+};
+
+// The words as one command line; a word with blanks or quotes is quoted.
+std::string command_line(const std::vector<std::string>& words) {
+  std::string line;
+  for (const auto& w : words) {
+    if (!line.empty()) line += ' ';
+    if (w.find_first_of(" \t\"\\") == std::string::npos && !w.empty()) {
+      line += w;
+      continue;
+    }
+    line += '"';
+    for (char c : w) line += (c == '"' || c == '\\') ? std::string{'\\', c} : std::string{c};
+    line += '"';
+  }
+  return line;
+}
+
+void print_reply(const actor::TellReply& r, bool as_json) {
+  if (as_json) {
+    const nlohmann::json j{{"sender", r.sender}, {"message_code", std::string(1, actor::to_char(r.code))},
+                           {"command_id", r.command_id}, {"keywords", r.keywords}};
+    std::puts(j.dump().c_str());
+  } else {
+    std::string line = fmt::format("{} {}", r.sender, actor::to_char(r.code));
+    for (const auto& [k, v] : r.keywords.items()) line += fmt::format(" {}={}", k, v.is_string() ? v.get<std::string>() : v.dump());
+    std::puts(line.c_str());
+  }
+  std::fflush(stdout);
+}
+
+int run_tell(const TellArgs& a) {
+  actor::TellOptions o;
+  o.link = a.bus.link();
+  o.timeout_s = a.timeout_s;
+  const auto last = actor::tell(a.actor, command_line(a.words), o, [&a](const actor::TellReply& r) { print_reply(r, a.json); });
+  return last.code == actor::MessageCode::done ? exit_code_value::ok : exit_code_value::failed;
+}
+
+}  // namespace
+
+void add_actor_commands(CLI::App& app, GlobalOptions& global) {
+  auto* group = app.add_subcommand("actor", "run axon as an actor on a RabbitMQ bus (docs/actor.md)");
+  group->require_subcommand(1);
+  auto fo = std::make_shared<ActorFpsOptions>();
+  auto* f = group->add_subcommand("fps", "the focal plane as an actor (embedded simulated plane unless --bus/--connect)");
+  add_broker_options(*f, fo->bus);
+  f->add_option("--name", fo->name, "the actor's name: its queue takes command.NAME.# (default fps)");
+  f->add_option("--layout", fo->layout, "the plane: default, benchtop or a layout FILE (default benchtop)");
+  f->add_option("--bus", fo->buses, "real buses by spec (cannet://HOST:PORT/N, ...): no simulator");
+  f->add_flag("--connect", fo->connect, "the layout's gateways at their own addresses: no simulator");
+  f->add_option("--time-scale", fo->time_scale, "simulator: simulated seconds per second (default 10)");
+  f->add_option("--seed", fo->seed, "simulator: seed (default 1)");
+  f->add_option("--status-period", fo->status_period_s, "seconds between status broadcasts (default 10; 0: none)");
+  f->add_option("--duration", fo->duration_s, "stop after this many seconds (default: until Ctrl-C)");
+  f->callback([fo, &global] { global.exit_code = run_actor_fps(*fo); });
+
+  auto ta = std::make_shared<TellArgs>();
+  auto* t = app.add_subcommand("tell", "send a command to an actor over the bus; print the replies (exit 0 on ':')");
+  add_broker_options(*t, ta->bus);
+  t->add_option("actor", ta->actor, "the actor's name")->required();
+  t->add_flag("--json", ta->json, "one JSON object per reply: sender, message_code, command_id, keywords");
+  t->add_option("--timeout", ta->timeout_s, "seconds to wait for the final reply (default 30)");
+  // Everything after the actor's name is the command, options of tell included (give those first):
+  // `axon tell fps goto 12 -30 170` needs no `--`.
+  t->prefix_command();
+  t->footer("COMMAND [ARG ...] follows ACTOR; tell's own options go before ACTOR.");
+  t->callback([ta, t, &global] {
+    ta->words = t->remaining();
+    if (!ta->words.empty() && ta->words.front() == "--") ta->words.erase(ta->words.begin());
+    if (ta->words.empty()) throw Exception(usage("tell: give the command after the actor's name"));
+    global.exit_code = run_tell(*ta);
+  });
+}
+
+}  // namespace axon::app

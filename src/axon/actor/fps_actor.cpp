@@ -1,0 +1,280 @@
+#include "axon/actor/fps_actor.hpp"
+
+#include "axon/core/error.hpp"
+#include "axon/fps/host/client.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+namespace axon::actor {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using json = nlohmann::json;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+json robot_json(const fps::RobotStatus& r) {
+  json j{{"id", r.id}, {"bus", r.bus}, {"state", r.state}, {"ready", r.ready}, {"firmware", r.firmware}};
+  j["alpha"] = r.position ? json(r.position->alpha) : json(nullptr);
+  j["beta"] = r.position ? json(r.position->beta) : json(nullptr);
+  if (!r.error.empty()) j["error"] = r.error;
+  return j;
+}
+
+json move_json(const fps::MoveOutcome& out) {
+  json robots = json::array();
+  for (const auto& r : out.robots) {
+    json j{{"id", r.id}, {"ok", r.ok}, {"state", r.state}};
+    j["alpha"] = r.reached ? json(r.reached->alpha) : json(nullptr);
+    j["beta"] = r.reached ? json(r.reached->beta) : json(nullptr);
+    if (!r.detail.empty()) j["detail"] = r.detail;
+    robots.push_back(std::move(j));
+  }
+  return json{{"completed", out.completed}, {"robots", std::move(robots)}};
+}
+
+std::optional<double> number(const std::string& s) {
+  double v = 0;
+  const auto* end = s.data() + s.size();
+  const auto [p, ec] = std::from_chars(s.data(), end, v);
+  if (ec != std::errc() || p != end) return std::nullopt;
+  return v;
+}
+
+// `ID ALPHA BETA` triplets; ID `all` stands for every known robot.
+std::map<std::uint16_t, fps::Angles> parse_targets(const std::vector<std::string>& args,
+                                                   const std::vector<std::uint16_t>& known) {
+  if (args.empty() || args.size() % 3 != 0)
+    throw Exception(Error(CoreErrc::invalid_argument, "goto takes ID ALPHA BETA triplets (ID: a robot or all)"));
+  std::map<std::uint16_t, fps::Angles> targets;
+  for (std::size_t i = 0; i < args.size(); i += 3) {
+    const auto alpha = number(args[i + 1]), beta = number(args[i + 2]);
+    if (!alpha || !beta)
+      throw Exception(Error(CoreErrc::invalid_argument, fmt::format("goto: {:?} {:?} are not angles in degrees",
+                                                                    args[i + 1], args[i + 2])));
+    if (args[i] == "all") {
+      for (auto id : known) targets[id] = {*alpha, *beta};
+      continue;
+    }
+    const auto id = number(args[i]);
+    const bool whole = id && *id >= 0 && *id <= 65535 && *id == static_cast<double>(static_cast<std::uint16_t>(*id));
+    if (!whole) throw Exception(Error(CoreErrc::invalid_argument, fmt::format("goto: {:?} is not a robot id", args[i])));
+    const auto robot = static_cast<std::uint16_t>(*id);
+    if (std::find(known.begin(), known.end(), robot) == known.end())
+      throw Exception(Error(CoreErrc::invalid_argument, fmt::format("goto: robot {} is not on the buses", robot)));
+    targets[robot] = {*alpha, *beta};
+  }
+  return targets;
+}
+
+}  // namespace
+
+struct FpsActor::Impl {
+  ActorCore& core;
+  fps::Client& client;
+  FpsActorOptions options;
+  std::mutex device;  // one client call at a time (the watcher's locked() excepted: it only reads)
+
+  struct Move {
+    Command* command = nullptr;
+    std::size_t robots = 0;
+    Clock::time_point started;
+  };
+  std::mutex state;  // what follows
+  json last_robots = json::array();
+  std::optional<Move> move;
+  bool was_locked = false;
+  std::string lock_reason;
+
+  std::mutex wake_mutex;
+  std::condition_variable wake;
+  bool stopping = false;
+  std::thread watcher;
+
+  Impl(ActorCore& c, fps::Client& cl, FpsActorOptions o) : core(c), client(cl), options(o) {}
+
+  void remember(const std::vector<fps::RobotStatus>& rows) {
+    json robots = json::array();
+    for (const auto& r : rows) robots.push_back(robot_json(r));
+    std::lock_guard lock(state);
+    last_robots = std::move(robots);
+  }
+
+  json counters_json() const {
+    const auto c = core.counters();
+    return json{{"received", c.received}, {"accepted", c.accepted}, {"not_json", c.not_json}, {"malformed", c.malformed},
+                {"unknown", c.unknown},   {"refused", c.refused},   {"failed", c.failed}};
+  }
+
+  // The status keywords; read from the robots when the client is free, else from the last read.
+  json status_keywords() {
+    std::unique_lock lock(device, std::try_to_lock);
+    const bool fresh = lock.owns_lock();
+    json j;
+    if (fresh) {
+      remember(client.status());
+      j["locked"] = client.locked();
+      j["locked_by"] = client.lock_reason();
+      lock.unlock();
+    }
+    std::lock_guard s(state);
+    if (!fresh) {
+      j["locked"] = was_locked;
+      j["locked_by"] = lock_reason;
+    }
+    j["robots"] = last_robots;
+    std::size_t ready = 0;
+    for (const auto& r : last_robots) ready += r.value("ready", false) ? 1 : 0;
+    j["ready"] = ready;
+    j["stale"] = !fresh;
+    j["moving"] = move.has_value();
+    if (move) j["move_progress"] = progress_json(*move);
+    j["commands"] = counters_json();
+    return j;
+  }
+
+  static json progress_json(const Move& m) {
+    return json{{"command_id", m.command->id().command_id}, {"robots", m.robots}, {"elapsed_s", seconds_since(m.started)}};
+  }
+
+  void status(Command& c) { c.finish(status_keywords()); }
+
+  void go(Command& c) {
+    std::unique_lock lock(device);
+    const auto targets = parse_targets(c.args(), client.robots());
+    if (client.locked())
+      throw Exception(Error(CoreErrc::invalid_argument, fmt::format("locked ({}): unlock first", client.lock_reason())));
+    json started = json::array();
+    for (const auto& [id, a] : targets) started.push_back(json{{"id", id}, {"alpha", a.alpha}, {"beta", a.beta}});
+    c.write(MessageCode::running, {{"move_started", {{"robots", targets.size()}, {"targets", started}}}});
+    {
+      std::lock_guard s(state);
+      move = Move{&c, targets.size(), Clock::now()};
+    }
+    struct EndMove {
+      Impl& impl;
+      ~EndMove() {
+        std::lock_guard s(impl.state);
+        impl.move.reset();
+      }
+    } end_move{*this};
+    const auto out = client.goto_absolute(targets);
+    remember(client.status());
+    json kw{{"move_result", move_json(out)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
+    if (out.completed) c.finish(std::move(kw));
+    else c.fail(out.summary.empty() ? "not every robot reached its target" : out.summary, std::move(kw));
+  }
+
+  void stop(Command& c) {
+    bool moving = false;
+    {
+      std::lock_guard s(state);
+      moving = move.has_value();
+    }
+    if (moving) {  // the move holds the client: interrupt() is the call any thread may make
+      client.interrupt(fmt::format("{} command ({})", c.verb(), c.id().command_id));
+      c.finish({{"stopped", {{"while_moving", true}}}, {"locked", true}});
+      return;
+    }
+    std::lock_guard lock(device);
+    client.stop();
+    c.finish({{"stopped", {{"while_moving", false}}}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}});
+  }
+
+  void unlock(Command& c) {
+    std::lock_guard lock(device);
+    const auto out = client.unlock();
+    c.finish({{"unlocked", {{"acknowledged", out.acknowledged}, {"silent", out.silent}}},
+              {"locked", client.locked()},
+              {"locked_by", client.lock_reason()}});
+  }
+
+  // ---- the watcher's thread ----
+
+  void check_lock() {
+    bool locked = false;
+    std::string reason;
+    try {
+      locked = client.locked();
+      if (locked) reason = client.lock_reason();
+    } catch (const std::exception& e) {
+      spdlog::debug("fps actor: lock state: {}", e.what());
+      return;
+    }
+    {
+      std::lock_guard s(state);
+      if (locked == was_locked) return;
+      was_locked = locked;
+      lock_reason = reason;
+    }
+    if (!locked) return core.broadcast(MessageCode::info, {{"locked", false}, {"locked_by", ""}});
+    json kw{{"locked", true}, {"locked_by", reason}};
+    const bool collision = reason.find("collision") != std::string::npos;
+    if (collision) kw["collision_alert"] = {{"reason", reason}};
+    core.broadcast(collision ? MessageCode::error : MessageCode::warning, kw);
+  }
+
+  void report_progress() {
+    std::lock_guard s(state);
+    if (move) move->command->write(MessageCode::running, {{"move_progress", progress_json(*move)}});
+  }
+
+  void watch() noexcept {
+    const auto period = std::chrono::duration<double>(options.watch_period_s);
+    auto next_status = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.status_period_s));
+    auto next_progress = Clock::now();
+    std::unique_lock lock(wake_mutex);
+    while (!wake.wait_for(lock, period, [this] { return stopping; })) {
+      lock.unlock();
+      try {
+        check_lock();
+        const auto now = Clock::now();
+        if (now >= next_progress) {
+          report_progress();
+          next_progress = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.progress_period_s));
+        }
+        if (options.status_period_s > 0 && now >= next_status) {
+          core.broadcast(MessageCode::info, status_keywords());
+          next_status = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.status_period_s));
+        }
+      } catch (const std::exception& e) {
+        spdlog::warn("fps actor: {}", e.what());
+      }
+      lock.lock();
+    }
+  }
+};
+
+FpsActor::FpsActor(ActorCore& core, fps::Client& client, FpsActorOptions options)
+    : impl_(std::make_unique<Impl>(core, client, options)) {
+  impl_->remember(client.discover());
+  auto* i = impl_.get();
+  core.add({"status", "status", false, [i](Command& c) { i->status(c); }});
+  core.add({"goto", "goto ID ALPHA BETA [ID ALPHA BETA ...] (ID: a robot or all)", true, [i](Command& c) { i->go(c); }});
+  core.add({"stop", "stop", false, [i](Command& c) { i->stop(c); }});
+  core.add({"abort", "abort", false, [i](Command& c) { i->stop(c); }});
+  core.add({"unlock", "unlock", true, [i](Command& c) { i->unlock(c); }});
+  impl_->watcher = std::thread([i] { i->watch(); });
+}
+
+FpsActor::~FpsActor() {
+  impl_->core.close();  // no command may reach the client after this
+  {
+    std::lock_guard lock(impl_->wake_mutex);
+    impl_->stopping = true;
+  }
+  impl_->wake.notify_all();
+  impl_->watcher.join();
+}
+
+}  // namespace axon::actor

@@ -1,0 +1,53 @@
+// FpsActor: the fiber positioners of a focal plane as an actor (docs/actor.md, keywords in
+// docs/schema/fps.json). It adds the fps verbs to an ActorCore and drives an open fps::Client:
+//
+//   status                       every robot's state and arms, the lock, the command counters
+//   goto ID ALPHA BETA [...]     moves one robot or several at once (ID `all`: every robot)
+//   stop | abort                 aborts every robot (during a move this also locks the array)
+//   unlock                       clears collision flags and the lock
+//
+// and writes unsolicited keywords to every listener: `locked`/`locked_by` and a `collision_alert`
+// when the array locks (checked every FpsActorOptions::watch_period_s, 20 ms by default, on a
+// thread of its own), the status every status_period_s, and `move_progress` to the commander of a
+// running move every progress_period_s.
+//
+// goto and unlock are exclusive: a second one while one runs is refused. The client is called by
+// one command at a time; a status asked during a move answers from the status read before it
+// (keyword `stale`), with the move's progress. The collision safety stays the client's own
+// (fps::Client: any collision report locks the array and aborts every robot), bus or no bus.
+//
+// The client must be open and outlive the actor; the constructor discovers the robots (throws
+// axon::Exception as fps::Client::discover does). The destructor closes the core (later commands
+// are refused), waits for the running ones and stops the watcher; it never throws.
+#pragma once
+
+#include "axon/actor/actor_core.hpp"
+
+#include <memory>
+
+namespace axon::fps {
+class Client;
+}
+
+namespace axon::actor {
+
+struct FpsActorOptions {
+  double status_period_s = 10.0;   // 0: no periodic status
+  double watch_period_s = 0.02;    // how often the lock is checked
+  double progress_period_s = 1.0;  // move_progress while a goto runs
+};
+
+class FpsActor {
+ public:
+  FpsActor(ActorCore& core, fps::Client& client, FpsActorOptions options = {});
+  ~FpsActor();
+  FpsActor(const FpsActor&) = delete;
+  FpsActor& operator=(const FpsActor&) = delete;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace axon::actor

@@ -1,0 +1,93 @@
+// The fps actor on the six-robot benchtop plane simulated in this process, without a broker: its
+// replies go to a collector.
+#include "axon/actor/fps_actor.hpp"
+#include "axon/fps/host/client.hpp"
+#include "axon/fps/sim/simulated_plane.hpp"
+#include "replies.hpp"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+namespace axon::actor {
+namespace {
+
+using test::body_of;
+using test::code_of;
+using test::command;
+
+struct FpsActorOnBenchtop : ::testing::Test {
+  fps::sim::SimulatedPlane plane{"benchtop", fps::sim::SimulatedPlaneOptions{50.0, 1, false, false}};
+  fps::Client client;
+  test::Replies out;
+  ActorCore core{"fps", out.sink()};
+  std::unique_ptr<FpsActor> actor;
+
+  void SetUp() override {
+    client.open(plane.plane());
+    actor = std::make_unique<FpsActor>(core, client, FpsActorOptions{0.0, 0.02, 0.2});
+  }
+  std::uint16_t first_robot() const { return plane.plane().robots().front().id; }
+};
+
+TEST_F(FpsActorOnBenchtop, StatusListsEveryRobotAndTheLock) {
+  core.handle(command("status", "s"));
+  const auto r = out.final_of("s");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(code_of(*r), ':');
+  const auto kw = body_of(*r);
+  EXPECT_EQ(kw["robots"].size(), plane.plane().robots().size());
+  EXPECT_EQ(kw["ready"], plane.plane().robots().size());
+  EXPECT_EQ(kw["locked"], false);
+  EXPECT_EQ(kw["stale"], false);
+}
+
+TEST_F(FpsActorOnBenchtop, GotoMovesTheRobotAndEndsDoneWithItsResult) {
+  const auto id = first_robot();
+  core.handle(command(fmt::format("goto {} 30 170", id), "g"));
+  const auto r = out.final_of("g");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(code_of(*r), ':') << r->body;
+  const auto robots = body_of(*r)["move_result"]["robots"];
+  ASSERT_EQ(robots.size(), 1u);
+  EXPECT_NEAR(robots[0]["alpha"].get<double>(), 30.0, 0.1);
+  EXPECT_NEAR(robots[0]["beta"].get<double>(), 170.0, 0.1);
+  EXPECT_EQ(code_of(out.of("g").front()), '>');  // move_started first
+}
+
+TEST_F(FpsActorOnBenchtop, BadGotoArgumentsFailWithAReason) {
+  const std::pair<std::string, std::string> cases[] = {{"goto 1 2", "triplets"},
+                                                         {"goto 999 10 10", "robot 999 is not on the buses"},
+                                                         {fmt::format("goto {} ten 10", first_robot()), "not angles"}};
+  int n = 0;
+  for (const auto& [text, reason] : cases) {  // one after the other: goto is exclusive
+    const auto id = std::to_string(n++);
+    core.handle(command(text, id));
+    const auto r = out.final_of(id);
+    ASSERT_TRUE(r) << text;
+    EXPECT_EQ(code_of(*r), 'f') << text;
+    EXPECT_NE(body_of(*r)["error"].get<std::string>().find(reason), std::string::npos) << r->body;
+  }
+}
+
+TEST_F(FpsActorOnBenchtop, ACollisionLocksAndEveryListenerGetsTheAlert) {
+  plane.inject_collision(first_robot());
+  const auto alert = out.wait_for([](const Message& m) {
+    return m.routing_key == kBroadcastKey && body_of(m).contains("collision_alert");
+  });
+  ASSERT_TRUE(alert);
+  EXPECT_EQ(code_of(*alert), 'e');
+  EXPECT_EQ(body_of(*alert)["locked"], true);
+  core.handle(command("goto all 10 170", "refused"));  // moves are refused while locked
+  const auto r = out.final_of("refused");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(code_of(*r), 'f');
+  EXPECT_NE(body_of(*r)["error"].get<std::string>().find("locked"), std::string::npos) << r->body;
+  core.handle(command("unlock", "u"));
+  const auto u = out.final_of("u");
+  ASSERT_TRUE(u);
+  EXPECT_EQ(code_of(*u), ':') << u->body;
+  EXPECT_EQ(body_of(*u)["locked"], false);
+}
+
+}  // namespace
+}  // namespace axon::actor
