@@ -23,7 +23,7 @@
 // close()) stop robots this client set moving, close the connections and never throw.
 //
 // Threading: one thread at a time may call a client (calls are not queued against each other);
-// interrupt() is the exception: any thread may call it, also while a call waits.
+// interrupt(), locked(), lock_reason() are the exceptions: any thread may call them (while open).
 #pragma once
 
 #include "axon/fps/layout/focal_plane.hpp"
