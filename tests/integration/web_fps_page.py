@@ -101,11 +101,13 @@ def check_click_shows_status(driver):
     size = canvas.size
     ActionChains(driver).move_to_element_with_offset(canvas, spot['x'] - size['width'] / 2,
                                                      spot['y'] - size['height'] / 2).click().perform()
-    wait_until('details of robot 42', lambda: driver.find_element(By.ID, 'details').get_attribute('data-robot') == '42')
-    bits = driver.find_element(By.ID, 'status-bits').text
+    # The details panel is rebuilt with every state update (10 a second): read it in one script
+    # call each time, never through an element reference an update may have replaced.
+    wait_until('details of robot 42', lambda: page(driver, "document.getElementById('details').dataset.robot") == '42')
+    bits = page(driver, "document.getElementById('status-bits').textContent")
     for name in ('SYSTEM_INITIALIZATION', 'DATUM_ALPHA_INITIALIZED', 'DATUM_BETA_INITIALIZED', 'DISPLACEMENT_COMPLETED'):
         assert name in bits, (name, bits)
-    assert '04.01.13' in driver.find_element(By.ID, 'details').text
+    assert '04.01.13' in page(driver, "document.getElementById('details').textContent")
 
 
 def check_collision_lock(driver, url, tmp):
