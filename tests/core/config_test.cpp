@@ -60,6 +60,18 @@ TEST(Config, UnknownKeyRejectedWithPosition) {
   EXPECT_NE(r.error().detail.find("u.yaml:2:1: key 'bitrte'"), std::string::npos);
 }
 
+// Found by fuzz_config_loaders: a map used as a key made yaml-cpp throw out of reject_unknown().
+TEST(Config, AKeyThatIsNotAPlainNameIsAnUnknownKeyNotAnException) {
+  auto root = ConfigNode::load_string("{ 0.4from }: 7\n? [1, 2]\n: 3\n", "k.yaml").value();
+  auto r = root.reject_unknown({"name"});
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error(), CoreErrc::config_unknown_key);
+  EXPECT_NE(r.error().detail.find("k.yaml:1:1: key '{0.4from"), std::string::npos) << r.error().detail;
+  const auto keys = root.keys();
+  ASSERT_EQ(keys.size(), 2u);
+  EXPECT_EQ(keys[1], "[1, 2]");
+}
+
 TEST(Config, SyntaxErrorHasPosition) {
   auto r = ConfigNode::load_string("a: [1, 2\n", "s.yaml");
   ASSERT_FALSE(r);

@@ -64,8 +64,14 @@ struct CanNetGatewayEmulator::Impl : std::enable_shared_from_this<CanNetGatewayE
     std::uint64_t id;
     std::string peer;               // the client's address, for the log
     bool open = true;
+    bool spoke = false;             // it sent at least one line
+    std::uint64_t errors = 0;       // R ERR answers it got
     std::string out;                // lines waiting for the writer
+    std::size_t in_flight = 0;      // bytes the writer is writing now
     core::Wakeup* writer_idle = nullptr;  // the writer, when it has nothing to write
+    core::Wakeup* reader_blocked = nullptr;  // the reader, while too much waits for the client
+
+    [[nodiscard]] std::size_t pending() const noexcept { return out.size() + in_flight; }
   };
   struct Channel {
     std::string name;               // provider channel; empty: not fitted
@@ -117,7 +123,27 @@ struct CanNetGatewayEmulator::Impl : std::enable_shared_from_this<CanNetGatewayE
     if (!conn.open) return;
     conn.out.append(line);
     conn.out.push_back('\n');
+    stats.output_high_water = std::max<std::uint64_t>(stats.output_high_water, conn.pending());
     if (conn.writer_idle) conn.writer_idle->notify();
+  }
+  // An R ERR for the client: counted, and logged once per connection at warning level.
+  void send_error(Connection& conn, int code, std::string_view text) {
+    ++stats.error_replies;
+    if (++conn.errors == 1)
+      spdlog::warn("CAN@net emulator: client {}: R ERR {} {} (further errors of this client at debug level)", conn.peer,
+                   code, wire_text(text));
+    else
+      spdlog::debug("CAN@net emulator: client {}: R ERR {} {}", conn.peer, code, wire_text(text));
+    send(conn, refuse(code, text));
+  }
+  // Waits while more than max_output_bytes wait for the client (it does not read).
+  asio::awaitable<void> wait_for_room(const std::shared_ptr<Connection>& conn) {
+    while (conn->open && conn->pending() > options.max_output_bytes) {
+      core::Wakeup drained(executor);
+      conn->reader_blocked = &drained;
+      core::OnExit clear{[&conn] { conn->reader_blocked = nullptr; }};
+      co_await drained.wait();
+    }
   }
   void send(Connection& conn, const Line& line) { send(conn, std::string_view(format_line(line))); }
   void send_to_client(const Line& line) {
@@ -211,8 +237,12 @@ void CanNetGatewayEmulator::Impl::attach(tcp::socket socket) {
     // As the device does: the newest connection wins. Its ASCII protocol has no message for this,
     // so the old client only sees its connection closed; the log says who took over.
     ++stats.replaced;
-    spdlog::warn("CAN@net emulator {}: client {} takes over from client {}, whose connection is closed",
-                 local_text(), peer, client->peer);
+    if (client->spoke)
+      spdlog::warn("CAN@net emulator {}: client {} takes over from client {}, whose connection is closed",
+                   local_text(), peer, client->peer);
+    else
+      spdlog::debug("CAN@net emulator {}: client {} takes over from client {}, which had said nothing", local_text(),
+                    peer, client->peer);
     drop(client, fmt::format("replaced by a newer connection from {}", peer));
   }
   for (auto& c : chan) c.reset();
@@ -232,6 +262,7 @@ void CanNetGatewayEmulator::Impl::drop(std::shared_ptr<Connection> conn, std::st
   conn->socket.shutdown(tcp::socket::shutdown_both, ignored);
   conn->socket.close(ignored);
   if (conn->writer_idle) conn->writer_idle->notify();
+  if (conn->reader_blocked) conn->reader_blocked->notify();
   if (client == conn) client.reset();
 }
 
@@ -250,12 +281,16 @@ asio::awaitable<void> CanNetGatewayEmulator::Impl::run_reader(std::shared_ptr<Im
     }
     lines.append(std::string_view(buf.data(), n));
     while (conn->open) {
+      // A client that does not read its answers is not served until it has (nor read from: its
+      // commands wait in the kernel), so that what waits for it stays bounded.
+      if (conn->pending() > s.options.max_output_bytes) co_await s.wait_for_room(conn);
+      if (!conn->open) break;
       auto piece = lines.next();
       if (!piece) break;
+      conn->spoke = true;
       if (piece->overlong) {
         ++s.stats.commands;
-        ++s.stats.error_replies;
-        s.send(*conn, refuse(kErrSyntax, fmt::format("line longer than {} characters", kMaxLineLength)));
+        s.send_error(*conn, kErrSyntax, fmt::format("line longer than {} characters", kMaxLineLength));
         continue;
       }
       auto m = s.handle_line(*conn, piece->text);
@@ -287,8 +322,11 @@ asio::awaitable<void> CanNetGatewayEmulator::Impl::run_writer(std::shared_ptr<Im
     }
     chunk.clear();
     chunk.swap(conn->out);
+    conn->in_flight = chunk.size();
     boost::system::error_code ec;
     co_await asio::async_write(conn->socket, asio::buffer(chunk), asio::redirect_error(asio::use_awaitable, ec));
+    conn->in_flight = 0;
+    if (conn->reader_blocked) conn->reader_blocked->notify();
     if (ec) {
       s.drop(conn, fmt::format("write failed: {}", ec.message()));
       co_return;
@@ -301,17 +339,19 @@ std::optional<FrameMessage> CanNetGatewayEmulator::Impl::handle_line(Connection&
   auto parsed = parse_line(text);
   if (!parsed) {
     ++stats.commands;
-    ++stats.error_replies;
-    send(conn, refuse(kErrSyntax, parsed.error().detail));
+    send_error(conn, kErrSyntax, parsed.error().detail);
     return std::nullopt;
   }
   const Line& line = parsed.value();
   if (const auto* m = std::get_if<FrameMessage>(&line)) return *m;
   ++stats.commands;
-  Line reply = is_host_command(line) ? answer(line)
-                                     : refuse(kErrNotCommand, fmt::format("'{}' is not a host command", format_line(line)));
-  if (std::holds_alternative<ReplyError>(reply)) ++stats.error_replies;
-  send(conn, reply);
+  if (!is_host_command(line)) {
+    send_error(conn, kErrNotCommand, fmt::format("'{}' is not a host command", format_line(line)));
+    return std::nullopt;
+  }
+  Line reply = answer(line);
+  if (const auto* e = std::get_if<ReplyError>(&reply)) send_error(conn, e->code, e->text);
+  else send(conn, reply);
   return std::nullopt;
 }
 
@@ -353,7 +393,7 @@ asio::awaitable<void> CanNetGatewayEmulator::Impl::run_pump(std::shared_ptr<Impl
       ++s.stats.filtered;
       continue;
     }
-    if (conn->out.size() >= s.options.max_output_bytes) {
+    if (conn->pending() >= s.options.max_output_bytes) {
       ++s.stats.output_drops;
       c.overrun = true;
       continue;

@@ -19,6 +19,16 @@
 //   format has no entries or one entry matches. The field set-up (CLEAR, ADD EXT 0 0) passes all.
 // - Fault hooks put a channel bus-off or in error-warning and send the device's events.
 //
+// Hostile peers (docs/reliability.md): the bytes queued for the client stay within
+// max_output_bytes plus one line. Bus frames beyond it are dropped (output_drops, flag O of the
+// status); a client that sends commands without reading the answers is not read from (its
+// commands wait in the kernel) until it has read. A partial line is held up to kMaxLineLength;
+// a longer one is answered with one R ERR and skipped. The first R ERR of a connection is logged
+// at warning level, the next ones at debug level. Connections replacing each other (the newest
+// wins, as on the device) cost nothing: the old socket is closed at once; a takeover is a warning
+// when the replaced client had said anything, else a debug line (a flood of connections that
+// say nothing does not flood the log).
+//
 // Threading: everything runs on the executor given to the constructor (the provider's buses must
 // live on it too).
 #pragma once
@@ -60,6 +70,7 @@ struct CanNetEmulatorStats {
   std::uint64_t not_running_drops = 0;  // client frames discarded: channel stopped or bus-off
   std::uint64_t output_drops = 0;       // bus frames dropped: the client did not read fast enough
   std::uint64_t filtered = 0;           // bus frames the channel's filters held back
+  std::uint64_t output_high_water = 0;  // most bytes ever queued for a client's socket
 };
 
 class CanNetGatewayEmulator {

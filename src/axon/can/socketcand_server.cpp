@@ -49,6 +49,7 @@ struct SocketcandServer::Impl {
   SocketcandServerStats stats;
   std::vector<SocketcandSession*> sessions;
   bool stopped = false;
+  bool refusing = false;  // a refusal was logged at warning level; reset by the next client accepted
 };
 
 namespace {
@@ -66,7 +67,8 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
         socket(std::move(s)),
         writer(socket),
         raw_pause(socket.get_executor()),
-        stats_timer(socket.get_executor()) {
+        stats_timer(socket.get_executor()),
+        handshake_timer(socket.get_executor()) {
     boost::system::error_code ec;
     peer = describe(socket.remote_endpoint(ec));
   }
@@ -90,6 +92,7 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
   std::uint32_t stats_interval_ms = 0;
   std::uint64_t stats_generation = 0;
   sc::Stat counters;
+  asio::steady_timer handshake_timer;  // until the first `< open >`
 
   void start() {
     server->sessions.push_back(this);
@@ -98,6 +101,27 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
     spdlog::debug("socketcand: {} connected", peer);
     reply(sc::Hi{});
     asio::co_spawn(socket.get_executor(), read_loop(shared_from_this()), asio::detached);
+    if (server->options.handshake_timeout > core::Duration::zero())
+      asio::co_spawn(socket.get_executor(), handshake_watch(shared_from_this()), asio::detached);
+  }
+
+  // Closes the connection if no channel is open when the handshake time is up.
+  static asio::awaitable<void> handshake_watch(std::shared_ptr<SocketcandSession> self) {
+    self->handshake_timer.expires_after(self->server->options.handshake_timeout);
+    boost::system::error_code ec;
+    co_await self->handshake_timer.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+    if (self->ended || self->state != State::no_bus) co_return;
+    ++self->server->stats.handshake_timeouts;
+    spdlog::warn("socketcand: {}: no channel opened within {} ms; connection closed", self->peer,
+                 std::chrono::duration_cast<std::chrono::milliseconds>(self->server->options.handshake_timeout).count());
+    self->shut_down();
+  }
+
+  // Queues text for the client and keeps the high-water mark of its queue.
+  void queue(std::string_view text, std::size_t units) {
+    writer.write(text, units, shared_from_this());
+    auto& high = server->stats.output_high_water;
+    high = std::max<std::uint64_t>(high, writer.pending_bytes());
   }
 
   // Closes the connection now (server stop, read error).
@@ -114,6 +138,7 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
     ++stats_generation;
     stats_timer.cancel();
     raw_pause.cancel();
+    handshake_timer.cancel();
     if (bus) bus->close();
     bus.reset();
     writer.stop();
@@ -129,7 +154,7 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
     scratch.clear();
     if (separate) scratch += '\n';
     sc::append(scratch, m);
-    writer.write(scratch, 1, shared_from_this());
+    queue(scratch, 1);
   }
 
   // A client message the server rejects: answered, counted, logged (the first at warning level).
@@ -147,7 +172,11 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
     std::array<char, 4096> buf{};
     while (!self->ended) {
       while (auto r = self->tokenizer.next()) {
-        if (self->ended || self->hang_up) break;
+        // A client that does not read its answers is not served (nor read from: its requests
+        // wait in the kernel) until it has, so that what is queued for it stays within the backlog.
+        if (self->writer.pending_bytes() > self->server->options.client_backlog)
+          co_await self->writer.wait_until_at_most(self->server->options.client_backlog);
+        if (self->ended || self->hang_up || self->writer.failed()) break;
         if (*r)
           co_await self->handle(r->value());
         else
@@ -158,6 +187,7 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
         co_await self->writer.wait_until_at_most(0);
         break;
       }
+      if (self->writer.failed()) break;
       boost::system::error_code ec;
       const std::size_t n =
           co_await self->socket.async_read_some(asio::buffer(buf), asio::redirect_error(asio::use_awaitable, ec));
@@ -301,7 +331,7 @@ struct SocketcandSession : std::enable_shared_from_this<SocketcandSession> {
       }
       self->counters.rx_frames += n;
       self->server->stats.frames_out += n;
-      self->writer.write(text, n, self);
+      self->queue(text, n);
     }
   }
 
@@ -385,10 +415,16 @@ Result<void> SocketcandServer::listen(const net::Endpoint& where) {
           }
           if (impl->sessions.size() >= impl->options.max_clients) {
             ++impl->stats.clients_rejected;
-            spdlog::warn("socketcand server: refusing a client: {} already connected", impl->sessions.size());
+            if (!impl->refusing)
+              spdlog::warn("socketcand server: refusing a client: {} already connected (further refusals logged at "
+                           "debug level until one is accepted)", impl->sessions.size());
+            else
+              spdlog::debug("socketcand server: refusing a client: {} already connected", impl->sessions.size());
+            impl->refusing = true;
             socket.close(ec);
             continue;
           }
+          impl->refusing = false;
           socket.set_option(tcp::no_delay(true), ec);
           std::make_shared<SocketcandSession>(impl, std::move(socket))->start();
         }

@@ -13,6 +13,15 @@
 // `< error ... >` and counted. The one exception, as with the daemon, is `< open >` of a channel
 // the provider does not have: the server answers `< error ... >` and hangs up.
 //
+// Hostile peers (docs/reliability.md): what is queued for one client is bounded by
+// client_backlog (bus frames wait in its endpoint's receive queue, BusOptions::rx_capacity frames,
+// and are dropped there; a client that sends requests without reading their answers is no longer
+// read from until it has read), a partial message by socketcand::kMaxMessageLength, and the
+// number of clients by max_clients. A connection that has not opened a channel within
+// handshake_timeout is closed, so that silent connections cannot keep the places. Refusals,
+// timeouts and each client's first bad message are logged at warning level, once (the next
+// refusals of the same burst and the client's further bad messages at debug level).
+//
 // Wire format, chosen for python-can 4.1 (see docs/can-socketcand.md): handshake answers are sent
 // alone and unterminated; once raw mode is confirmed, every message is preceded by '\n' and frames
 // start only `raw_start_delay` after the `< ok >`.
@@ -46,6 +55,8 @@ struct SocketcandServerOptions {
   // Bytes queued for one client's socket before the server stops taking frames from its endpoint
   // (a slow reader then loses frames in the endpoint's receive queue, counted in its rx_dropped).
   std::size_t client_backlog = 256 * 1024;
+  // A connection must open a channel within this time, else it is closed (0: no limit).
+  core::Duration handshake_timeout = std::chrono::seconds(10);
 };
 
 struct SocketcandServerStats {
@@ -56,6 +67,8 @@ struct SocketcandServerStats {
   std::uint64_t frames_out = 0;        // frames sent to clients (once per client)
   std::uint64_t errors = 0;            // malformed or out-of-place client messages, failed opens
   std::uint64_t send_failures = 0;     // frames the bus refused (queue full, bus closed)
+  std::uint64_t handshake_timeouts = 0;  // connections closed: no channel opened within handshake_timeout
+  std::uint64_t output_high_water = 0;   // most bytes ever queued for one client's socket
 };
 
 class SocketcandServer {

@@ -81,17 +81,30 @@ Result<std::vector<ConfigNode>> ConfigNode::items() const {
   return out;
 }
 
+namespace {
+
+// The text of a map key: a plain key as written, any other (a map or a list used as a key, a null)
+// in YAML flow form, so that it is reported as an unknown key rather than thrown at the reader.
+std::string key_text(const YAML::Node& key) {
+  if (key.IsScalar()) return key.Scalar();
+  YAML::Emitter out;
+  out << YAML::Flow << key;
+  return out.c_str();
+}
+
+}  // namespace
+
 std::vector<std::string> ConfigNode::keys() const {
   std::vector<std::string> out;
   if (!node_.IsMap()) return out;
-  for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  for (const auto& kv : node_) out.push_back(key_text(kv.first));
   return out;
 }
 
 Result<void> ConfigNode::reject_unknown(std::initializer_list<std::string_view> known) const {
   if (!node_.IsMap()) return ok();
   for (const auto& kv : node_) {
-    const std::string k = kv.first.as<std::string>();
+    const std::string k = key_text(kv.first);
     bool found = false;
     for (auto kn : known) found = found || kn == k;
     if (!found) {

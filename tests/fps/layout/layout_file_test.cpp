@@ -64,6 +64,14 @@ TEST(LayoutFile, LoadsRobotsFlagsFibresOffsetsAndFiducials) {
   EXPECT_TRUE(plane.neighbours(8).robots.empty());
 }
 
+// Found by fuzz_fps_layout: a gateway whose key was a map ended the program (an exception out of
+// the loader) instead of being refused.
+TEST(LayoutFile, AKeyThatIsAMapIsRefusedNotThrown) {
+  const auto why = error_of("name: bench\ngateways:\n  - {id: 1, {address: x}: 2, channels: 2}\n");
+  EXPECT_NE(why.find("bench.yaml:3"), std::string::npos) << why;
+  EXPECT_NE(why.find("unknown"), std::string::npos) << why;
+}
+
 TEST(LayoutFile, DuplicateIdNamesBothLines) {
   const auto e = error_of(std::string(kHeader) +
                           "robots:\n"

@@ -94,6 +94,8 @@ Result<Trajectories> load_trajectory_file(const std::string& file) {
   Trajectories out;
   std::map<std::uint16_t, int> line_of;  // where each robot's entry starts (1-based)
   for (const auto& kv : root) {
+    if (!kv.first.IsScalar())  // a map or a list as a key: as<std::string>() would throw
+      return file_error(fmt::format("{}:{}: a robot id must be a plain number", file, kv.first.Mark().line + 1));
     const auto key = kv.first.as<std::string>();
     AXON_TRY(id, robot_key(file, key));
     const int line = kv.first.Mark().line + 1;

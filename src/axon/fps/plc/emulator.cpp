@@ -1,6 +1,7 @@
 #include "axon/fps/plc/emulator.hpp"
 
 #include "axon/fps/plc/error.hpp"
+#include "axon/fps/plc/request_framer.hpp"
 
 #include <boost/asio/post.hpp>
 #include <fmt/format.h>
@@ -8,39 +9,70 @@
 #include <spdlog/spdlog.h>
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netinet/in.h>
-#include <sys/select.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <mutex>
+#include <span>
 #include <thread>
 #include <vector>
 
 namespace axon::fps::plc {
 
+namespace {
+
+using SteadyTime = std::chrono::steady_clock::time_point;
+
+// "HOST:PORT" of a client socket.
+std::string peer_of(int fd) {
+  sockaddr_in addr{};
+  socklen_t len = sizeof addr;
+  if (getpeername(fd, reinterpret_cast<sockaddr*>(&addr), &len) != 0) return "?";
+  char text[INET_ADDRSTRLEN] = {};
+  inet_ntop(AF_INET, &addr.sin_addr, text, sizeof text);
+  return fmt::format("{}:{}", text, ntohs(addr.sin_port));
+}
+
+bool set_nonblocking(int fd) {
+  const int flags = fcntl(fd, F_GETFL, 0);
+  return flags >= 0 && fcntl(fd, F_SETFL, flags | O_NONBLOCK) == 0;
+}
+
+}  // namespace
+
 class PlcEmulator::Impl {
  public:
+  // One client connection (server thread only).
+  struct Conn {
+    int fd = -1;
+    std::string peer;
+    RequestFramer framer;
+    std::optional<SteadyTime> partial_since;  // when the request held in the framer began
+  };
+
   explicit Impl(EmulatorOptions o) : options(std::move(o)) {}
   ~Impl() { shutdown(); }
 
   Result<void> open();
+  Result<void> listen();
   void shutdown() noexcept;
   void loop();
-  void serve(int fd, std::vector<int>& clients, fd_set& all);
-  // "HOST:PORT" of a client socket.
-  static std::string peer_of(int fd) {
-    sockaddr_in addr{};
-    socklen_t len = sizeof addr;
-    if (getpeername(fd, reinterpret_cast<sockaddr*>(&addr), &len) != 0) return "?";
-    char text[INET_ADDRSTRLEN] = {};
-    inet_ntop(AF_INET, &addr.sin_addr, text, sizeof text);
-    return fmt::format("{}:{}", text, ntohs(addr.sin_port));
-  }
+  void accept_all(std::vector<Conn>& conns);
+  // Reads what the client sent and answers its complete requests; false: the connection ends.
+  bool serve(Conn& c);
+  // Answers one request; false when the answer could not be sent whole.
+  bool answer(Conn& c, std::span<const std::uint8_t> adu);
+  void close_conn(Conn& c) noexcept;
+  // Counts under the lock and logs: `what` happened to the connection, which is then closed.
+  void reject(Conn& c, std::uint64_t EmulatorCounters::*counter, std::string_view what);
   // Under the lock.
   void apply_script_locked();
   void write_input_locked(const AnalogInput& in, std::optional<double> v) {
@@ -58,6 +90,8 @@ class PlcEmulator::Impl {
   modbus_mapping_t* mapping = nullptr;
   int listen_fd = -1;
   int wake[2] = {-1, -1};
+  bool refusing = false;        // a refusal was logged at warning level; the next accepted client resets it
+  SteadyTime accept_paused_until{};  // after accept() failed for want of descriptors
   std::uint16_t port = 0;
   std::thread thread;
   mutable std::mutex mu;
@@ -77,13 +111,10 @@ Result<void> PlcEmulator::Impl::open() {
     return Error(PlcErrc::server_failed, fmt::format("PLC emulator: '{}' is not an IPv4 address", options.bind_address));
   ctx = modbus_new_tcp(host.c_str(), options.port);
   if (!ctx) return Error(PlcErrc::server_failed, fmt::format("PLC emulator: {}", modbus_strerror(errno)));
-  listen_fd = modbus_tcp_listen(ctx, 8);
-  if (listen_fd == -1)
-    return Error(PlcErrc::server_failed,
-                 fmt::format("PLC emulator: listen on {}:{}: {}", host, options.port, modbus_strerror(errno)));
-  sockaddr_in addr{};
-  socklen_t len = sizeof addr;
-  if (getsockname(listen_fd, reinterpret_cast<sockaddr*>(&addr), &len) == 0) port = ntohs(addr.sin_port);
+  // libmodbus sleeps this long before some exception answers (to flush a serial line): as short
+  // as it allows, so that a client sending bad requests holds up nobody.
+  modbus_set_response_timeout(ctx, 0, 1);
+  AXON_TRY(listen());
   mapping = modbus_mapping_new_start_address(0, options.map.coil_span(), 0, 0, 0, 0, 0, options.map.input_register_span());
   if (!mapping) return Error(PlcErrc::server_failed, fmt::format("PLC emulator: {}", modbus_strerror(errno)));
   if (pipe(wake) != 0) return Error(PlcErrc::server_failed, fmt::format("PLC emulator: pipe: {}", std::strerror(errno)));
@@ -98,6 +129,17 @@ Result<void> PlcEmulator::Impl::open() {
   write_input_locked(m.coolant_flow, options.initial_coolant_flow);
   apply_script_locked();
   thread = std::thread([this] { loop(); });
+  return ok();
+}
+
+Result<void> PlcEmulator::Impl::listen() {
+  listen_fd = modbus_tcp_listen(ctx, SOMAXCONN);  // a burst of connections waits in the backlog
+  if (listen_fd == -1 || !set_nonblocking(listen_fd))
+    return Error(PlcErrc::server_failed, fmt::format("PLC emulator: listen on {}:{}: {}", options.bind_address,
+                                                     options.port, modbus_strerror(errno)));
+  sockaddr_in addr{};
+  socklen_t len = sizeof addr;
+  if (getsockname(listen_fd, reinterpret_cast<sockaddr*>(&addr), &len) == 0) port = ntohs(addr.sin_port);
   return ok();
 }
 
@@ -142,31 +184,39 @@ void PlcEmulator::Impl::dispatch(const std::vector<RelayEvent>& events) {
   }
 }
 
-void PlcEmulator::Impl::serve(int fd, std::vector<int>& clients, fd_set& all) {
-  std::vector<std::uint8_t> query(MODBUS_TCP_MAX_ADU_LENGTH);
-  modbus_set_socket(ctx, fd);
-  const int rc = modbus_receive(ctx, query.data());
-  if (rc == 0) return;  // not for this server (another unit id): ignored, as the PLC does
-  if (rc < 0) {
-    // The client left, or sent what is not a Modbus TCP request (libmodbus cannot resync the
-    // stream, so the connection ends). Either way nothing in the map changed.
-    if (errno != ECONNRESET) {
-      std::lock_guard lock(mu);
-      ++counters.bad_requests;
-      spdlog::warn("plc emulator: client {}: {}; connection closed", peer_of(fd), modbus_strerror(errno));
-    }
-    ::close(fd);
-    FD_CLR(fd, &all);
-    clients.erase(std::remove(clients.begin(), clients.end(), fd), clients.end());
-    return;
+void PlcEmulator::Impl::close_conn(Conn& c) noexcept {
+  if (c.fd < 0) return;
+  ::close(c.fd);
+  c.fd = -1;
+  std::lock_guard lock(mu);
+  --counters.clients;
+}
+
+void PlcEmulator::Impl::reject(Conn& c, std::uint64_t EmulatorCounters::*counter, std::string_view what) {
+  {
+    std::lock_guard lock(mu);
+    ++(counters.*counter);
   }
+  spdlog::warn("plc emulator: client {}: {}; connection closed", c.peer, what);
+  close_conn(c);
+}
+
+bool PlcEmulator::Impl::answer(Conn& c, std::span<const std::uint8_t> adu) {
+  // libmodbus reads a request's data by its quantity fields, not by its length: a buffer of the
+  // largest request keeps it inside memory whatever the request claims.
+  std::array<std::uint8_t, kMaxRequestSize> query{};
+  std::copy(adu.begin(), adu.end(), query.begin());
   std::vector<RelayEvent> events;
+  int rc = 0;
+  int error = 0;
   {
     std::lock_guard lock(mu);
     apply_script_locked();
     const auto span = options.map.coil_span();
     std::vector<std::uint8_t> before(mapping->tab_bits, mapping->tab_bits + span);
-    modbus_reply(ctx, query.data(), rc, mapping);
+    modbus_set_socket(ctx, c.fd);
+    rc = modbus_reply(ctx, query.data(), static_cast<int>(adu.size()), mapping);
+    error = errno;
     ++counters.requests;
     for (std::uint16_t a = 0; a < span; ++a) {
       if ((before[a] != 0) == (mapping->tab_bits[a] != 0)) continue;
@@ -180,53 +230,107 @@ void PlcEmulator::Impl::serve(int fd, std::vector<int>& clients, fd_set& all) {
   // nobody expected can be traced.
   for (const auto& e : events) {
     const bool sync = e.relay.kind == RelayKind::sync_line;
-    spdlog::info("plc emulator: client {} switched {} {}", peer_of(fd), e.relay.to_string(),
+    spdlog::info("plc emulator: client {} switched {} {}", c.peer, e.relay.to_string(),
                  sync ? (e.on ? "high" : "low") : (e.on ? "on" : "off"));
   }
   dispatch(events);
+  if (rc >= 0) return true;
+  // The socket does not block: a full send buffer (EAGAIN, or a partial send libmodbus reports
+  // as bad data) means the client has not been reading its answers.
+  if (error == EAGAIN || error == EWOULDBLOCK || error == EMBBADDATA)
+    reject(c, &EmulatorCounters::slow_readers, "does not read its answers (send buffer full)");
+  else
+    close_conn(c);  // the client left
+  return false;
+}
+
+bool PlcEmulator::Impl::serve(Conn& c) {
+  std::array<std::uint8_t, 4096> buf{};
+  const ssize_t n = ::recv(c.fd, buf.data(), buf.size(), 0);
+  if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) return true;
+  if (n <= 0) {  // the client left (a partial request with it changes nothing)
+    close_conn(c);
+    return false;
+  }
+  c.framer.feed(std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n)));
+  bool answered = false;
+  while (auto r = c.framer.next()) {
+    if (!*r) {
+      // Not Modbus TCP: there is no finding the next request in the stream.
+      reject(c, &EmulatorCounters::bad_requests, r->error().detail);
+      return false;
+    }
+    if (!answer(c, r->value())) return false;
+    answered = true;
+  }
+  if (c.framer.buffered() == 0) c.partial_since.reset();
+  else if (answered || !c.partial_since) c.partial_since = std::chrono::steady_clock::now();
+  return true;
+}
+
+void PlcEmulator::Impl::accept_all(std::vector<Conn>& conns) {
+  for (;;) {
+    const int fd = ::accept4(listen_fd, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    if (fd < 0) {
+      if (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM) {
+        // The connection stays in the backlog: breathe rather than spin on it.
+        spdlog::warn("plc emulator: accept: {}; accepting again in 100 ms", std::strerror(errno));
+        accept_paused_until = std::chrono::steady_clock::now() + std::chrono::milliseconds(100);
+      }
+      return;  // EAGAIN: none left; others concern that one connection only
+    }
+    std::lock_guard lock(mu);
+    if (conns.size() >= options.max_clients) {
+      ++counters.refused;
+      if (!refusing)
+        spdlog::warn("plc emulator: refusing client {}: {} clients connected (further refusals logged at debug level)",
+                     peer_of(fd), conns.size());
+      else
+        spdlog::debug("plc emulator: refusing client {}", peer_of(fd));
+      refusing = true;
+      ::close(fd);
+      continue;
+    }
+    refusing = false;
+    conns.push_back(Conn{fd, peer_of(fd), {}, {}});
+    ++counters.connections;
+    ++counters.clients;
+  }
 }
 
 void PlcEmulator::Impl::loop() {
-  fd_set all;
-  FD_ZERO(&all);
-  FD_SET(listen_fd, &all);
-  FD_SET(wake[0], &all);
-  std::vector<int> clients;
+  std::vector<Conn> conns;
+  std::vector<pollfd> fds;
   for (;;) {
-    fd_set rd = all;
-    int maxfd = std::max(listen_fd, wake[0]);
-    for (int c : clients) maxfd = std::max(maxfd, c);
-    timeval tv{0, 50000};
-    const int n = select(maxfd + 1, &rd, nullptr, nullptr, &tv);
+    const auto now = std::chrono::steady_clock::now();
+    const bool accepting = now >= accept_paused_until;
+    fds.clear();
+    fds.push_back({wake[0], POLLIN, 0});
+    fds.push_back({accepting ? listen_fd : -1, POLLIN, 0});
+    for (const auto& c : conns) fds.push_back({c.fd, POLLIN, 0});
+    const int n = ::poll(fds.data(), fds.size(), 50);
     if (n < 0) {
       if (errno == EINTR) continue;
-      spdlog::error("plc emulator: select: {}", std::strerror(errno));
+      spdlog::error("plc emulator: poll: {}", std::strerror(errno));
       break;
     }
     {
       std::lock_guard lock(mu);
       apply_script_locked();
     }
-    if (n == 0) continue;
-    if (FD_ISSET(wake[0], &rd)) break;
-    if (FD_ISSET(listen_fd, &rd)) {
-      const int fd = accept(listen_fd, nullptr, nullptr);
-      if (fd >= 0) {
-        if (fd >= FD_SETSIZE) {
-          ::close(fd);
-        } else {
-          FD_SET(fd, &all);
-          clients.push_back(fd);
-          std::lock_guard lock(mu);
-          ++counters.connections;
-        }
-      }
-    }
-    const std::vector<int> ready = clients;
-    for (int fd : ready)
-      if (FD_ISSET(fd, &rd)) serve(fd, clients, all);
+    if (fds[0].revents != 0) break;
+    for (std::size_t i = 0; i < conns.size(); ++i)
+      if (fds[i + 2].revents != 0) serve(conns[i]);
+    const auto deadline = std::chrono::steady_clock::now() - options.request_timeout;
+    for (auto& c : conns)
+      if (c.fd >= 0 && c.partial_since && *c.partial_since < deadline)
+        reject(c, &EmulatorCounters::stalled_requests,
+               fmt::format("request not completed within {} ms ({} bytes of it came)", options.request_timeout.count(),
+                           c.framer.buffered()));
+    std::erase_if(conns, [](const Conn& c) { return c.fd < 0; });
+    if (fds[1].revents != 0) accept_all(conns);
   }
-  for (int fd : clients) ::close(fd);
+  for (auto& c : conns) close_conn(c);
 }
 
 PlcEmulator::PlcEmulator(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

@@ -6,7 +6,16 @@
 // Any client may write the coils, as on the real PLC (Modbus has no sessions): every change a
 // client makes is logged at info level with its address. Requests libmodbus answers with an
 // exception (unknown function, address out of the map) keep the connection; a frame that is not
-// Modbus TCP at all is counted (bad_requests), logged and ends that connection only.
+// Modbus TCP at all (request_framer.hpp) is counted (bad_requests), logged and ends that
+// connection only.
+//
+// Hostile peers (docs/reliability.md): no client can hold up the others. Sockets are non-blocking
+// and requests are framed per connection, so a client that sends half a request and goes silent
+// only loses its own connection after request_timeout (stalled_requests); a client that does not
+// read its answers is disconnected once the kernel's send buffer for it is full (slow_readers),
+// never waited for; beyond max_clients connections a new one is closed at once (refused). Each
+// of these is counted and logged once per connection (refusals: once per burst, then at debug).
+// Per connection the emulator holds at most one partial request (kMaxRequestSize bytes).
 //
 //   - on_relay_change(handler): called once per coil that a client's write changed, with the
 //     relay and its new state (sync line: on = high; a rising edge is on == true). Handlers run on
@@ -30,6 +39,8 @@
 
 #include <boost/asio/any_io_executor.hpp>
 
+#include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -56,6 +67,8 @@ struct EmulatorOptions {
   double initial_pressure_hpa = 780.0;
   double initial_coolant_flow = 4.0;
   std::optional<boost::asio::any_io_executor> hook_executor;
+  std::size_t max_clients = 64;  // connections served at once; more are refused
+  std::chrono::milliseconds request_timeout{1000};  // to complete a request once its first byte came
 };
 
 struct EmulatorCounters {
@@ -63,6 +76,10 @@ struct EmulatorCounters {
   std::uint64_t requests = 0;
   std::uint64_t relay_changes = 0;
   std::uint64_t bad_requests = 0;   // frames that are not Modbus TCP requests (the connection is closed)
+  std::uint64_t refused = 0;        // connections closed at once: max_clients were connected
+  std::uint64_t stalled_requests = 0;  // connections closed: a request not completed within request_timeout
+  std::uint64_t slow_readers = 0;   // connections closed: the client did not read its answers
+  std::uint64_t clients = 0;        // connected now
 };
 
 class PlcEmulator {
