@@ -27,6 +27,7 @@ struct SimBlmcOptions {
   std::string config;
   std::string fault_plan;
   double duration_s = 0;
+  bool realtime = true;
 };
 
 void log_end(const bsim::SimulatedBoard& sim) {
@@ -46,6 +47,8 @@ int run_sim_blmc(const SimBlmcOptions& o) {
   if (!o.config.empty()) so.config = need(bsim::BoardConfig::from_config(need(core::ConfigNode::load_file(o.config))));
   so.faults = need(bsim::load_fault_plans(o.fault_plan, o.boards));
   so.socketcand = o.socketcand;
+  // Below the host's control loop (SCHED_FIFO 80): on one machine the host's deadline comes first.
+  if (o.realtime) so.realtime.fifo_priority = 70;
   return run_command([&](asio::io_context& io, auto set_on_signal) -> asio::awaitable<int> {
     bsim::SimulatedBoard sim(so);
     std::printf("listening socketcand %s\n", sim.endpoint().c_str());
@@ -70,6 +73,7 @@ void add_sim_blmc_command(CLI::App& sim_cmd, GlobalOptions& global) {
   b->add_option("--config", o->config, "board/motor parameters YAML (docs/blmc-simulator.md)");
   b->add_option("--fault-plan", o->fault_plan, "fault plan YAML (docs/blmc-simulator.md)");
   b->add_option("--duration", o->duration_s, "stop after this many seconds (default: until Ctrl-C)")->check(non_negative());
+  b->add_flag("!--no-realtime", o->realtime, "do not ask for SCHED_FIFO 70 for the boards' 1 kHz loop");
   b->callback([o, &global] { global.exit_code = run_sim_blmc(*o); });
 }
 

@@ -63,7 +63,11 @@ void SimulatedBoard::Impl::start(const SimulatedBoardOptions& o) {
 }
 
 SimulatedBoard::SimulatedBoard(SimulatedBoardOptions options) : impl_(std::make_unique<Impl>()) {
-  impl_->loop.call([&] { impl_->start(options); });  // on failure ~Impl takes down what started
+  impl_->loop.call([&] {
+    if (options.realtime.fifo_priority > 0 || options.realtime.lock_memory || !options.realtime.cpus.empty())
+      core::apply_realtime(options.realtime);
+    impl_->start(options);  // on failure ~Impl takes down what started
+  });
 }
 
 SimulatedBoard::~SimulatedBoard() { stop(); }

@@ -21,6 +21,7 @@
 #include "axon/blmc/sim/board_config.hpp"
 #include "axon/blmc/sim/fault_plan.hpp"
 #include "axon/blmc/sim/runner_stats.hpp"
+#include "axon/core/realtime.hpp"
 
 #include <array>
 #include <cstdint>
@@ -36,6 +37,10 @@ struct SimulatedBoardOptions {
   std::vector<BoardFaultPlan> faults;   // per board (fewer entries: no faults for the rest)
   std::string socketcand = "127.0.0.1:0";  // where to serve (port 0: any free port)
   bool bus_load = true;                 // account bit times on the buses (bus_load() figures)
+  // The loop thread's scheduling (core/realtime.hpp): a board keeps its 1 kHz whatever else runs,
+  // so a simulator that stands in for one next to a real-time host may ask for SCHED_FIFO too.
+  // Nothing by default; a refusal is a logged warning.
+  core::RealtimeRequest realtime{};
 };
 
 // One board's state and counters at the moment of the call.
