@@ -49,7 +49,7 @@ struct ServeArgs {
   std::string numbering = "same";
   std::string pcap;
   RotationArgs pcap_rotation, csv_rotation;
-  int rt_priority = 80;  // the reply is due within 500 us: real-time unless told otherwise
+  int rt_priority = 0;
   std::vector<int> cpus;
   bool busy_poll = false;
   double max_step = 0;
@@ -256,7 +256,7 @@ void add_serve(CLI::App* c4g, GlobalOptions& global) {
   s->add_option("--numbering", o->numbering, "reply number: same (the manual) or next (NUM + 1)");
   s->add_option("--pcap", o->pcap, "record every datagram into this pcap file");
   add_rotation_options(s, o->pcap_rotation, "pcap", "--pcap");
-  s->add_option("--rt-priority", o->rt_priority, "SCHED_FIFO priority of the cycle thread (and mlockall); default 80, 0: none")->check(CLI::Range(0, 99));
+  s->add_option("--rt-priority", o->rt_priority, "SCHED_FIFO priority of the cycle thread (and mlockall)")->check(CLI::Range(0, 99));
   s->add_option("--cpu", o->cpus, "pin the cycle thread to this CPU (repeatable)");
   s->add_flag("--busy-poll", o->busy_poll, "spin on the socket instead of sleeping (a dedicated core)");
   s->add_option("--max-step", o->max_step, "Safety: max change of a commanded position per cycle [motor turns] (default: --max-motor-speed x the period)")->check(non_negative());
