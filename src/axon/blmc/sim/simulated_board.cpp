@@ -64,8 +64,7 @@ void SimulatedBoard::Impl::start(const SimulatedBoardOptions& o) {
 
 SimulatedBoard::SimulatedBoard(SimulatedBoardOptions options) : impl_(std::make_unique<Impl>()) {
   impl_->loop.call([&] {
-    if (options.realtime.fifo_priority > 0 || options.realtime.lock_memory || !options.realtime.cpus.empty())
-      core::apply_realtime(options.realtime);
+    core::apply_realtime(options.realtime);  // each step only when asked for: nothing by default
     impl_->start(options);  // on failure ~Impl takes down what started
   });
 }
