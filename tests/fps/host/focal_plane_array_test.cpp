@@ -178,3 +178,42 @@ TEST(FocalPlaneArray, GatewayLostDuringUploadStartsNothingAndSaysWhatEachRobotHo
     for (auto* m : rig.sim->simulator().robots()) EXPECT_FALSE(m->moving());
   });
 }
+
+// Another client takes gateway 2 over while every robot moves (a CAN@net gateway serves one client
+// at a time): everything stops, the robots behind gateway 2 through one reconnection, and that stop
+// is over, and reported, by the time run_trajectories returns (the CLI prints the report then).
+TEST(FocalPlaneArray, GatewayTakenOverMidMoveIsStoppedThroughOneReconnectionBeforeTheRunReturns) {
+  PlaneRig rig;
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    std::shared_ptr<can::CanNetGateway> other;
+    asio::co_spawn(
+        rig.runner.io,
+        [&]() -> asio::awaitable<void> {
+          co_await eventually([&] { return rig.sim->simulator().find(7)->moving(); }, 20000);
+          const std::vector<int> channels{1};
+          auto g = co_await can::CanNetGateway::connect(rig.runner.io.get_executor(), rig.sim->gateways().at(1).endpoint,
+                                                        channels);
+          EXPECT_TRUE(g.has_value());
+          if (g) other = g.value();
+        },
+        asio::detached);
+    auto r = co_await rig.fpa->run_trajectories(everyone_to(rig, {90, 120}, 10, 40.0), {}, true);
+    EXPECT_TRUE(r.has_value());
+    if (!r) co_return;
+    EXPECT_FALSE(r.value().completed);
+    EXPECT_TRUE(rig.fpa->array().locked());
+    EXPECT_EQ(rig.fpa->lost_gateways(), (std::vector<std::uint16_t>{2}));
+    const std::string stop = "gateway 2: reconnected once and sent TRAJECTORY_ABORT on channel(s) 1, 2: "
+                             "6 of 6 robots acknowledged (6 had been moving)";
+    EXPECT_EQ(rig.fpa->link_stops(), std::vector<std::string>{stop});
+    EXPECT_TRUE(co_await eventually([&] {
+      for (auto* m : rig.sim->simulator().robots())
+        if (m->moving()) return false;
+      return true;
+    }));
+    for (auto* m : rig.sim->simulator().robots()) EXPECT_LT(m->physical_deg(sim::Arm::alpha), 80.0);
+    if (other) other->close();
+  });
+}

@@ -29,9 +29,13 @@ struct LateReply {
 // Sends this tick's packet and collects the replies that arrive within the window.
 void exchange(Controller& c, UdpClient& udp, std::span<const std::byte> d, Clock::duration window, RunReport& report,
               std::array<std::byte, 2048>& buf, LateReply& late) {
+  // The round trip is timed from just before the send: on loopback the PC's reply can arrive (and
+  // be stamped by the kernel) while sendto() is still returning, so a clock read after the send
+  // would make every round trip 0.
+  const auto sending_at = Clock::now();
   if (auto r = udp.send(d); !r) c.on_send_failed(r.error().detail);
   // The window starts once the datagram is out: a simulator preempted before or inside the send
-  // must not charge its own delay to the PC (a reply may even arrive before this: rtt 0).
+  // must not charge its own delay to the PC.
   const auto sent_at = Clock::now();
   const auto deadline = sent_at + window;
   while (c.awaiting_reply() && !c.reply_received()) {
@@ -45,7 +49,7 @@ void exchange(Controller& c, UdpClient& udp, std::span<const std::byte> d, Clock
     }
     c.on_datagram(std::span<const std::byte>(buf.data(), n));
     if (c.reply_received())
-      report.rtt.add(std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(got.value().arrived - sent_at).count()));
+      report.rtt.add(std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(got.value().arrived - sending_at).count()));
   }
 }
 

@@ -12,6 +12,7 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <set>
 
 namespace axon::fps::host {
@@ -104,16 +105,22 @@ std::optional<std::size_t> FocalPlaneArray::bus_index(const BusRef& ref) const {
 }
 
 asio::awaitable<void> FocalPlaneArray::watch(FocalPlaneArray* self, std::shared_ptr<bool> alive) {
-  std::set<std::uint16_t> seen;
   while (*alive) {
     co_await core::sleep_for(self->options_.connection_poll);
     if (!*alive || self->closed_) co_return;
-    for (const auto& link : self->gateways_) {
-      if (link.gateway->is_connected() || seen.contains(link.id)) continue;
-      seen.insert(link.id);
-      self->link_lost(link);
-    }
+    self->check_links();
   }
+}
+
+void FocalPlaneArray::check_links() {
+  for (const auto& link : gateways_) {
+    if (link.gateway->is_connected() || std::ranges::find(lost_, link.id) != lost_.end()) continue;
+    link_lost(link);
+  }
+}
+
+asio::awaitable<void> FocalPlaneArray::link_stops_done() {
+  while (reconnecting_ > 0) co_await core::sleep_for(10ms);
 }
 
 void FocalPlaneArray::link_lost(const GatewayLink& link) {
@@ -221,6 +228,10 @@ asio::awaitable<Result<TrajectoryReport>> FocalPlaneArray::run_trajectories(
     };
   }
   auto r = co_await array_->run_trajectories(std::move(trajectories), std::move(options));
+  // A gateway lost during the run (even one the watch has not polled yet): the stop of its robots
+  // through a reconnection belongs to this run, so it ends before the caller reads link_stops().
+  if (!closed_) check_links();
+  co_await link_stops_done();
   co_return r;
 }
 
@@ -228,7 +239,7 @@ asio::awaitable<void> FocalPlaneArray::close() {
   if (closed_) co_return;
   closed_ = true;
   *alive_ = false;
-  while (reconnecting_ > 0) co_await core::sleep_for(10ms);
+  co_await link_stops_done();
   co_await array_->close();
   for (auto& b : buses_) b->close();
   for (auto& l : gateways_)

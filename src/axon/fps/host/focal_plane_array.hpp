@@ -89,7 +89,8 @@ class FocalPlaneArray {
   // Array::discover, each bus collecting until the layout's robots there answered (or the window).
   asio::awaitable<Result<DiscoveryReport>> discover();
   // Array::run_trajectories; with by_sync_line the start is a pulse of the PLC's sync line
-  // (HostErrc::invalid_argument without a PLC).
+  // (HostErrc::invalid_argument without a PLC). Returns once the stops through a reconnection to
+  // gateways lost during the run have ended too (link_stops() then says what they did).
   asio::awaitable<Result<TrajectoryReport>> run_trajectories(std::map<std::uint16_t, protocol::Trajectory> trajectories,
                                                              TrajectoryOptions options = {}, bool by_sync_line = false);
 
@@ -105,7 +106,9 @@ class FocalPlaneArray {
  private:
   FocalPlaneArray(const FocalPlane& plane, FocalPlaneArrayOptions options);
   static asio::awaitable<void> watch(FocalPlaneArray* self, std::shared_ptr<bool> alive);
+  void check_links();  // link_lost() for each gateway newly disconnected
   void link_lost(const GatewayLink& link);
+  asio::awaitable<void> link_stops_done();  // once every stop_behind() has ended
   asio::awaitable<void> stop_behind(GatewayLink link, std::vector<std::uint16_t> robots, std::size_t moving);
 
   FocalPlane plane_;
