@@ -76,12 +76,21 @@ TEST(BlmcMotorBoard, RunsAPdLawOnBothMotorsAndTheDestructorDisables) {
     MotorBoard board(sim.bus_spec(), board_options());
     board.enable();
     EXPECT_TRUE(board.enabled());
-    const auto report = board.run_control(move_by({0.5, -0.3}, start), 1500ms, settings());
+    // The law runs until both motors settle near their targets (typically about 1 s; a loaded
+    // machine, or a sanitizer build, holds the threads longer, so no fixed time is asserted).
+    board.start_control(move_by({0.5, -0.3}, start), settings());
+    const auto near_targets = [&] {
+      const auto m = board.measurements();
+      return std::abs(m.position.value.motor1 - (start[0] + 0.5)) < 0.02 &&
+             std::abs(m.position.value.motor2 - (start[1] - 0.3)) < 0.02;
+    };
+    for (int i = 0; i < 1000 && board.control_running() && !near_targets(); ++i) std::this_thread::sleep_for(10ms);
+    std::this_thread::sleep_for(300ms);  // and stay there
+    EXPECT_TRUE(near_targets()) << board.measurements().position.value.motor1 << " "
+                                << board.measurements().position.value.motor2;
+    const auto report = board.stop_control();
     EXPECT_FALSE(report.fault) << report.fault_text;
-    EXPECT_GT(report.stats.cycles, 500u);
-    const auto m = board.measurements();
-    EXPECT_NEAR(m.position.value.motor1, start[0] + 0.5, 0.02);
-    EXPECT_NEAR(m.position.value.motor2, start[1] - 0.3, 0.02);
+    EXPECT_GT(report.stats.cycles, 200u);  // at least the 300 ms hold at 1 kHz, give or take misses
     const auto r = sim.report();
     EXPECT_TRUE(r.motors[0].enabled);  // control ended, the motors stay on until disabled
   }
