@@ -97,6 +97,35 @@ TEST(BlmcMotorBoard, RunsAPdLawOnBothMotorsAndTheDestructorDisables) {
   expect_board_off(sim);
 }
 
+// A motor that starts just below the board's +100 rev rollover and is driven 0.5 rev on: the
+// host sees 100.3 rev, not -99.7, so the PD law settles there instead of driving the motor on at
+// full current to chase a 200 rev error.
+TEST(BlmcMotorBoard, APdMoveAcrossThePositionRolloverSettlesOnTheOtherSide) {
+  auto so = sim_options();
+  so.config.motors[0].initial_position_rev = 99.8;
+  so.config.motors[1].initial_position_rev = -99.9;
+  sim::SimulatedBoard sim(so);
+  std::array<std::atomic<double>, 2> start{};
+  MotorBoard board(sim.bus_spec(), board_options());
+  board.enable();
+  board.start_control(move_by({0.5, -0.3}, start), settings());
+  const auto settled = [&] {
+    const auto m = board.measurements();
+    return std::abs(m.position.value.motor1 - 100.3) < 0.02 && std::abs(m.position.value.motor2 + 100.2) < 0.02;
+  };
+  for (int i = 0; i < 1000 && board.control_running() && !settled(); ++i) std::this_thread::sleep_for(10ms);
+  std::this_thread::sleep_for(300ms);
+  const auto m = board.measurements();
+  EXPECT_NEAR(m.position.value.motor1, 100.3, 0.02);
+  EXPECT_NEAR(m.position.value.motor2, -100.2, 0.02);
+  const auto report = board.stop_control();
+  EXPECT_FALSE(report.fault) << report.fault_text;
+  // The shafts really are there: past the wrap, within a fraction of a turn of the target.
+  const auto r = sim.report();
+  EXPECT_NEAR(r.position_rev[0], -99.7, 0.05);
+  EXPECT_NEAR(r.position_rev[1], 99.8, 0.05);
+}
+
 TEST(BlmcMotorBoard, ABoardFaultIsAReportedSafetyStopNotAnException) {
   sim::SimulatedBoard sim(sim_options());
   MotorBoard board(sim.bus_spec(), board_options());

@@ -43,12 +43,41 @@ std::uint64_t Measurements::count(Quantity q) const noexcept {
   }
 }
 
+double PositionUnwrap::offset_rev(std::size_t motor) const noexcept {
+  return 2 * protocol::kPositionRolloverRev * static_cast<double>(wraps[motor]);
+}
+
 namespace {
 template <class T>
 void store(Stamped<T>& s, const T& v, core::TimePoint now) noexcept {
   s.value = v;
   s.at = now;
   ++s.count;
+}
+
+// The unwrapped reading of one motor's position (see PositionUnwrap).
+double unwrap_position(PositionUnwrap& u, std::size_t motor, double raw, bool first) noexcept {
+  const double delta = raw - u.last_raw[motor];
+  if (!first && delta < -protocol::kPositionRolloverRev) ++u.wraps[motor];
+  if (!first && delta > protocol::kPositionRolloverRev) --u.wraps[motor];
+  u.last_raw[motor] = raw;
+  return raw + u.offset_rev(motor);
+}
+
+MotorPair unwrap_pair(Measurements& m, const MotorPair& raw) noexcept {
+  const bool first = !m.position.received();
+  return {unwrap_position(m.unwrap, 0, raw.motor1, first), unwrap_position(m.unwrap, 1, raw.motor2, first)};
+}
+
+// An index tick's position on the turn of the counter nearest the motor's current position.
+double unwrap_index(const Measurements& m, std::size_t motor, double raw) noexcept {
+  double p = raw + m.unwrap.offset_rev(motor);
+  if (!m.position.received()) return p;
+  const double now = motor == 0 ? m.position.value.motor1 : m.position.value.motor2;
+  const double range = 2 * protocol::kPositionRolloverRev;
+  if (p - now > protocol::kPositionRolloverRev) p -= range;
+  if (now - p > protocol::kPositionRolloverRev) p += range;
+  return p;
 }
 }  // namespace
 
@@ -76,7 +105,8 @@ FrameOutcome apply_frame(Measurements& m, const can::Frame& f, core::TimePoint n
       if (f.payload()[4] > 1) break;
       auto e = protocol::decode_encoder_index(f);
       if (!e) break;
-      store(m.index[e.value().motor], e.value().position_rev, now);
+      const std::size_t motor = e.value().motor;
+      store(m.index[motor], unwrap_index(m, motor, e.value().position_rev), now);
       ++m.frames;
       return FrameOutcome::index;
     }
@@ -87,7 +117,7 @@ FrameOutcome apply_frame(Measurements& m, const can::Frame& f, core::TimePoint n
       if (*id == MessageId::current) dst = &m.current;
       else if (*id == MessageId::position) dst = &m.position;
       else if (*id == MessageId::velocity) dst = &m.velocity;
-      store(*dst, v.value(), now);
+      store(*dst, dst == &m.position ? unwrap_pair(m, v.value()) : v.value(), now);
       ++m.frames;
       return FrameOutcome::measurement;
     }

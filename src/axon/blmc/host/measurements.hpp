@@ -28,14 +28,27 @@ struct Stamped {
 enum class Quantity : std::uint8_t { status, current, position, velocity, adc, encoder_index };
 const char* to_string(Quantity q) noexcept;
 
+// The board's position counter rolls over at +-100 rev (protocol::kPositionRolloverRev): a shaft
+// turning past +100 reads -100 on the next frame. The host counts those wraps per motor, so that
+// `position` is continuous and PD laws, homing and the position limits never see a 200 rev jump. A
+// change of more than half the counter's range between two frames can only be a wrap (as motion it
+// would be 100 rev within one frame period, 6 million rpm at 1 kHz). Encoder index positions are
+// unwrapped the same way, to the turn nearest the current position.
+struct PositionUnwrap {
+  std::array<double, 2> last_raw{};      // the last reading, as the board sent it
+  std::array<std::int64_t, 2> wraps{};   // +1 for each wrap from +100 to -100, -1 the other way
+  [[nodiscard]] double offset_rev(std::size_t motor) const noexcept;
+};
+
 struct Measurements {
   Stamped<protocol::Status> status;
   Stamped<MotorPair> current;   // A
-  Stamped<MotorPair> position;  // motor revolutions
+  Stamped<MotorPair> position;  // motor revolutions, unwrapped across the counter's rollover
   Stamped<MotorPair> velocity;  // krpm
   Stamped<MotorPair> adc;       // 0..1 (A6, B6)
-  // Position at the last encoder index tick, per motor (index 0 = motor 1).
+  // Position at the last encoder index tick, per motor (index 0 = motor 1), unwrapped.
   std::array<Stamped<double>, 2> index;
+  PositionUnwrap unwrap;
 
   std::uint64_t frames = 0;    // board frames decoded
   std::uint64_t rejected = 0;  // frames with a board identifier that failed to decode

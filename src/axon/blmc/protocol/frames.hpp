@@ -24,6 +24,10 @@
 
 namespace axon::blmc::protocol {
 
+// The firmware's position counter rolls over: readings lie in [-100, 100) motor revolutions, and a
+// shaft turning past +100 reads -100 next (error 5, POS_ROLLOVER, only when enabled).
+inline constexpr double kPositionRolloverRev = 100.0;
+
 // One value per motor, in the message's unit (A, motor rev, krpm, ADC fraction, or gains).
 struct MotorPair {
   double motor1 = 0.0;

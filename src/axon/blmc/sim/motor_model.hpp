@@ -14,6 +14,7 @@
 // reading at the mark.
 #pragma once
 
+#include "axon/blmc/protocol/frames.hpp"
 #include "axon/blmc/sim/motor_config.hpp"
 
 #include <cstdint>
@@ -21,8 +22,7 @@
 
 namespace axon::blmc::sim {
 
-// The firmware's position range: readings lie in [-100, 100).
-inline constexpr double kPositionRolloverRev = 100.0;
+using protocol::kPositionRolloverRev;  // readings lie in [-100, 100)
 // The physics step.
 inline constexpr double kSubstepS = 1.0e-4;
 
