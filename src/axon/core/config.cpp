@@ -156,4 +156,11 @@ Result<double> ConfigNode::as_double() const {
   return d;
 }
 
+std::string yaml_quoted(std::string_view text) {
+  YAML::Emitter out;
+  out.SetOutputCharset(YAML::EscapeNonAscii);
+  out << YAML::DoubleQuoted << std::string(text);
+  return out.c_str();
+}
+
 }  // namespace axon::core

@@ -111,4 +111,9 @@ Result<T> ConfigNode::as() const {
   }
 }
 
+// `text` as a YAML double-quoted scalar (quotes, backslashes, control and non-ASCII characters
+// escaped), for writers of configuration files: whatever a string holds, the file reads back the
+// same string.
+[[nodiscard]] std::string yaml_quoted(std::string_view text);
+
 }  // namespace axon::core

@@ -146,6 +146,24 @@ TEST(LayoutFile, MissingKeyIsNamed) {
   EXPECT_NE(e.find("robots[0].y"), std::string::npos) << e;
 }
 
+// Found by fuzz_fps_layout: an address holding a double quote was written between quotes
+// unescaped, so the written file did not load again. Names and addresses are YAML-quoted now.
+TEST(LayoutFile, NamesAndAddressesWithQuotesAndColonsRoundTrip) {
+  const std::string text = "name: 'bench #2: \"west\" \\ side'\npitch_mm: 22.4\ngateways:\n"
+                           "  - {id: 1, address: 0127.0.0.1:1\", sextant: 1, channels: 4}\n"
+                           "robots:\n  - {id: 1, x: 0, y: 0, sextant: 1, gateway: 1, bus: 1}\n";
+  auto a = load(text);
+  ASSERT_TRUE(a.has_value()) << a.error().message();
+  EXPECT_EQ(a.value().spec().name, "bench #2: \"west\" \\ side");
+  EXPECT_EQ(a.value().spec().gateways.at(0).address, "0127.0.0.1:1\"");
+  const std::string written = to_yaml(a.value());
+  auto b = load(written);
+  ASSERT_TRUE(b.has_value()) << b.error().message() << "\n" << written;
+  EXPECT_EQ(b.value().spec().name, a.value().spec().name);
+  EXPECT_EQ(b.value().spec().gateways.at(0).address, a.value().spec().gateways.at(0).address);
+  EXPECT_EQ(to_yaml(b.value()), written);
+}
+
 TEST(LayoutFile, GeneratedLayoutRoundTripsThroughYaml) {
   auto g = generate_layout();
   ASSERT_TRUE(g.has_value()) << g.error().message();

@@ -189,14 +189,14 @@ std::string to_yaml(const FocalPlane& plane) {
   std::string out;
   out += fmt::format("# axon fps focal-plane layout (docs/fps-layout.md): {} robots, {} fiducials, {} gateways\n",
                      s.robots.size(), s.fiducials.size(), s.gateways.size());
-  out += fmt::format("name: {}\npitch_mm: {}\n", s.name, num(s.pitch_mm));
+  out += fmt::format("name: {}\npitch_mm: {}\n", core::yaml_quoted(s.name), num(s.pitch_mm));
   out += fmt::format("neighbours: {{robot_radius_mm: {}, adjacent_radius_mm: {}, fiducial_radius_mm: {}}}\n",
                      num(s.neighbours.robot_radius_mm), num(s.neighbours.adjacent_radius_mm),
                      num(s.neighbours.fiducial_radius_mm));
   out += "gateways:\n";
   for (const auto& g : s.gateways)
-    out += fmt::format("  - {{id: {}, address: \"{}\", sextant: {}, channels: {}}}\n", g.id, g.address, g.sextant,
-                       g.channels);
+    out += fmt::format("  - {{id: {}, address: {}, sextant: {}, channels: {}}}\n", g.id, core::yaml_quoted(g.address),
+                       g.sextant, g.channels);
   out += "robots:\n";
   for (const auto& r : s.robots) {
     std::string fibres;
