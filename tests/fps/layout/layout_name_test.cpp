@@ -1,5 +1,5 @@
 // Layouts by name: the shipped ones resolve with and without the data folder, and the built-in
-// benchtop is the shipped file.
+// benchtop and the generated default are the shipped files.
 #include "axon/fps/layout/layout_file.hpp"
 #include "axon/fps/layout/layout_name.hpp"
 
@@ -19,10 +19,13 @@ TEST(LayoutName, BuiltInBenchtopIsTheShippedFile) {
   EXPECT_EQ(built_in.robots().size(), 6u);
 }
 
-TEST(LayoutName, DefaultIsGeneratedWithoutTheDataFolder) {
+// A program using the library without the data folder gets the same 500-robot plane as the CLI,
+// which reads data/layouts/default.yaml.
+TEST(LayoutName, DefaultIsGeneratedWithoutTheDataFolderAndIsTheShippedFile) {
   const auto plane = resolve_layout("default").value();
-  EXPECT_GT(plane.robots().size(), 490u);
+  EXPECT_EQ(plane.robots().size(), 500u);
   EXPECT_EQ(plane.gateways().size(), 6u);
+  EXPECT_EQ(to_yaml(plane), to_yaml(resolve_layout("default", kData).value()));
 }
 
 TEST(LayoutName, AFilePathLoadsThatFile) {
