@@ -24,7 +24,7 @@ std::string slurp(const std::string& name) {
 }
 
 // The sample's four tables as text, to be spoiled one cell at a time.
-struct Sample {
+struct SampleTables {
   std::string positioners = slurp("positionerTable.csv");
   std::string wok = slurp("wokCoords.csv");
   std::string fiducials = slurp("fiducialCoords.csv");
@@ -45,7 +45,7 @@ struct Sample {
   }
 };
 
-void replace(std::string& text, const std::string& from, const std::string& to) {
+void spoil(std::string& text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
   ASSERT_NE(at, std::string::npos) << from;
   text.replace(at, from.size(), to);
@@ -118,54 +118,54 @@ TEST(CalibrationTables, ADirectoryIsALayoutNameAndWritesAsYaml) {
 }
 
 TEST(CalibrationTables, ABadCellNamesFileLineAndColumn) {
-  Sample s;
-  replace(s.positioners, "7.4215", "7.4x15");
+  SampleTables s;
+  spoil(s.positioners, "7.4215", "7.4x15");
   auto e = s.error();
   EXPECT_NE(e.find("positionerTable.csv:3: column 'alphaArmLen'"), std::string::npos) << e;
   EXPECT_NE(e.find("'7.4x15'"), std::string::npos) << e;
 
-  s = Sample{};
-  replace(s.positioners, "7.4215", "-7.4215");
+  s = SampleTables{};
+  spoil(s.positioners, "7.4215", "-7.4215");
   EXPECT_NE(s.error().find("column 'alphaArmLen': an arm length must be above 0"), std::string::npos) << s.error();
 
-  s = Sample{};
-  replace(s.positioners, ",103,", ",3000,");
+  s = SampleTables{};
+  spoil(s.positioners, ",103,", ",3000,");
   EXPECT_NE(s.error().find("positionerTable.csv:4: column 'positionerID': expected an id 1..2047"), std::string::npos)
       << s.error();
 
-  s = Sample{};
-  replace(s.positioners, ",103,", ",102,");
+  s = SampleTables{};
+  spoil(s.positioners, ",103,", ",102,");
   EXPECT_NE(s.error().find("robot 102 already listed at line 3"), std::string::npos) << s.error();
 
-  s = Sample{};
-  replace(s.positioners, "R+12C9", "R+99C9");
+  s = SampleTables{};
+  spoil(s.positioners, "R+12C9", "R+99C9");
   EXPECT_NE(s.error().find("positionerTable.csv:7: column 'holeID': hole 'R+99C9' is not in the wok table"),
             std::string::npos)
       << s.error();
 
-  s = Sample{};
-  replace(s.wok, ",11.2,252.1866,0,0,-1,0,1,0", ",11.2,252.1866,0,0,-1,0,-1,0");  // a left-handed frame
+  s = SampleTables{};
+  spoil(s.wok, ",11.2,252.1866,0,0,-1,0,1,0", ",11.2,252.1866,0,0,-1,0,-1,0");  // a left-handed frame
   EXPECT_NE(s.error().find("wokCoords.csv:4: column 'ix': axes"), std::string::npos) << s.error();
 
-  s = Sample{};
-  replace(s.wok, "-22.4,232.7876,0", "-22.4,nan,0");
+  s = SampleTables{};
+  spoil(s.wok, "-22.4,232.7876,0", "-22.4,nan,0");
   EXPECT_NE(s.error().find("wokCoords.csv:7: column 'yWok': expected a finite number, got 'nan'"), std::string::npos)
       << s.error();
 
-  s = Sample{};
-  replace(s.fiducials, "F23", "Fx");
+  s = SampleTables{};
+  spoil(s.fiducials, "F23", "Fx");
   EXPECT_NE(s.error().find("fiducialCoords.csv:3: column 'id'"), std::string::npos) << s.error();
 
-  s = Sample{};
-  replace(s.cameras, "283.7,-163.8,0", "283.7,-163.8");
+  s = SampleTables{};
+  spoil(s.cameras, "283.7,-163.8,0", "283.7,-163.8");
   EXPECT_NE(s.error().find("gfaCoords.csv:3: 14 cells, but the header names 15 columns"), std::string::npos)
       << s.error();
 
-  s = Sample{};
-  replace(s.positioners, "betaOffset", "betaOffs");
+  s = SampleTables{};
+  spoil(s.positioners, "betaOffset", "betaOffs");
   EXPECT_NE(s.error().find("positionerTable.csv:1: no column 'betaOffset'"), std::string::npos) << s.error();
 
-  s = Sample{};
+  s = SampleTables{};
   s.fiducials.clear();
   EXPECT_NE(s.error().find("fiducialCoords.csv:1: empty table"), std::string::npos) << s.error();
 }

@@ -79,7 +79,7 @@ TEST(LayoutGeometry, ModelCarriesEveryRobotsGeometryAndTheGuideCameras) {
   EXPECT_TRUE(paired);
 }
 
-struct Problem {
+struct GeometryProblem {
   FocalPlane truth = true_plane();
   CollisionModel true_model = model_from_layout(truth).value();
   CollisionModel old_model = model_from_layout(old_plane(truth)).value();
@@ -98,7 +98,7 @@ struct Problem {
   }
 };
 
-PlannerOptions quick() {
+PlannerOptions one_thread() {
   PlannerOptions o;
   o.parallel = false;
   o.check.threads = 1;
@@ -106,10 +106,10 @@ PlannerOptions quick() {
 }
 
 TEST(LayoutGeometry, OldGeometryPlanTouchesTheTrueGeometryTheNewPlanDoesNot) {
-  const Problem p;
+  const GeometryProblem p;
   // Planned on the old geometry: clean in its own model...
   PlanRequest old_req{p.start, p.targets(p.old_model), {}};
-  const Plan old_plan = plan_moves(p.old_model, old_req, quick()).value();
+  const Plan old_plan = plan_moves(p.old_model, old_req, one_thread()).value();
   ASSERT_TRUE(old_plan.verified);
   EXPECT_EQ(old_plan.not_reached, 0u) << old_plan.summary(p.old_model);
 
@@ -137,7 +137,7 @@ TEST(LayoutGeometry, OldGeometryPlanTouchesTheTrueGeometryTheNewPlanDoesNot) {
   // Planned on the true geometry: the impossible targets are parked, with the reason, and the
   // plan checks clean on the true geometry, by the planner and by an independent checker run.
   PlanRequest req{p.start, p.targets(p.true_model), {}};
-  const Plan plan = plan_moves(p.true_model, req, quick()).value();
+  const Plan plan = plan_moves(p.true_model, req, one_thread()).value();
   EXPECT_TRUE(plan.verified);
   EXPECT_EQ(plan.robots[0].status, RobotPlan::Status::parked);
   EXPECT_NE(plan.robots[0].reason.find("guide camera 2"), std::string::npos) << plan.robots[0].reason;
