@@ -66,7 +66,8 @@ struct Loaded {
 };
 
 Loaded load(const PlanArgs& a) {
-  if (a.layout.empty()) throw Exception(Error(CoreErrc::invalid_argument, "give the focal-plane layout: --layout default|benchtop|FILE"));
+  if (a.layout.empty())
+    throw Exception(Error(CoreErrc::invalid_argument, "give the focal-plane layout: --layout default|benchtop|FILE|DIR"));
   auto plane = need(resolve_layout(a.layout));
   plan::LayoutModelOptions lo;
   lo.buffer_mm = a.buffer;
@@ -189,7 +190,8 @@ void add_fps_plan_commands(CLI::App& fps_cmd, GlobalOptions& global, FpsArrayRun
   const auto args = std::make_shared<PlanArgs>();  // shared with the callbacks
   auto& a = *args;
   auto common = [&a](CLI::App* c) {
-    c->add_option("--layout", a.layout, "focal-plane layout: default, benchtop or a YAML file")->required();
+    c->add_option("--layout", a.layout, "focal-plane layout: default, benchtop, a YAML file or a directory of calibration tables")
+        ->required();
     c->add_option("--seed", a.seed, "seed for random poses and the planner's nudges (default 1)");
     c->add_option("--buffer", a.buffer, "collision buffer of every robot, mm (default 2.0)")->check(non_negative());
   };

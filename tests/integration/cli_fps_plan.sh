@@ -38,6 +38,13 @@ grep -q '^plan: ' "$TMP/plan-json.err" || fail "plan --json: summary not on stde
 rc=0; "$AXON" fps plan --layout "$DATA/benchtop.yaml" --to random --json -o "$TMP/x.json" 2>/dev/null || rc=$?
 [ "$rc" = 2 ] || fail "plan --json -o FILE: exit $rc, expected 2"
 
+# A directory of calibration tables is a layout: the robots' own geometry and the guide cameras.
+CAL="$(cd "$(dirname "$0")/../fps/data/calibration" && pwd)"
+"$AXON" fps plan --layout "$CAL" --to random --seed 3 --allow-partial 2>"$TMP/cal.err" \
+  || fail "plan on calibration tables exited with $? ($(cat "$TMP/cal.err"))"
+grep -q '^plan: 6 robots' "$TMP/cal.err" && grep -q 'verified by the checker' "$TMP/cal.err" \
+  || fail "plan on calibration tables: $(cat "$TMP/cal.err")"
+
 # A target file with a typo'd robot is an error, not a silent drop.
 printf 'targets:\n  - {robot: 99, alpha: 10, beta: 170}\n' >"$TMP/bad.yaml"
 if "$AXON" fps plan --layout "$DATA/benchtop.yaml" --to "$TMP/bad.yaml" 2>"$TMP/bad.err"; then fail "unknown robot accepted"; fi

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace axon::fps {
@@ -196,6 +197,153 @@ TEST(LayoutFile, ShippedLayoutsLoad) {
   ASSERT_TRUE(bench.has_value()) << bench.error().message();
   EXPECT_EQ(bench.value().gateways().size(), 1u);
   EXPECT_EQ(bench.value().buses().size(), 1u);
+}
+
+// The geometry keys (arms, guide cameras, per-robot orientation, arm lengths, measured fibres):
+// optional with the old values as defaults, validated, and written back as they were read.
+const std::string kGeometry = std::string(kHeader) +
+                              "arms: {alpha_length_mm: 7.41, beta_tip_mm: 16.25, beta_collision_mm: 14.7276}\n"
+                              "robots:\n"
+                              "  - {id: 1, x: 0, y: 0, sextant: 1, gateway: 1, bus: 1, fibres: [boss, metrology]}\n"
+                              "  - {id: 2, x: 22.4, y: 0, sextant: 1, gateway: 1, bus: 1, fibres: [boss],\n"
+                              "     orientation_deg: -90.125, alpha_length_mm: 7.3912345, beta_length_mm: 16.19,\n"
+                              "     fibre_offsets: {boss: [14.9655, -0.3811], metrology: [14.3201, 0]}}\n"
+                              "fiducials:\n"
+                              "  - {id: 3, x: 11.2, y: 19.399}\n"
+                              "guide_cameras:\n"
+                              "  - {id: 2, x1: -56.54, y1: 276.26, x2: 56.54, y2: 276.26, buffer_mm: 3.5}\n"
+                              "  - {id: 5, x1: 0, y1: -300, x2: 10, y2: -300}\n";
+
+TEST(LayoutFileGeometry, LoadsArmsRobotGeometryAndGuideCameras) {
+  auto r = load(kGeometry);
+  ASSERT_TRUE(r.has_value()) << r.error().message();
+  const auto& plane = r.value();
+  EXPECT_EQ(plane.arms(), (ArmLengths{7.41, 16.25, 14.7276}));
+  const auto* plain = plane.find(1);
+  EXPECT_EQ(plain->orientation_deg, 0);
+  EXPECT_FALSE(plain->alpha_length_mm.has_value());
+  EXPECT_FALSE(plain->beta_length_mm.has_value());
+  EXPECT_TRUE(plain->fibre_offsets.empty());
+  const auto* measured = plane.find(2);
+  EXPECT_EQ(measured->orientation_deg, -90.125);
+  EXPECT_EQ(measured->alpha_length_mm, 7.3912345);
+  EXPECT_EQ(measured->beta_length_mm, 16.19);
+  ASSERT_EQ(measured->fibre_offsets.size(), 2u);
+  EXPECT_EQ(measured->fibre_offsets[0], (FibreOffset{Fibre::boss, 14.9655, -0.3811}));
+  EXPECT_EQ(measured->fibre_offsets[1], (FibreOffset{Fibre::metrology, 14.3201, 0}));
+  ASSERT_EQ(plane.guide_cameras().size(), 2u);
+  EXPECT_EQ(plane.guide_cameras()[0], (GuideCamera{2, -56.54, 276.26, 56.54, 276.26, 3.5}));
+  EXPECT_EQ(plane.guide_cameras()[1].buffer_mm, 3.0);  // the default
+}
+
+TEST(LayoutFileGeometry, WritesTheGeometryBackExactly) {
+  const auto plane = load(kGeometry).value();
+  const std::string yaml = to_yaml(plane);
+  EXPECT_NE(yaml.find("beta_collision_mm: 14.7276"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("alpha_length_mm: 7.3912345"), std::string::npos) << yaml;  // not cut to 4 decimals
+  EXPECT_NE(yaml.find("guide_cameras:"), std::string::npos) << yaml;
+  const auto again = load(yaml);
+  ASSERT_TRUE(again.has_value()) << again.error().message() << "\n" << yaml;
+  EXPECT_EQ(to_yaml(again.value()), yaml);
+  EXPECT_EQ(again.value().arms(), plane.arms());
+  EXPECT_EQ(again.value().guide_cameras(), plane.guide_cameras());
+  const auto* a = plane.find(2);
+  const auto* b = again.value().find(2);
+  EXPECT_EQ(b->orientation_deg, a->orientation_deg);
+  EXPECT_EQ(b->alpha_length_mm, a->alpha_length_mm);
+  EXPECT_EQ(b->beta_length_mm, a->beta_length_mm);
+  EXPECT_EQ(b->fibre_offsets, a->fibre_offsets);
+}
+
+TEST(LayoutFileGeometry, PlainLayoutsKeepTodaysGeometryAndTheirText) {
+  const std::string plain = std::string(kHeader) + "robots:\n  - {id: 1, x: 0, y: 0, sextant: 1, gateway: 1, bus: 1}\n";
+  const auto plane = load(plain).value();
+  EXPECT_EQ(plane.arms(), ArmLengths{});
+  EXPECT_EQ(plane.arms().beta_collision_mm, 14.7);
+  EXPECT_TRUE(plane.guide_cameras().empty());
+  const std::string yaml = to_yaml(plane);
+  for (const char* key : {"arms:", "guide_cameras", "orientation_deg", "alpha_length_mm", "fibre_offsets"})
+    EXPECT_EQ(yaml.find(key), std::string::npos) << key << " in\n" << yaml;
+}
+
+TEST(LayoutFileGeometry, BadLengthsAndCamerasAreLocatedErrors) {
+  const std::string robot = std::string(kHeader) + "robots:\n  - {id: 1, x: 0, y: 0, sextant: 1, gateway: 1, bus: 1";
+  auto e = error_of(robot + ", alpha_length_mm: -7.4}\n");
+  EXPECT_NE(e.find("bench.yaml:5:"), std::string::npos) << e;
+  EXPECT_NE(e.find("alpha_length_mm"), std::string::npos) << e;
+  EXPECT_NE(e.find("above 0"), std::string::npos) << e;
+  e = error_of(robot + ", beta_length_mm: 0}\n");
+  EXPECT_NE(e.find("beta_length_mm"), std::string::npos) << e;
+  e = error_of(robot + ", fibre_offsets: {gaia: [1, 2]}}\n");
+  EXPECT_NE(e.find("unknown fibre 'gaia'"), std::string::npos) << e;
+  e = error_of(robot + ", fibre_offsets: {boss: [1]}}\n");
+  EXPECT_NE(e.find("[X, Y]"), std::string::npos) << e;
+  e = error_of(robot + "}\narms: {beta_collision_mm: -1}\n");
+  EXPECT_NE(e.find("bench.yaml:6:"), std::string::npos) << e;
+  EXPECT_NE(e.find("beta_collision_mm"), std::string::npos) << e;
+  e = error_of(robot + "}\narms: {beta_colision_mm: 14}\n");
+  EXPECT_NE(e.find("beta_colision_mm"), std::string::npos) << e;
+  const std::string cameras = robot + "}\nguide_cameras:\n";
+  e = error_of(cameras + "  - {id: 1, x1: 5, y1: 7, x2: 5, y2: 7}\n");
+  EXPECT_NE(e.find("bench.yaml:7:"), std::string::npos) << e;
+  EXPECT_NE(e.find("same point"), std::string::npos) << e;
+  e = error_of(cameras + "  - {id: 1, x1: 5, y1: 7, x2: 6, y2: 7, buffer_mm: -1}\n");
+  EXPECT_NE(e.find("buffer_mm must not be negative"), std::string::npos) << e;
+  e = error_of(cameras + "  - {id: 1, x1: 5, y1: 7, x2: 6, y2: 7}\n  - {id: 1, x1: 0, y1: 0, x2: 1, y2: 0}\n");
+  EXPECT_NE(e.find("bench.yaml:8:"), std::string::npos) << e;
+  EXPECT_NE(e.find("already used at line 7"), std::string::npos) << e;
+  e = error_of(cameras + "  - {id: 1, x1: 5, y1: 7, x2: 6}\n");
+  EXPECT_NE(e.find("y2"), std::string::npos) << e;
+}
+
+// Layouts built in code meet the same rules in FocalPlane::build, with typed errors.
+TEST(LayoutFileGeometry, BuildRefusesNonFiniteNegativeAndDegenerateGeometry) {
+  FocalPlaneSpec good;
+  good.name = "code";
+  good.gateways.push_back(GatewaySite{1, "", 0, 4});
+  RobotSite r;
+  r.id = 1;
+  r.sextant = 1;
+  r.bus = BusRef{1, 1};
+  good.robots.push_back(r);
+  ASSERT_TRUE(FocalPlane::build(good).has_value());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto refused = [](FocalPlaneSpec spec, const char* words) {
+    auto p = FocalPlane::build(std::move(spec));
+    ASSERT_FALSE(p.has_value()) << words;
+    EXPECT_EQ(p.error().code, CoreErrc::config_bad_value);
+    EXPECT_NE(p.error().detail.find(words), std::string::npos) << p.error().detail;
+  };
+  auto s = good;
+  s.arms.beta_collision_mm = -14.7;
+  refused(s, "beta collision segment");
+  s = good;
+  s.arms.alpha_length_mm = nan;
+  refused(s, "alpha length");
+  s = good;
+  s.robots[0].alpha_length_mm = std::numeric_limits<double>::infinity();
+  refused(s, "robot 1: alpha length");
+  s = good;
+  s.robots[0].beta_length_mm = 0.0;
+  refused(s, "robot 1: beta length");
+  s = good;
+  s.robots[0].orientation_deg = nan;
+  refused(s, "robot 1: position and orientation");
+  s = good;
+  s.robots[0].x_mm = nan;
+  refused(s, "robot 1: position and orientation");
+  s = good;
+  s.robots[0].fibre_offsets = {{Fibre::boss, 15, 0}, {Fibre::boss, 15, 0.1}};
+  refused(s, "boss fibre position given twice");
+  s = good;
+  s.guide_cameras = {GuideCamera{4, 100, 100, 100, 100, 3}};
+  refused(s, "zero-length");
+  s = good;
+  s.guide_cameras = {GuideCamera{4, 100, 100, 110, 100, nan}};
+  refused(s, "guide camera 4: buffer");
+  s = good;
+  s.guide_cameras = {GuideCamera{4, 100, 100, 110, 100, 3}, GuideCamera{4, 0, 100, 10, 100, 3}};
+  refused(s, "guide camera 4 listed twice");
 }
 
 }  // namespace

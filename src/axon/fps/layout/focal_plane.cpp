@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <set>
+#include <string_view>
 
 namespace axon::fps {
 
@@ -33,11 +35,63 @@ Error bad(std::string what) { return Error(CoreErrc::config_bad_value, std::move
 
 double distance(double ax, double ay, double bx, double by) { return std::hypot(ax - bx, ay - by); }
 
+bool finite(std::initializer_list<double> values) {
+  for (double v : values)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+// A length must be a finite number above zero.
+Result<void> check_length(double v, std::string_view what) {
+  if (!std::isfinite(v) || !(v > 0)) return bad(fmt::format("{} must be a finite length above 0, not {}", what, v));
+  return ok();
+}
+
+Result<void> check_robot_geometry(const RobotSite& r) {
+  if (!finite({r.x_mm, r.y_mm, r.orientation_deg}))
+    return bad(fmt::format("robot {}: position and orientation must be finite numbers", r.id));
+  if (r.alpha_length_mm) {
+    AXON_TRY(check_length(*r.alpha_length_mm, fmt::format("robot {}: alpha length", r.id)));
+  }
+  if (r.beta_length_mm) {
+    AXON_TRY(check_length(*r.beta_length_mm, fmt::format("robot {}: beta length", r.id)));
+  }
+  for (std::size_t i = 0; i < r.fibre_offsets.size(); ++i) {
+    const auto& f = r.fibre_offsets[i];
+    if (!finite({f.x_mm, f.y_mm}))
+      return bad(fmt::format("robot {}: {} fibre position must be finite", r.id, fibre_name(f.fibre)));
+    for (std::size_t j = 0; j < i; ++j)
+      if (r.fibre_offsets[j].fibre == f.fibre)
+        return bad(fmt::format("robot {}: {} fibre position given twice", r.id, fibre_name(f.fibre)));
+  }
+  return ok();
+}
+
+Result<void> check_fixed_geometry(const FocalPlaneSpec& spec) {
+  AXON_TRY(check_length(spec.arms.alpha_length_mm, "arms: alpha length"));
+  AXON_TRY(check_length(spec.arms.beta_tip_mm, "arms: beta tip"));
+  AXON_TRY(check_length(spec.arms.beta_collision_mm, "arms: beta collision segment"));
+  for (const auto& f : spec.fiducials)
+    if (!finite({f.x_mm, f.y_mm})) return bad(fmt::format("fiducial {}: position must be finite", f.id));
+  std::set<int> ids;
+  for (const auto& g : spec.guide_cameras) {
+    if (!ids.insert(g.id).second) return bad(fmt::format("guide camera {} listed twice", g.id));
+    if (!finite({g.x1_mm, g.y1_mm, g.x2_mm, g.y2_mm}))
+      return bad(fmt::format("guide camera {}: end points must be finite", g.id));
+    if (distance(g.x1_mm, g.y1_mm, g.x2_mm, g.y2_mm) < kMinGuideCameraLengthMm)
+      return bad(fmt::format("guide camera {}: its two end points coincide (a zero-length segment)", g.id));
+    if (!std::isfinite(g.buffer_mm) || g.buffer_mm < 0)
+      return bad(fmt::format("guide camera {}: buffer must be finite and not negative, not {}", g.id, g.buffer_mm));
+  }
+  return ok();
+}
+
 }  // namespace
 
 Result<FocalPlane> FocalPlane::build(FocalPlaneSpec spec) {
   if (!(spec.pitch_mm > 0)) return bad(fmt::format("layout '{}': pitch must be positive", spec.name));
   const double min_sep = spec.pitch_mm / 2;
+  AXON_TRY(check_fixed_geometry(spec));
   std::map<std::uint16_t, const GatewaySite*> gateways;
   for (const auto& g : spec.gateways) {
     if (g.channels < 1 || g.channels > kMaxGatewayChannels)
@@ -50,6 +104,7 @@ Result<FocalPlane> FocalPlane::build(FocalPlaneSpec spec) {
     const auto& r = spec.robots[i];
     if (r.id < 1 || r.id > 2047) return bad(fmt::format("robot id {} outside 1..2047", r.id));
     if (!ids.insert(r.id).second) return bad(fmt::format("robot {} listed twice", r.id));
+    AXON_TRY(check_robot_geometry(r));
     if (r.sextant < 1 || r.sextant > kSextants) return bad(fmt::format("robot {}: sextant {} outside 1..6", r.id, r.sextant));
     auto g = gateways.find(r.bus.gateway);
     if (g == gateways.end()) return bad(fmt::format("robot {}: gateway {} is not declared", r.id, r.bus.gateway));

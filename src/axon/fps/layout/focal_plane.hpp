@@ -1,5 +1,7 @@
-// The focal plane as built: where every robot sits, which sextant powers it, which gateway channel
-// (bus) it talks on, which fibres it carries; where the fiducials are; who is whose neighbour.
+// The focal plane as built: where every robot sits and which way it faces, which sextant powers it,
+// which gateway channel (bus) it talks on, which fibres it carries, its arms where metrology
+// measured them; the plane's nominal arm lengths; where the fiducials and the guide cameras are;
+// who is whose neighbour.
 //
 // A FocalPlane is built once (from a layout file, layout_file.hpp, or the generator,
 // layout_generator.hpp) and is immutable afterwards; construction validates it and precomputes
@@ -25,6 +27,8 @@ namespace axon::fps {
 inline constexpr double kDefaultPitchMm = 22.4;
 inline constexpr int kSextants = 6;
 inline constexpr int kMaxGatewayChannels = 4;  // CAN@net NT 420
+// A guide camera's edge shorter than this is taken for a typo (two equal end points).
+inline constexpr double kMinGuideCameraLengthMm = 1e-6;
 
 // One CAN bus of the focal plane: a gateway and one of its channels.
 struct BusRef {
@@ -45,10 +49,26 @@ struct ArmOffsets {
   bool operator==(const ArmOffsets&) const = default;
 };
 
+// A fibre's position on the beta arm as metrology measured it, in the beta-arm frame (x along the
+// arm from the beta axis, y across it towards increasing beta), mm.
+struct FibreOffset {
+  Fibre fibre = Fibre::boss;
+  double x_mm = 0;
+  double y_mm = 0;
+  bool operator==(const FibreOffset&) const = default;
+};
+
 struct RobotSite {
   std::uint16_t id = 0;  // positioner id on the bus, 1..2047
   double x_mm = 0;
   double y_mm = 0;
+  // Direction of the robot's own x axis (alpha = 0), counter-clockwise from the plane's x axis.
+  double orientation_deg = 0;
+  // This robot's arms where metrology measured them (nullopt: the layout's ArmLengths).
+  std::optional<double> alpha_length_mm;  // alpha axis to beta axis
+  std::optional<double> beta_length_mm;   // beta axis to the arm's end; shifts fibres and the
+                                          // collision segment by the difference to beta_tip_mm
+  std::vector<FibreOffset> fibre_offsets; // measured fibre positions (empty: the arm design's)
   int sextant = 0;  // 1..6
   BusRef bus;
   std::vector<Fibre> fibres;
@@ -63,6 +83,25 @@ struct Fiducial {
   int id = 0;
   double x_mm = 0;
   double y_mm = 0;
+};
+
+// The nominal arms of every robot of the plane (the planner's collision body is the segment from
+// the beta axis to beta_collision_mm along the beta arm).
+struct ArmLengths {
+  double alpha_length_mm = 7.4;     // alpha axis to beta axis
+  double beta_tip_mm = 16.2;        // beta axis to the end of the beta arm
+  double beta_collision_mm = 14.7;  // beta axis to the end of the collision segment
+  bool operator==(const ArmLengths&) const = default;
+};
+
+// A guide camera's edge as the robots see it: a fixed segment obstacle with its own buffer (the
+// beta arm's capsule must stay farther than its buffer + this one from the segment).
+struct GuideCamera {
+  int id = 0;
+  double x1_mm = 0, y1_mm = 0;
+  double x2_mm = 0, y2_mm = 0;
+  double buffer_mm = 3.0;
+  bool operator==(const GuideCamera&) const = default;
 };
 
 struct GatewaySite {
@@ -93,14 +132,17 @@ struct FocalPlaneSpec {
   double pitch_mm = kDefaultPitchMm;
   NeighbourOptions neighbours;
   std::vector<GatewaySite> gateways;
+  ArmLengths arms;
   std::vector<RobotSite> robots;
   std::vector<Fiducial> fiducials;
+  std::vector<GuideCamera> guide_cameras;
 };
 
 class FocalPlane {
  public:
-  // Validates (ids unique, positions distinct, sextants 1..6, every robot on a declared gateway's
-  // channel) and precomputes the neighbour lists. Errors: CoreErrc::config_bad_value with the
+  // Validates (ids unique, positions distinct and finite, sextants 1..6, every robot on a declared
+  // gateway's channel; arm lengths finite and positive; guide cameras finite, of non-zero length,
+  // with a non-negative buffer and unique ids) and precomputes the neighbour lists. Errors: CoreErrc::config_bad_value with the
   // offending robot named. The file loader validates first with file:line:col locations; this is
   // the last line of defence for layouts built in code.
   static Result<FocalPlane> build(FocalPlaneSpec spec);
@@ -111,6 +153,8 @@ class FocalPlane {
   [[nodiscard]] const std::vector<RobotSite>& robots() const noexcept { return spec_.robots; }
   [[nodiscard]] const std::vector<Fiducial>& fiducials() const noexcept { return spec_.fiducials; }
   [[nodiscard]] const std::vector<GatewaySite>& gateways() const noexcept { return spec_.gateways; }
+  [[nodiscard]] const ArmLengths& arms() const noexcept { return spec_.arms; }
+  [[nodiscard]] const std::vector<GuideCamera>& guide_cameras() const noexcept { return spec_.guide_cameras; }
   [[nodiscard]] const FocalPlaneSpec& spec() const noexcept { return spec_; }
 
   // nullptr when the id is not in the layout.

@@ -1,6 +1,7 @@
 #include "axon/fps/layout/layout_name.hpp"
 
 #include "axon/core/config.hpp"
+#include "axon/fps/layout/calibration_tables.hpp"
 #include "axon/fps/layout/layout_file.hpp"
 #include "axon/fps/layout/layout_generator.hpp"
 
@@ -34,8 +35,10 @@ Result<FocalPlane> resolve_layout(const std::string& name, const std::string& da
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::is_regular_file(name, ec)) return load_layout_file(name);
+  if (is_calibration_dir(name)) return load_calibration_dir(name);
   if (name != "default" && name != "benchtop")
-    return Error(CoreErrc::invalid_argument, fmt::format("layout '{}': not a file, nor `default` or `benchtop`", name));
+    return Error(CoreErrc::invalid_argument,
+                 fmt::format("layout '{}': not a file, a directory of calibration tables, nor `default` or `benchtop`", name));
   if (!data_dir.empty()) {
     const fs::path shipped = fs::path(data_dir) / "layouts" / (name + ".yaml");
     if (fs::is_regular_file(shipped, ec)) return load_layout_file(shipped.string());

@@ -1,4 +1,5 @@
-// Layouts by name, as a program or the command line names them: a file path, or `default` /
+// Layouts by name, as a program or the command line names them: a file path, a directory of
+// calibration tables (calibration_tables.hpp: positionerTable.csv and its companions), or `default` /
 // `benchtop`, the two layouts axon ships (data/layouts). Without the data folder, `default` is
 // generated (layout_generator.hpp) and `benchtop` comes from a copy built into the library, so a
 // program that never saw the source tree can still start a simulated plane of either.

@@ -63,7 +63,9 @@ Positioner::Positioner(const RobotSpec& spec, const ArmDesign& design)
       tip_len_(design.beta_tip_mm + spec.calibration.beta_length_delta_mm) {
   fibres_.reserve(design.fibres.size());
   for (const auto& f : design.fibres) {
-    const Vec2 o{f.offset.x + spec.calibration.beta_length_delta_mm, f.offset.y};
+    Vec2 o{f.offset.x + spec.calibration.beta_length_delta_mm, f.offset.y};
+    for (const auto& m : spec.calibration.fibres)
+      if (iequal(m.name, f.name)) o = m.offset;
     fibres_.push_back({norm(o), std::atan2(o.y, o.x), o});
   }
 }

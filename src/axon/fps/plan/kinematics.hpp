@@ -11,7 +11,7 @@
 // - Per-robot calibration adds zero offsets to the commanded angles and length corrections to the
 //   arms: world alpha = orientation + alpha + alpha_offset; beta arm direction = world alpha +
 //   beta + beta_offset; alpha arm length = nominal + alpha_length_delta; every x on the beta arm is
-//   shifted by beta_length_delta.
+//   shifted by beta_length_delta, except fibres whose measured position the calibration gives.
 //
 // A Positioner precomputes what its hot paths need, so forward kinematics, the collision segment
 // and inverse kinematics never allocate.
@@ -62,6 +62,11 @@ struct RobotCalibration {
   double beta_offset_deg = 0;
   double alpha_length_delta_mm = 0;
   double beta_length_delta_mm = 0;
+  // Measured fibre positions on this robot's beta arm, matched to the design's fibres by name
+  // (case-insensitive); taken as they are (beta_length_delta_mm does not move them). Fibres not
+  // listed keep the design's offset shifted by beta_length_delta_mm; names the design lacks are
+  // ignored.
+  std::vector<Fibre> fibres;
 };
 
 // The commanded angle range a planner may use (inside the hard stops; see docs/fps-plan.md).

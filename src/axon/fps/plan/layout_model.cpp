@@ -1,6 +1,30 @@
 #include "axon/fps/plan/layout_model.hpp"
 
+#include <fmt/format.h>
+
 namespace axon::fps::plan {
+
+ArmDesign design_of(const FocalPlane& plane, const LayoutModelOptions& o) {
+  ArmDesign d;
+  d.alpha_length_mm = plane.arms().alpha_length_mm;
+  d.beta_tip_mm = plane.arms().beta_tip_mm;
+  d.beta_collision_mm = plane.arms().beta_collision_mm;
+  d.fibres = o.fibres;
+  return d;
+}
+
+RobotCalibration calibration_of(const RobotSite& r, const ArmLengths& arms) {
+  RobotCalibration c;
+  c.orientation_deg = r.orientation_deg;
+  if (r.offsets) {
+    c.alpha_offset_deg = r.offsets->alpha_deg;
+    c.beta_offset_deg = r.offsets->beta_deg;
+  }
+  if (r.alpha_length_mm) c.alpha_length_delta_mm = *r.alpha_length_mm - arms.alpha_length_mm;
+  if (r.beta_length_mm) c.beta_length_delta_mm = *r.beta_length_mm - arms.beta_tip_mm;
+  for (const auto& f : r.fibre_offsets) c.fibres.push_back({std::string(fibre_name(f.fibre)), {f.x_mm, f.y_mm}});
+  return c;
+}
 
 Result<CollisionModel> model_from_layout(const FocalPlane& plane, const LayoutModelOptions& o) {
   std::vector<RobotSpec> robots;
@@ -9,17 +33,17 @@ Result<CollisionModel> model_from_layout(const FocalPlane& plane, const LayoutMo
     RobotSpec s;
     s.id = r.id;
     s.centre = {r.x_mm, r.y_mm};
-    if (r.offsets) {
-      s.calibration.alpha_offset_deg = r.offsets->alpha_deg;
-      s.calibration.beta_offset_deg = r.offsets->beta_deg;
-    }
+    s.calibration = calibration_of(r, plane.arms());
     s.limits = o.limits;
     s.buffer_mm = o.buffer_mm;
-    robots.push_back(s);
+    robots.push_back(std::move(s));
   }
   std::vector<FiducialSpec> fiducials;
   for (const auto& f : plane.fiducials()) fiducials.push_back({f.id, {f.x_mm, f.y_mm}, o.fiducial_buffer_mm});
-  return CollisionModel::build(robots, o.design, fiducials);
+  std::vector<ObstacleSpec> cameras;
+  for (const auto& g : plane.guide_cameras())
+    cameras.push_back({fmt::format("guide camera {}", g.id), {{g.x1_mm, g.y1_mm}, {g.x2_mm, g.y2_mm}}, g.buffer_mm});
+  return CollisionModel::build(robots, design_of(plane, o), fiducials, cameras);
 }
 
 std::vector<bool> frozen_robots(const FocalPlane& plane) {

@@ -1,5 +1,9 @@
-// The focal-plane layout (src/axon/fps/layout) as the planner sees it: robots, fiducials, and which
-// robots must not move.
+// The focal-plane layout (src/axon/fps/layout) as the planner sees it: robots with their own
+// geometry, the plane's arms, fiducials, guide cameras, and which robots must not move.
+//
+// One geometry model: the CollisionModel built here is what the planner, the checker, target
+// validation and the host's plan-and-move use, so a layout's per-robot orientation, arm lengths,
+// measured fibres and its guide cameras reach every one of them.
 #pragma once
 
 #include "axon/fps/layout/focal_plane.hpp"
@@ -10,13 +14,21 @@
 namespace axon::fps::plan {
 
 struct LayoutModelOptions {
-  ArmDesign design{};
+  // The fibres of the arm design (the arm lengths come from the layout's `arms`).
+  std::vector<Fibre> fibres = ArmDesign::default_fibres();
   double buffer_mm = 2.0;           // every robot's collision buffer
   double fiducial_buffer_mm = 3.0;
   AngleLimits limits{};
 };
 
-// Robots in layout order (per-robot arm offsets become calibration offsets).
+// The arm design of the layout: its ArmLengths with the options' fibres.
+ArmDesign design_of(const FocalPlane& plane, const LayoutModelOptions& options = {});
+// One robot's calibration: orientation, arm offsets, length corrections against the layout's arms
+// (alpha_length_mm - arms.alpha_length_mm, beta_length_mm - arms.beta_tip_mm), measured fibres.
+RobotCalibration calibration_of(const RobotSite& robot, const ArmLengths& arms);
+
+// Robots in layout order; fiducials become point obstacles (fiducial_buffer_mm), guide cameras
+// segment obstacles named "guide camera <id>" with their own buffers.
 Result<CollisionModel> model_from_layout(const FocalPlane& plane, const LayoutModelOptions& options = {});
 // Disabled and offline robots, in layout order: they stay where they are.
 std::vector<bool> frozen_robots(const FocalPlane& plane);

@@ -12,8 +12,6 @@ namespace axon::fps::plan {
 
 namespace {
 
-constexpr double kTiny = 1e-4;        // mm: the certificate keeps this much above zero
-constexpr double kResolution = 0.01;  // mm: bound below which a sub-step counts as resolved
 constexpr int kMaxDepth = 8;          // halvings per step and pair
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kClrW = 1.0;   // escape score: clearance opened (mm, capped at 5)
@@ -263,9 +261,9 @@ void Stepper::hold_or_dodge(std::size_t i) {
 
 bool Stepper::certify(std::size_t i, Pose i0, Pose i1, double c0, double c1, std::size_t j, Pose j0, Pose j1,
                       double limit, double s, int depth) {
-  if (c0 + c1 - s >= 2 * kTiny) return true;
+  if (c0 + c1 - s >= 2 * kCertifyTinyMm) return true;
   if (c0 < 0 || c1 < 0) return false;
-  if (s <= kResolution) return true;  // a dip of at most kResolution / 2 between two clear samples
+  if (s <= kCertifyResolutionMm) return true;  // a dip of at most kCertifyResolutionMm / 2 between two clear samples
   if (depth >= kMaxDepth) return false;
   const Pose im = lerp(i0, i1, 0.5), jm = lerp(j0, j1, 0.5);
   const double cm = segment_distance(m_.robot(i).collision_segment(im), m_.robot(j).collision_segment(jm)) - limit;
@@ -276,9 +274,9 @@ bool Stepper::certify(std::size_t i, Pose i0, Pose i1, double c0, double c1, std
 
 bool Stepper::certify_obstacle(std::size_t i, Pose i0, Pose i1, double c0, double c1, const Segment& ob,
                                double limit, double s, int depth) {
-  if (c0 + c1 - s >= 2 * kTiny) return true;
+  if (c0 + c1 - s >= 2 * kCertifyTinyMm) return true;
   if (c0 < 0 || c1 < 0) return false;
-  if (s <= kResolution) return true;
+  if (s <= kCertifyResolutionMm) return true;
   if (depth >= kMaxDepth) return false;
   const Pose im = lerp(i0, i1, 0.5);
   const double cm = segment_distance(m_.robot(i).collision_segment(im), ob) - limit;
@@ -306,7 +304,7 @@ Stepper::Feasibility Stepper::feasible(std::size_t i, Pose p1, const Segment& s1
     // Lower bounds from the segments' midpoints: enough for the pairs that are far apart.
     const double lb0 = norm(mid(s0) - mid(sj0)) - hi - hj - limit;
     const double lb1 = norm(mid(s1) - mid(sj1)) - hi - hj - limit;
-    if (lb1 >= o_.margin_mm && lb0 + lb1 - s >= 2 * kTiny && (!want_clearance || lb1 >= 5.0)) {
+    if (lb1 >= o_.margin_mm && lb0 + lb1 - s >= 2 * kCertifyTinyMm && (!want_clearance || lb1 >= 5.0)) {
       f.min_clearance = std::min(f.min_clearance, lb1);
       continue;
     }
@@ -328,7 +326,7 @@ Stepper::Feasibility Stepper::feasible(std::size_t i, Pose p1, const Segment& s1
     const Segment& ob = obstacles[op.obstacle].shape;
     const double c1 = segment_distance(s1, ob) - op.limit_mm;
     f.min_clearance = std::min(f.min_clearance, c1);
-    if (c1 >= 2 * trav + o_.margin_mm + 2 * kTiny) continue;  // c0 >= c1 - trav
+    if (c1 >= 2 * trav + o_.margin_mm + 2 * kCertifyTinyMm) continue;  // c0 >= c1 - trav
     const double c0 = segment_distance(s0, ob) - op.limit_mm;
     if (!(c1 >= std::min(o_.margin_mm, c0) && certify_obstacle(i, p0, p1, c0, c1, ob, op.limit_mm, trav, 0))) {
       f.ok = false;

@@ -34,6 +34,10 @@
 
 namespace axon::fps::plan {
 
+// The step certificate's constants, shared by the engine and the untangle (untangle.hpp):
+inline constexpr double kCertifyTinyMm = 1e-4;        // the certificate keeps this much above zero
+inline constexpr double kCertifyResolutionMm = 0.01;  // a sub-step this short counts as resolved
+
 struct StepperRobot {
   Pose start;
   Pose goal;

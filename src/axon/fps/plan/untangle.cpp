@@ -12,8 +12,6 @@ namespace axon::fps::plan {
 
 namespace {
 
-constexpr double kTiny = 1e-4;        // mm: the certificate keeps this much above zero
-constexpr double kResolution = 0.01;  // mm: as the engine (stepper.cpp)
 constexpr double kFineMargin = 0.01;  // mm: margin of the finer grids (the certificate still holds)
 
 struct Fixed {
@@ -119,9 +117,9 @@ class RobotGrid {
   [[nodiscard]] bool edge_ok(Pose p0, Pose p1, double c0, double c1, int depth = 0) const noexcept {
     const double s = (std::abs(p1.alpha_deg - p0.alpha_deg) * r_.reach_mm() +
                       std::abs(p1.beta_deg - p0.beta_deg) * r_.collision_length_mm()) * kRad;
-    if (c0 + c1 - s >= 2 * kTiny) return true;
+    if (c0 + c1 - s >= 2 * kCertifyTinyMm) return true;
     if (c0 < 0 || c1 < 0) return false;
-    if (s <= kResolution) return true;  // a dip of at most kResolution / 2 between two clear ends
+    if (s <= kCertifyResolutionMm) return true;  // a dip of at most kCertifyResolutionMm / 2 between two clear ends
     if (depth >= 8) return false;
     const Pose m{0.5 * (p0.alpha_deg + p1.alpha_deg), 0.5 * (p0.beta_deg + p1.beta_deg)};
     const double cm = clearance(m);
