@@ -48,7 +48,11 @@ MotorBoardOptions board_options() {
 
 // The disable travels over socketcand: the board applies it a moment after the host sent it.
 void expect_board_off(const sim::SimulatedBoard& sim) {
-  for (int i = 0; i < 300 && sim.report().status.system_enabled; ++i) std::this_thread::sleep_for(10ms);
+  const auto off = [&] {
+    const auto r = sim.report();
+    return !r.status.system_enabled && !r.motors[0].enabled && !r.motors[1].enabled;
+  };
+  for (int i = 0; i < 300 && !off(); ++i) std::this_thread::sleep_for(10ms);
   const auto r = sim.report();
   EXPECT_FALSE(r.status.system_enabled);
   EXPECT_FALSE(r.motors[0].enabled);
@@ -144,6 +148,37 @@ TEST(BlmcMotorBoard, ABoardFaultIsAReportedSafetyStopNotAnException) {
   board.recover();
   EXPECT_EQ(board.wait_status().error, protocol::ErrorCode::none);
   EXPECT_TRUE(sim.report().status.system_enabled);
+  board.disable();
+  expect_board_off(sim);
+}
+
+// The board reports an error with the code the spec leaves undefined (6). The host stops the loop
+// on that status frame (not seconds later on stale data), zeroes the current, names the code, and
+// a recovery while the cause lasts is refused in the same words.
+TEST(BlmcMotorBoard, AnUndocumentedErrorCodeIsASafetyStopNamingIt) {
+  sim::SimulatedBoard sim(sim_options());
+  MotorBoard board(sim.bus_spec(), board_options());
+  board.enable();
+  auto s = settings();
+  s.limits.stale_after = 3s;  // the status (once a second) comes before the data would count as stale
+  board.start_control([](const ControlState&) { return Command{MotorCommand::current(0.1), MotorCommand::current(0)}; },
+                      s);
+  for (int i = 0; i < 300 && sim.report().motors[0].iq_ref_a == 0.0; ++i) std::this_thread::sleep_for(10ms);
+  sim.inject(sim::FaultKind::undocumented, 0, 10s);
+  for (int i = 0; i < 300 && board.control_running(); ++i) std::this_thread::sleep_for(10ms);
+  const auto report = board.stop_control();
+  ASSERT_TRUE(report.fault);
+  EXPECT_EQ(report.fault->kind, host::FaultKind::undocumented_error) << report.fault_text;
+  EXPECT_EQ(report.fault_text, "board sent undocumented error code 6");
+  EXPECT_EQ(sim.report().motors[0].iq_ref_a, 0.0);  // the host's zero reached the board
+  EXPECT_GE(board.measurements().undocumented_errors, 1u);
+  try {
+    board.recover();
+    FAIL() << "recovered while the board still reports code 6";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), HostErrc::board_error);
+    EXPECT_NE(std::string(e.what()).find("undocumented error code 6"), std::string::npos) << e.what();
+  }
   board.disable();
   expect_board_off(sim);
 }

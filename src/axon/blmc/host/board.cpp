@@ -197,8 +197,8 @@ asio::awaitable<Result<void>> Board::wait_until(core::TimePoint deadline, const 
 
 asio::awaitable<Result<protocol::Status>> Board::wait_status(core::Duration timeout) {
   if (cyclic_) co_return Error(HostErrc::cyclic_active, options_.name);
-  const auto start = state_.status.count;
-  auto r = co_await wait_until(clock_->now() + timeout, [&] { return state_.status.count > start; });
+  const auto start = state_.status_byte.count;
+  auto r = co_await wait_until(clock_->now() + timeout, [&] { return state_.status_byte.count > start; });
   if (!r) {
     auto e = r.error();
     if (e == HostErrc::timeout)
@@ -206,6 +206,7 @@ asio::awaitable<Result<protocol::Status>> Board::wait_status(core::Duration time
                              std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count());
     co_return e;
   }
+  if (state_.undocumented_error()) co_return status_error();
   co_return state_.status.value;
 }
 
@@ -222,41 +223,35 @@ asio::awaitable<Result<void>> Board::wait_data(core::Duration timeout, std::uint
   co_return r;
 }
 
+Error Board::status_error() const {
+  if (state_.undocumented_error())
+    return Error(HostErrc::board_error, fmt::format("{}: board sent undocumented error code {}", options_.name,
+                                                    unsigned{protocol::error_bits(state_.status_byte.value)}));
+  return Error(HostErrc::board_error,
+               fmt::format("{}: board error {}", options_.name, protocol::name(state_.status.value.error)));
+}
+
 asio::awaitable<Result<void>> Board::wait_ready(core::Duration timeout) {
   if (cyclic_) co_return Error(HostErrc::cyclic_active, options_.name);
-  const auto start = state_.status.count;
+  const auto start = state_.status_byte.count;
   const auto deadline = clock_->now() + timeout;
   auto ready = [&](const protocol::Status& s) {
     return s.system_enabled && (!options_.motors[0] || (s.motor1_enabled && s.motor1_ready)) &&
            (!options_.motors[1] || (s.motor2_enabled && s.motor2_ready));
   };
-  for (;;) {
-    auto r = co_await wait_until(deadline, [&] { return state_.status.count > start; });
+  // Every status frame after the call until one shows the motors ready or an error.
+  for (auto seen = start;; seen = state_.status_byte.count) {
+    auto r = co_await wait_until(deadline, [&] { return state_.status_byte.count > seen; });
     if (!r) {
       if (r.error() != HostErrc::timeout) co_return r.error();
-      if (state_.status.count > start)
+      if (state_.status_byte.count > start)
         co_return Error(HostErrc::not_ready, fmt::format("{}: not ready after {} ms: {}", options_.name,
                                                          std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count(),
                                                          state_.status.value.to_string()));
       co_return Error(HostErrc::timeout, fmt::format("{}: no status frame while waiting for ready", options_.name));
     }
-    const auto& s = state_.status.value;
-    if (s.error != protocol::ErrorCode::none)
-      co_return Error(HostErrc::board_error, fmt::format("{}: board error {}", options_.name, protocol::name(s.error)));
-    if (ready(s)) co_return ok();
-    // Not ready yet: wait for a later status.
-    const auto seen = state_.status.count;
-    auto r2 = co_await wait_until(deadline, [&] { return state_.status.count > seen; });
-    if (!r2) {
-      if (r2.error() != HostErrc::timeout) co_return r2.error();
-      co_return Error(HostErrc::not_ready, fmt::format("{}: not ready after {} ms: {}", options_.name,
-                                                       std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count(),
-                                                       state_.status.value.to_string()));
-    }
-    const auto& s2 = state_.status.value;
-    if (s2.error != protocol::ErrorCode::none)
-      co_return Error(HostErrc::board_error, fmt::format("{}: board error {}", options_.name, protocol::name(s2.error)));
-    if (ready(s2)) co_return ok();
+    if (state_.undocumented_error() || state_.status.value.error != protocol::ErrorCode::none) co_return status_error();
+    if (ready(state_.status.value)) co_return ok();
   }
 }
 

@@ -113,10 +113,11 @@ class Board {
   // wait_ready(ready_timeout).
   asio::awaitable<Result<void>> enable();
   // Waits for a status frame newer than the call showing the system and the used motors enabled
-  // and ready. board_error (naming the code) when it carries an error, not_ready after the timeout
-  // (timeout when no status came at all).
+  // and ready. board_error (naming the code, or the undocumented code 6) when it carries an
+  // error, not_ready after the timeout (timeout when no status came at all).
   asio::awaitable<Result<void>> wait_ready(core::Duration timeout);
-  // The next status frame.
+  // The next status frame; board_error when it carries the undocumented error code 6 (which a
+  // protocol::Status cannot hold).
   asio::awaitable<Result<protocol::Status>> wait_status(core::Duration timeout);
   // Waits until `n` more measurement frames (current, position, velocity, ADC) arrived.
   asio::awaitable<Result<void>> wait_data(core::Duration timeout, std::uint64_t n = 1);
@@ -155,6 +156,8 @@ class Board {
 
  private:
   asio::awaitable<Result<void>> wait_until(core::TimePoint deadline, const std::function<bool()>& done);
+  // board_error naming the latest status frame's error code (documented or not).
+  [[nodiscard]] Error status_error() const;
   asio::awaitable<void> tx_pump(std::shared_ptr<Shared> shared);
 
   can::Bus* bus_;
