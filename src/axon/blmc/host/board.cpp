@@ -130,9 +130,16 @@ Board::~Board() {
   if (motors_on_) queue_disable();
 }
 
+std::vector<can::Frame> Board::shutdown_frames() const {
+  auto frames = disable_frames();
+  if (onboard_used_)
+    for (const auto& f : onboard_reset_frames()) frames.push_back(f);
+  return frames;
+}
+
 void Board::queue_disable() {
   if (closed_ || !bus_->is_open()) return;
-  asio::co_spawn(bus_->get_executor(), send_all(bus_, bus_->destroyed_flag(), disable_frames()), asio::detached);
+  asio::co_spawn(bus_->get_executor(), send_all(bus_, bus_->destroyed_flag(), shutdown_frames()), asio::detached);
 }
 
 void Board::interrupt() noexcept {
@@ -305,12 +312,50 @@ asio::awaitable<Result<void>> Board::disable() {
     auto r = co_await stop_cyclic();
     if (!r) first = r;
   }
-  for (const auto& f : disable_frames()) {
+  for (const auto& f : shutdown_frames()) {
     auto r = co_await send_frame(f);
     if (!r && first) first = r;
   }
   if (first) motors_on_ = false;
   co_return first;
+}
+
+// ---- the board's own controller and switches ---------------------------------------------------
+
+asio::awaitable<Result<void>> Board::send_onboard(Result<std::vector<can::Frame>> frames) {
+  if (cyclic_) co_return Error(HostErrc::cyclic_active, fmt::format("{}: on-board controller", options_.name));
+  if (!frames) co_return Error(frames.error().code, fmt::format("{}: {}", options_.name, frames.error().detail));
+  onboard_used_ = true;
+  for (const auto& f : frames.value()) {
+    auto r = co_await send_frame(f);
+    if (!r) co_return r;
+  }
+  co_return ok();
+}
+
+asio::awaitable<Result<void>> Board::set_onboard_gains(OnboardGains gains) {
+  auto r = co_await send_onboard(onboard_frames(gains));
+  co_return r;
+}
+
+asio::awaitable<Result<void>> Board::set_onboard_references(OnboardReferences refs) {
+  auto r = co_await send_onboard(onboard_frames(refs, state_.unwrap));
+  co_return r;
+}
+
+asio::awaitable<Result<void>> Board::set_onboard_current_limits(OnboardCurrentLimits limits) {
+  auto r = co_await send_onboard(onboard_frames(limits));
+  co_return r;
+}
+
+asio::awaitable<Result<void>> Board::set_virtual_springs(std::array<bool, 2> on) {
+  auto r = co_await send_onboard(virtual_spring_frames(on));
+  co_return r;
+}
+
+asio::awaitable<Result<void>> Board::set_rollover_error(bool on) {
+  auto r = co_await send_frame(rollover_error_frame(on));
+  co_return r;
 }
 
 // ---- cyclic mode --------------------------------------------------------------------------------

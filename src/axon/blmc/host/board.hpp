@@ -29,6 +29,7 @@
 #pragma once
 
 #include "axon/blmc/host/measurements.hpp"
+#include "axon/blmc/host/onboard.hpp"
 #include "axon/blmc/host/rt_link.hpp"
 #include "axon/blmc/protocol/command.hpp"
 #include "axon/blmc/protocol/frames.hpp"
@@ -137,6 +138,17 @@ class Board {
   void interrupt() noexcept;
   void clear_interrupt() noexcept { interrupted_ = false; }
   [[nodiscard]] bool interrupted() const noexcept { return interrupted_; }
+  // ---- the board's own controller and switches (onboard.hpp), coroutine mode. Each checks its
+  // values first (HostErrc::invalid_argument in words; nothing is sent then) and sends its frames
+  // in order. Once one of them went out, disable() and the destructor's queued disable also send
+  // onboard_reset_frames() (controller limits 0, springs off) after the usual frames.
+  asio::awaitable<Result<void>> set_onboard_gains(OnboardGains gains);
+  // Position references in the host's positions (latest().position), see onboard.hpp.
+  asio::awaitable<Result<void>> set_onboard_references(OnboardReferences refs);
+  asio::awaitable<Result<void>> set_onboard_current_limits(OnboardCurrentLimits limits);
+  asio::awaitable<Result<void>> set_rollover_error(bool on);
+  asio::awaitable<Result<void>> set_virtual_springs(std::array<bool, 2> on);
+
   // The state decoded so far (coroutine mode; in cyclic mode port().latest() is current).
   [[nodiscard]] const Measurements& latest() const noexcept { return state_; }
 
@@ -156,6 +168,8 @@ class Board {
 
  private:
   asio::awaitable<Result<void>> wait_until(core::TimePoint deadline, const std::function<bool()>& done);
+  asio::awaitable<Result<void>> send_onboard(Result<std::vector<can::Frame>> frames);
+  [[nodiscard]] std::vector<can::Frame> shutdown_frames() const;
   // board_error naming the latest status frame's error code (documented or not).
   [[nodiscard]] Error status_error() const;
   asio::awaitable<void> tx_pump(std::shared_ptr<Shared> shared);
@@ -174,6 +188,7 @@ class Board {
   bool closed_ = false;
   bool motors_on_ = false;  // we enabled motors and did not disable them yet
   bool interrupted_ = false;
+  bool onboard_used_ = false;  // a set_onboard_* / set_virtual_springs call sent its frames
 };
 
 }  // namespace axon::blmc::host
