@@ -295,6 +295,21 @@ TEST(BlmcMotorBoard, RefusesOnboardSettingsItCannotSendInWords) {
   (void)board.stop_control();
 }
 
+// The spec's command table gives ENABLE_SYS the default 1; the simulator powers up with the system
+// off unless asked. The host relies on neither: its enable sends ENABLE_SYS=1, and its disable
+// leaves off also a board that came up with the system on.
+TEST(BlmcMotorBoard, ABoardPoweringUpWithTheSystemOnAsDocumentedIsEnabledAndLeftOff) {
+  auto so = sim_options();
+  so.config.system_enabled_at_power_up = true;
+  sim::SimulatedBoard sim(so);
+  MotorBoard board(sim.bus_spec(), board_options());
+  EXPECT_TRUE(board.wait_status().system_enabled);
+  board.enable();
+  EXPECT_TRUE(sim.report().motors[0].ready && sim.report().motors[1].ready);
+  board.disable();
+  expect_board_off(sim);
+}
+
 TEST(BlmcMotorBoard, HomingFindsEachMotorsIndexOffset) {
   auto o = sim_options();
   o.config.motors[0].index_offset_rev = 0.25;

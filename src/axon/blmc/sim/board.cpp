@@ -39,11 +39,14 @@ BoardFaultPlan checked(BoardFaultPlan p) {
 
 Board::Board(BoardConfig config, BoardFaultPlan faults)
     : config_(checked(std::move(config))), plan_(checked(std::move(faults))), rng_(plan_.seed),
-      motors_{MotorModel(config_.motors[0]), MotorModel(config_.motors[1])} {}
+      motors_{MotorModel(config_.motors[0]), MotorModel(config_.motors[1])} {
+  settings_.system_enabled = config_.system_enabled_at_power_up;
+}
 
 void Board::reset_firmware() {
   state_ = {};
   settings_ = {};
+  settings_.system_enabled = config_.system_enabled_at_power_up;
   faults_ = {};
   over_current_ = false;
   undocumented_ = false;
