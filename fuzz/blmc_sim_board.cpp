@@ -6,7 +6,7 @@
 //      become 0x0A..0x7FF or, with op bit 2, an extended identifier), one byte the length (% 10,
 //      lengths above 8 are rejected by can::Frame and skipped), then that many payload bytes
 //   1  time step: one byte of milliseconds (x 16 when op bit 2 is set)
-//   2  fault: one byte (kind % 4; bit 2 a one-second cause, bit 3 persistent); op bit 2 power-cycles instead
+//   2  fault: one byte (kind % 5; bit 4 a one-second cause, bit 5 persistent); op bit 2 power-cycles instead
 //   3  shaft state of a motor: one byte (bit 0 motor), one byte position, one byte velocity
 // Nothing may crash, every frame the board sends must decode as a board message, and the motors'
 // state must stay finite with readings within +-100 revolutions.
@@ -63,8 +63,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if ((op & 4) != 0) {
           board.power_cycle();
         } else {
-          board.inject(static_cast<sim::FaultKind>(b % 4), (b & 4) != 0 ? std::chrono::seconds(1) : sim::BoardTime{0},
-                       (b & 8) != 0);
+          board.inject(static_cast<sim::FaultKind>(b % 5), (b & 16) != 0 ? std::chrono::seconds(1) : sim::BoardTime{0},
+                       (b & 32) != 0);
         }
         break;
       }

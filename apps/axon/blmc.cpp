@@ -31,6 +31,7 @@
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <utility>
 
 namespace axon::app {
 namespace {
@@ -39,6 +40,14 @@ using namespace std::chrono_literals;
 namespace bh = blmc::host;
 namespace bp = blmc::protocol;
 using json = nlohmann::json;
+
+// `onboard`: what to set on the board's own controller; each pair is (motor 1, motor 2), empty when
+// not given.
+struct Onboard {
+  std::vector<double> kp, kd, position, velocity, p_limit, d_limit;
+  std::vector<int> springs;
+  int rollover_error = -1;  // -1: leave it
+};
 
 struct BlmcOptions {
   std::string bus;
@@ -69,6 +78,7 @@ struct BlmcOptions {
   double home_timeout_s = 20;
   std::string raw_text;
   std::string record_file;
+  Onboard onboard;
 };
 
 std::string bus_text(const BlmcOptions& o) {
@@ -493,6 +503,61 @@ asio::awaitable<int> cmd_raw(Session& s) {
   co_return written ? exit_code_value::ok : exit_code_value::failed;
 }
 
+bh::MotorPair pair_of(const std::vector<double>& v) { return {v.at(0), v.at(1)}; }
+
+// `onboard`: the settings given, in this order, each through the library (which checks the
+// values first); what was sent is printed as one line each (one JSON object with --json).
+asio::awaitable<int> cmd_onboard(Session& s) {
+  const auto& o = s.o().onboard;
+  if (o.rollover_error < 0 && o.position.empty() && o.kp.empty() && o.p_limit.empty() && o.springs.empty())
+    throw Exception(usage("onboard: give at least one of --kp/--kd, --position/--velocity, --p-limit/--d-limit, "
+                          "--springs, --rollover-error"));
+  auto& b = *s.board;
+  json sent = json::object();
+  std::vector<std::string> lines;
+  const auto note = [&](const char* key, const std::vector<double>& v, const char* unit) {
+    sent[key] = json::array({v.at(0), v.at(1)});
+    lines.push_back(fmt::format("set {} {:g} {:g} {}", key, v.at(0), v.at(1), unit));
+  };
+  if (o.rollover_error >= 0) {
+    auto r = co_await b.set_rollover_error(o.rollover_error == 1);
+    need(std::move(r));
+    sent["rollover_error"] = o.rollover_error == 1;
+    lines.push_back(fmt::format("set rollover_error {}", o.rollover_error));
+  }
+  if (!o.position.empty()) {
+    auto r = co_await b.set_onboard_references({pair_of(o.position), pair_of(o.velocity)});
+    need(std::move(r));
+    note("position", o.position, "rev");
+    note("velocity", o.velocity, "krpm");
+  }
+  if (!o.kp.empty()) {
+    auto r = co_await b.set_onboard_gains({pair_of(o.kp), pair_of(o.kd)});
+    need(std::move(r));
+    note("kp", o.kp, "A/rev");
+    note("kd", o.kd, "A/krpm");
+  }
+  if (!o.p_limit.empty()) {
+    auto r = co_await b.set_onboard_current_limits({pair_of(o.p_limit), pair_of(o.d_limit)});
+    need(std::move(r));
+    note("p_limit", o.p_limit, "A");
+    note("d_limit", o.d_limit, "A");
+  }
+  if (!o.springs.empty()) {
+    auto r = co_await b.set_virtual_springs({o.springs.at(0) != 0, o.springs.at(1) != 0});
+    need(std::move(r));
+    sent["springs"] = json::array({o.springs.at(0) == 1, o.springs.at(1) == 1});
+    lines.push_back(fmt::format("set springs {} {}", o.springs.at(0), o.springs.at(1)));
+  }
+  if (s.out().is_json()) {
+    sent["type"] = "onboard";
+    co_return s.out().emit(sent) ? exit_code_value::ok : exit_code_value::failed;
+  }
+  for (const auto& line : lines)
+    if (!s.out().emit(line)) co_return exit_code_value::failed;
+  co_return exit_code_value::ok;
+}
+
 // How a subcommand ends on SIGINT/SIGTERM/SIGHUP: observers (monitor, record) end normally (exit 0),
 // motion commands check the loop options first; every other command exits 128+N.
 enum class Kind { plain, observe, motion };
@@ -580,12 +645,36 @@ void add_motion_commands(CLI::App* b, GlobalOptions& global, const std::shared_p
   home->add_option("--timeout", o.home_timeout_s, "seconds (default 20)")->check(positive());
 }
 
+// Each option takes motor 1's value, then motor 2's.
+void add_onboard_command(CLI::App* b, GlobalOptions& global, const std::shared_ptr<Blmc>& cli) {
+  auto& o = cli->o.onboard;
+  auto* c = add(b, global, cli, "onboard",
+                "set the board's own controller (optional in the spec), rollover error, virtual springs", Kind::plain,
+                cmd_onboard);
+  const auto pair = [c](const char* name, std::vector<double>& v, const char* help) {
+    return c->add_option(name, v, help)->expected(2);
+  };
+  auto* kp = pair("--kp", o.kp, "KP per motor, A/rev (with --kd)");
+  auto* kd = pair("--kd", o.kd, "KD per motor, A/krpm (with --kp)");
+  auto* pos = pair("--position", o.position, "POS_REF per motor, rev (with --velocity)");
+  auto* vel = pair("--velocity", o.velocity, "VEL_REF per motor, krpm (with --position)");
+  auto* pl = pair("--p-limit", o.p_limit, "P term current limit per motor, A (with --d-limit)");
+  auto* dl = pair("--d-limit", o.d_limit, "D term current limit per motor, A (with --p-limit)");
+  for (auto [one, other] : {std::pair{kp, kd}, std::pair{pos, vel}, std::pair{pl, dl}}) {
+    one->needs(other);
+    other->needs(one);
+  }
+  c->add_option("--springs", o.springs, "virtual spring per motor, 1 = on, 0 = off")->expected(2)->check(CLI::Range(0, 1));
+  c->add_option("--rollover-error", o.rollover_error, "1: the board stops itself at the +-100 rev rollover, 0: not")
+      ->check(CLI::Range(0, 1));
+}
+
 }  // namespace
 
 void add_blmc_commands(CLI::App& app, GlobalOptions& global) {
   auto cli = std::make_shared<Blmc>();
   auto& o = cli->o;
-  auto* b = app.add_subcommand("blmc", "motor driver board: status, monitor, enable, current, PD, homing, record, raw");
+  auto* b = app.add_subcommand("blmc", "motor driver board: status, monitor, enable, current, PD, homing, record, raw, onboard");
   b->require_subcommand(1);
   add_board_options(b, o);
 
@@ -608,6 +697,7 @@ void add_blmc_commands(CLI::App& app, GlobalOptions& global) {
   add(b, global, cli, "raw", "send one frame (ID#DATA) or command (NAME=value)", Kind::plain, cmd_raw)
       ->add_option("frame", o.raw_text, "e.g. 000#0000000100000001 or ENABLE_SYS=1")
       ->required();
+  add_onboard_command(b, global, cli);
 }
 
 }  // namespace axon::app

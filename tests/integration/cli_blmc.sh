@@ -2,7 +2,8 @@
 # `axon blmc` against `axon sim blmc` in another process, over socketcand: the live status decodes;
 # host-side PD tracks a sine within a stated error and writes a candump log of the session; --csv
 # logs every control cycle; homing finds the encoder index; raw commands go out in the spec's
-# notation; `disable` leaves the board with the system off.
+# notation; the board's own controller holds a position set by `onboard`; `disable` leaves the
+# board with the system off.
 source "$(dirname "$0")/lib.sh"
 "$AXON" sim blmc --boards 1 --socketcand 127.0.0.1:0 >"$TMP/sim.out" 2>"$TMP/sim.err" &
 PIDS+=($!)
@@ -36,6 +37,20 @@ grep -Eq '^motor 1: index at -?[0-9.]+ rev' "$TMP/home.out" || fail "home: $(cat
 blmc raw ENABLE_SYS=1 >"$TMP/raw.out" 2>"$TMP/raw.err" || fail "raw failed"
 grep -q 'sent 000#0000000100000001 (COMMAND ENABLE_SYS=1)' "$TMP/raw.out" || fail "raw: $(cat "$TMP/raw.out")"
 blmc raw 'NOT_A_COMMAND=1' >"$TMP/rawbad.out" 2>"$TMP/rawbad.err" && fail "an unknown command was accepted"
+
+# The board's own controller (optional in the spec; the simulator has it): values it cannot take
+# are refused in words (exit 2); with the motors enabled it holds a position reference while no
+# host process sends a current.
+blmc onboard --kp -1 1 --kd 0 0 >"$TMP/ob.out" 2>"$TMP/ob.err" && fail "a negative gain was accepted"
+[ $? -eq 2 ] && grep -q 'motor 1 KP must be a finite number' "$TMP/ob.err" || fail "onboard --kp -1: $(cat "$TMP/ob.err")"
+blmc enable >/dev/null 2>"$TMP/enable.err" || fail "enable failed: $(cat "$TMP/enable.err")"
+blmc onboard --position 0.25 0.25 --velocity 0 0 --kp 8 8 --kd 1.5 1.5 --p-limit 2 2 --d-limit 1 1 \
+  >"$TMP/ob.out" 2>"$TMP/ob.err" || fail "onboard failed: $(cat "$TMP/ob.err")"
+grep -q '^set kp 8 8 A/rev$' "$TMP/ob.out" || fail "onboard: $(cat "$TMP/ob.out")"
+blmc monitor --duration 2 >"$TMP/hold.out" 2>"$TMP/hold.err" || fail "monitor failed"
+read -r p1 p2 < <(tail -1 "$TMP/hold.out" | awk '{print $6, $7}')
+awk -v a="$p1" -v b="$p2" 'BEGIN { exit !(a > 0.23 && a < 0.27 && b > 0.23 && b < 0.27) }' \
+  || fail "on-board PD: positions $p1 $p2, expected 0.25: $(tail -2 "$TMP/hold.out")"
 
 blmc disable >"$TMP/disable.out" 2>"$TMP/disable.err" || fail "disable failed"
 blmc status >"$TMP/status2.out" 2>>"$TMP/status.err" || fail "status failed"

@@ -145,9 +145,13 @@ TEST(BlmcBoard, DecodesEveryMeasurementWithTimestampsAndCountsBadFrames) {
     EXPECT_EQ(m.index[1].value, 0.125);
     EXPECT_EQ(m.index[1].count, 1u);
     EXPECT_EQ(m.index[0].count, 0u);
-    EXPECT_TRUE(m.status.value.motor1_ready);
-    EXPECT_EQ(m.frames, 6u);
-    EXPECT_EQ(m.rejected, 3u);
+    EXPECT_TRUE(m.status.value.motor1_ready);  // the last status that decoded
+    // The status with error code 6 is not a rejected frame: the board reported an error.
+    EXPECT_EQ(m.status_byte.value, 0xC0);
+    EXPECT_TRUE(m.undocumented_error());
+    EXPECT_EQ(m.undocumented_errors, 1u);
+    EXPECT_EQ(m.frames, 7u);
+    EXPECT_EQ(m.rejected, 2u);
     EXPECT_EQ(m.foreign, 1u);
   });
 }

@@ -141,6 +141,62 @@ TEST(BlmcControlLoop, BoardErrorIsReportedByName) {
   EXPECT_EQ(loop.fault()->fault.describe(), "board error ENCODER");
 }
 
+// A status frame with the error code the spec does not define (6): the loop stops in that very
+// cycle, every board gets zero current and its motors disabled, and the report says what came.
+TEST(BlmcControlLoop, AnUndocumentedErrorCodeDisablesEveryBoardInTheSameCycle) {
+  core::ManualClock clock;
+  CyclicPort a(64), b(64);
+  Constant ctl;
+  ctl.value = {1, 1};
+  ControlLoop loop({&a, &b}, ctl, {SafetyLimits{}}, {}, clock);
+  for (auto* p : {&a, &b}) {
+    feed(*p, {status_frame(true, true, true, true, true)});
+    feed_data(*p);
+  }
+  loop.step(clock.now(), clock.now());
+  ASSERT_FALSE(loop.faulted());
+  (void)drain(a);
+  (void)drain(b);
+  clock.advance(1ms);
+  feed(b, {can::Frame::standard(0x010, std::vector<std::uint8_t>{0xDF}).value()});  // code 6, flags still on
+  feed_data(a);
+  feed_data(b);
+  loop.step(clock.now(), clock.now());
+  ASSERT_TRUE(loop.faulted());
+  const auto f = loop.fault().value();
+  EXPECT_EQ(f.board, 1u);
+  EXPECT_EQ(f.fault.kind, FaultKind::undocumented_error);
+  EXPECT_EQ(f.fault.describe(), "board sent undocumented error code 6");
+  for (auto* p : {&a, &b}) {
+    const auto frames = drain(*p);
+    ASSERT_EQ(frames.size(), 3u);
+    EXPECT_EQ(protocol::decode_pair(MessageId::iq_ref, frames[0]).value(), (MotorPair{0, 0}));
+    EXPECT_EQ(protocol::decode_command(frames[1]).value().to_string(), "ENABLE_MTR1=0");
+    EXPECT_EQ(protocol::decode_command(frames[2]).value().to_string(), "ENABLE_MTR2=0");
+  }
+}
+
+// A board that disabled itself shows first as stale data; the undocumented code in its next
+// status still makes it into the report.
+TEST(BlmcControlLoop, AStaleDataFaultLearnsAnUndocumentedCodeFromTheNextStatus) {
+  core::ManualClock clock;
+  CyclicPort port(64);
+  Constant ctl;
+  ControlLoop loop({&port}, ctl, {SafetyLimits{}}, {}, clock);
+  feed(port, {status_frame(true, true, true, true, true)});
+  feed_data(port);
+  loop.step(clock.now(), clock.now());
+  clock.advance(20ms);
+  loop.step(clock.now(), clock.now());
+  ASSERT_TRUE(loop.faulted());
+  clock.advance(1ms);
+  feed(port, {can::Frame::standard(0x010, std::vector<std::uint8_t>{0xC0}).value()});
+  loop.step(clock.now(), clock.now());
+  const auto text = loop.fault()->fault.describe();
+  EXPECT_EQ(loop.fault()->fault.kind, FaultKind::stale_data);
+  EXPECT_NE(text.find("(board sent undocumented error code 6)"), std::string::npos) << text;
+}
+
 TEST(BlmcControlLoop, RejectsBadConfiguration) {
   Constant ctl;
   CyclicPort p(4);

@@ -13,6 +13,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <string>
 #include <thread>
@@ -48,7 +49,11 @@ MotorBoardOptions board_options() {
 
 // The disable travels over socketcand: the board applies it a moment after the host sent it.
 void expect_board_off(const sim::SimulatedBoard& sim) {
-  for (int i = 0; i < 300 && sim.report().status.system_enabled; ++i) std::this_thread::sleep_for(10ms);
+  const auto off = [&] {
+    const auto r = sim.report();
+    return !r.status.system_enabled && !r.motors[0].enabled && !r.motors[1].enabled;
+  };
+  for (int i = 0; i < 300 && !off(); ++i) std::this_thread::sleep_for(10ms);
   const auto r = sim.report();
   EXPECT_FALSE(r.status.system_enabled);
   EXPECT_FALSE(r.motors[0].enabled);
@@ -144,6 +149,163 @@ TEST(BlmcMotorBoard, ABoardFaultIsAReportedSafetyStopNotAnException) {
   board.recover();
   EXPECT_EQ(board.wait_status().error, protocol::ErrorCode::none);
   EXPECT_TRUE(sim.report().status.system_enabled);
+  board.disable();
+  expect_board_off(sim);
+}
+
+// The board reports an error with the code the spec leaves undefined (6). The host stops the loop
+// on that status frame (not seconds later on stale data), zeroes the current, names the code, and
+// a recovery while the cause lasts is refused in the same words.
+TEST(BlmcMotorBoard, AnUndocumentedErrorCodeIsASafetyStopNamingIt) {
+  sim::SimulatedBoard sim(sim_options());
+  MotorBoard board(sim.bus_spec(), board_options());
+  board.enable();
+  auto s = settings();
+  s.limits.stale_after = 3s;  // the status (once a second) comes before the data would count as stale
+  board.start_control([](const ControlState&) { return Command{MotorCommand::current(0.1), MotorCommand::current(0)}; },
+                      s);
+  for (int i = 0; i < 300 && sim.report().motors[0].iq_ref_a == 0.0; ++i) std::this_thread::sleep_for(10ms);
+  sim.inject(sim::FaultKind::undocumented, 0, 10s);
+  for (int i = 0; i < 300 && board.control_running(); ++i) std::this_thread::sleep_for(10ms);
+  const auto report = board.stop_control();
+  ASSERT_TRUE(report.fault);
+  EXPECT_EQ(report.fault->kind, host::FaultKind::undocumented_error) << report.fault_text;
+  EXPECT_EQ(report.fault_text, "board sent undocumented error code 6");
+  EXPECT_EQ(sim.report().motors[0].iq_ref_a, 0.0);  // the host's zero reached the board
+  EXPECT_GE(board.measurements().undocumented_errors, 1u);
+  try {
+    board.recover();
+    FAIL() << "recovered while the board still reports code 6";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), HostErrc::board_error);
+    EXPECT_NE(std::string(e.what()).find("undocumented error code 6"), std::string::npos) << e.what();
+  }
+  board.disable();
+  expect_board_off(sim);
+}
+
+// Polls `done` every 10 ms for up to `limit` (the simulator runs on its own thread).
+bool wait_for(const std::function<bool()>& done, std::chrono::milliseconds limit = 10s) {
+  for (auto t = 0ms; t < limit && !done(); t += 10ms) std::this_thread::sleep_for(10ms);
+  return done();
+}
+
+// The board's own P/D controller (optional in the spec, modelled by the simulator) moves each motor
+// to a position reference and holds it with no current from the host: after the enable the host
+// sends only the limits, the gains and the references, then watches. The disable also takes the
+// controller's limits back to 0.
+TEST(BlmcMotorBoard, TheOnBoardControllerHoldsAPositionReferenceWithoutHostCurrents) {
+  sim::SimulatedBoard sim(sim_options());
+  MotorBoard board(sim.bus_spec(), board_options());
+  board.enable();
+  const auto start = board.measurements().position.value;
+  const host::MotorPair target{start.motor1 + 0.5, start.motor2 - 0.3};
+  board.set_onboard_current_limits({{2, 2}, {1, 1}});
+  board.set_onboard_gains({{8, 8}, {1.5, 1.5}});  // A/rev, A/krpm
+  board.set_onboard_references({target, {0, 0}});
+  const auto at_target = [&] {
+    const auto p = board.measurements().position.value;
+    return std::abs(p.motor1 - target.motor1) < 0.02 && std::abs(p.motor2 - target.motor2) < 0.02;
+  };
+  EXPECT_TRUE(wait_for(at_target));
+  std::this_thread::sleep_for(300ms);  // and stays there
+  EXPECT_TRUE(at_target()) << board.measurements().position.value.motor1 << " "
+                           << board.measurements().position.value.motor2;
+  const auto r = sim.report();
+  for (const auto& m : r.motors) {
+    EXPECT_EQ(m.iq_ref_a, 0.0);  // the host never asked for a current
+    EXPECT_EQ(m.kp, 8.0);
+    EXPECT_EQ(m.p_limit_a, 2.0);
+  }
+  EXPECT_NEAR(r.motors[0].pos_ref_rev, target.motor1, 1e-6);
+  board.disable();
+  expect_board_off(sim);
+  EXPECT_TRUE(wait_for([&] { return sim.report().motors[1].d_limit_a == 0.0; }));
+  EXPECT_EQ(sim.report().motors[0].p_limit_a, 0.0);
+}
+
+// ENABLE_POS_ROLLOVER_ERROR=1 (off by default, as the spec says): the move across +100 rev that
+// settles on the other side above now makes the board raise POS_ROLLOVER and disable itself, and
+// the host's loop stops naming it.
+TEST(BlmcMotorBoard, WithTheRolloverErrorOnAMoveAcross100RevStopsWithPosRollover) {
+  auto so = sim_options();
+  so.config.motors[0].initial_position_rev = 99.8;
+  sim::SimulatedBoard sim(so);
+  MotorBoard board(sim.bus_spec(), board_options());
+  board.enable();
+  board.set_rollover_error(true);
+  std::array<std::atomic<double>, 2> start{};
+  board.start_control(move_by({0.5, 0}, start), settings());
+  EXPECT_TRUE(wait_for([&] { return !board.control_running(); }));
+  const auto report = board.stop_control();
+  ASSERT_TRUE(report.fault);
+  EXPECT_EQ(report.fault->board_error, protocol::ErrorCode::pos_rollover) << report.fault_text;
+  EXPECT_NE(report.fault_text.find("POS_ROLLOVER"), std::string::npos) << report.fault_text;
+  EXPECT_EQ(sim.report().status.error, protocol::ErrorCode::pos_rollover);
+}
+
+// A virtual spring replaces the motor's IqRef with a pull towards where it stood when the spring
+// came on: the host's current moves motor 2, not motor 1.
+TEST(BlmcMotorBoard, AVirtualSpringHoldsItsMotorAgainstTheHostsCurrent) {
+  sim::SimulatedBoard sim(sim_options());
+  MotorBoard board(sim.bus_spec(), board_options());
+  board.enable();
+  board.set_virtual_springs({true, false});
+  EXPECT_TRUE(wait_for([&] { return sim.report().motors[0].vspring; }));
+  const auto start = board.measurements().position.value;
+  const ControlLaw push = [](const ControlState&) { return Command{MotorCommand::current(0.1), MotorCommand::current(0.1)}; };
+  const auto report = board.run_control(push, 300ms, settings());
+  EXPECT_FALSE(report.fault) << report.fault_text;
+  const auto end = board.measurements().position.value;
+  EXPECT_LT(std::abs(end.motor1 - start.motor1), 0.01);
+  EXPECT_GT(end.motor2 - start.motor2, 0.1);
+  board.set_virtual_springs({false, false});
+  EXPECT_TRUE(wait_for([&] { return !sim.report().motors[0].vspring; }));
+}
+
+// Values the board cannot take are refused in words before anything is sent; while the host's
+// loop owns the board the settings wait for it to stop.
+TEST(BlmcMotorBoard, RefusesOnboardSettingsItCannotSendInWords) {
+  sim::SimulatedBoard sim(sim_options());
+  MotorBoard board(sim.bus_spec(), board_options());
+  const auto refused = [](const std::function<void()>& call, const std::string& words) {
+    try {
+      call();
+      ADD_FAILURE() << "accepted; expected: " << words;
+    } catch (const Exception& e) {
+      EXPECT_TRUE(e.code() == std::errc::invalid_argument) << e.what();
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  refused([&] { board.set_onboard_gains({{-1, 0}, {0, 0}}); }, "motor 1 KP must be a finite number within 0 .. 128");
+  refused([&] { board.set_onboard_current_limits({{0, 0}, {0, 500}}); }, "motor 2 D current limit");
+  refused([&] { board.set_onboard_references({{100.5, 0}, {0, 0}}); }, "lies outside -100 .. 100 rev");
+  board.set_onboard_gains({{1, 2}, {0, 0}});
+  EXPECT_TRUE(wait_for([&] { return sim.report().stats.controller_frames >= 2; }));
+  EXPECT_EQ(sim.report().stats.controller_frames, 2u);  // the refused calls sent nothing
+  EXPECT_EQ(sim.report().motors[1].kp, 2.0);
+  board.enable();
+  board.start_control([](const ControlState&) { return Command{}; }, settings());
+  try {
+    board.set_rollover_error(true);
+    ADD_FAILURE() << "a setting went out while control runs";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), HostErrc::cyclic_active) << e.what();
+  }
+  (void)board.stop_control();
+}
+
+// The spec's command table gives ENABLE_SYS the default 1; the simulator powers up with the system
+// off unless asked. The host relies on neither: its enable sends ENABLE_SYS=1, and its disable
+// leaves off also a board that came up with the system on.
+TEST(BlmcMotorBoard, ABoardPoweringUpWithTheSystemOnAsDocumentedIsEnabledAndLeftOff) {
+  auto so = sim_options();
+  so.config.system_enabled_at_power_up = true;
+  sim::SimulatedBoard sim(so);
+  MotorBoard board(sim.bus_spec(), board_options());
+  EXPECT_TRUE(board.wait_status().system_enabled);
+  board.enable();
+  EXPECT_TRUE(sim.report().motors[0].ready && sim.report().motors[1].ready);
   board.disable();
   expect_board_off(sim);
 }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace axon::blmc::host {
 namespace {
@@ -14,6 +15,10 @@ using protocol::Status;
 core::TimePoint at(int ms) { return core::TimePoint(std::chrono::milliseconds(ms)); }
 
 // Measurements as a healthy, enabled board gives them at `t`.
+can::Frame status_byte_frame(std::uint8_t byte) {
+  return can::Frame::standard(0x010, std::vector<std::uint8_t>{byte}).value();
+}
+
 Measurements healthy(core::TimePoint t) {
   Measurements m;
   m.status = {Status{true, true, true, true, true, ErrorCode::none}, t, 1};
@@ -71,6 +76,27 @@ TEST(BlmcSafety, BoardErrorTripsAndNamesTheCode) {
   EXPECT_EQ(s.fault().kind, FaultKind::board_error);
   EXPECT_EQ(s.fault().board_error, ErrorCode::can_recv_timeout);
   EXPECT_NE(s.fault().describe().find("CAN_RECV_TIMEOUT"), std::string::npos) << s.fault().describe();
+}
+
+// Error code 6 is not in the spec's table, but a board that sends it says something is wrong: the
+// host must stop in that cycle, not carry on until the data or the status go stale.
+TEST(BlmcSafety, AnUndocumentedBoardErrorCodeTripsAtOnceAndIsNamed) {
+  Safety s;
+  s.arm(at(0));
+  auto m = healthy(at(1));
+  EXPECT_EQ(apply_frame(m, status_byte_frame(0xDF), at(1)), FrameOutcome::undocumented_error);  // flags on, code 6
+  EXPECT_EQ(m.undocumented_errors, 1u);
+  const auto out = s.apply(m, {1.0, 1.0}, at(1));
+  EXPECT_EQ(out, (MotorPair{0, 0}));
+  ASSERT_TRUE(s.newly_tripped());
+  EXPECT_EQ(s.fault().kind, FaultKind::undocumented_error);
+  EXPECT_EQ(s.fault().describe(), "board sent undocumented error code 6");
+  // A later healthy status does not clear it: faults latch until reset.
+  m = healthy(at(2));
+  apply_frame(m, status_byte_frame(0x1F), at(2));
+  EXPECT_EQ(s.apply(m, {1.0, 1.0}, at(2)), (MotorPair{0, 0}));
+  s.reset(at(2));
+  EXPECT_EQ(s.apply(m, {1.0, 1.0}, at(2)), (MotorPair{1.0, 1.0}));
 }
 
 TEST(BlmcSafety, FaultIsLatchedUntilReset) {

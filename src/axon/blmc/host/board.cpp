@@ -130,9 +130,16 @@ Board::~Board() {
   if (motors_on_) queue_disable();
 }
 
+std::vector<can::Frame> Board::shutdown_frames() const {
+  auto frames = disable_frames();
+  if (onboard_used_)
+    for (const auto& f : onboard_reset_frames()) frames.push_back(f);
+  return frames;
+}
+
 void Board::queue_disable() {
   if (closed_ || !bus_->is_open()) return;
-  asio::co_spawn(bus_->get_executor(), send_all(bus_, bus_->destroyed_flag(), disable_frames()), asio::detached);
+  asio::co_spawn(bus_->get_executor(), send_all(bus_, bus_->destroyed_flag(), shutdown_frames()), asio::detached);
 }
 
 void Board::interrupt() noexcept {
@@ -197,8 +204,8 @@ asio::awaitable<Result<void>> Board::wait_until(core::TimePoint deadline, const 
 
 asio::awaitable<Result<protocol::Status>> Board::wait_status(core::Duration timeout) {
   if (cyclic_) co_return Error(HostErrc::cyclic_active, options_.name);
-  const auto start = state_.status.count;
-  auto r = co_await wait_until(clock_->now() + timeout, [&] { return state_.status.count > start; });
+  const auto start = state_.status_byte.count;
+  auto r = co_await wait_until(clock_->now() + timeout, [&] { return state_.status_byte.count > start; });
   if (!r) {
     auto e = r.error();
     if (e == HostErrc::timeout)
@@ -206,6 +213,7 @@ asio::awaitable<Result<protocol::Status>> Board::wait_status(core::Duration time
                              std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count());
     co_return e;
   }
+  if (state_.undocumented_error()) co_return status_error();
   co_return state_.status.value;
 }
 
@@ -222,41 +230,35 @@ asio::awaitable<Result<void>> Board::wait_data(core::Duration timeout, std::uint
   co_return r;
 }
 
+Error Board::status_error() const {
+  if (state_.undocumented_error())
+    return Error(HostErrc::board_error, fmt::format("{}: board sent undocumented error code {}", options_.name,
+                                                    unsigned{protocol::error_bits(state_.status_byte.value)}));
+  return Error(HostErrc::board_error,
+               fmt::format("{}: board error {}", options_.name, protocol::name(state_.status.value.error)));
+}
+
 asio::awaitable<Result<void>> Board::wait_ready(core::Duration timeout) {
   if (cyclic_) co_return Error(HostErrc::cyclic_active, options_.name);
-  const auto start = state_.status.count;
+  const auto start = state_.status_byte.count;
   const auto deadline = clock_->now() + timeout;
   auto ready = [&](const protocol::Status& s) {
     return s.system_enabled && (!options_.motors[0] || (s.motor1_enabled && s.motor1_ready)) &&
            (!options_.motors[1] || (s.motor2_enabled && s.motor2_ready));
   };
-  for (;;) {
-    auto r = co_await wait_until(deadline, [&] { return state_.status.count > start; });
+  // Every status frame after the call until one shows the motors ready or an error.
+  for (auto seen = start;; seen = state_.status_byte.count) {
+    auto r = co_await wait_until(deadline, [&] { return state_.status_byte.count > seen; });
     if (!r) {
       if (r.error() != HostErrc::timeout) co_return r.error();
-      if (state_.status.count > start)
+      if (state_.status_byte.count > start)
         co_return Error(HostErrc::not_ready, fmt::format("{}: not ready after {} ms: {}", options_.name,
                                                          std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count(),
                                                          state_.status.value.to_string()));
       co_return Error(HostErrc::timeout, fmt::format("{}: no status frame while waiting for ready", options_.name));
     }
-    const auto& s = state_.status.value;
-    if (s.error != protocol::ErrorCode::none)
-      co_return Error(HostErrc::board_error, fmt::format("{}: board error {}", options_.name, protocol::name(s.error)));
-    if (ready(s)) co_return ok();
-    // Not ready yet: wait for a later status.
-    const auto seen = state_.status.count;
-    auto r2 = co_await wait_until(deadline, [&] { return state_.status.count > seen; });
-    if (!r2) {
-      if (r2.error() != HostErrc::timeout) co_return r2.error();
-      co_return Error(HostErrc::not_ready, fmt::format("{}: not ready after {} ms: {}", options_.name,
-                                                       std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count(),
-                                                       state_.status.value.to_string()));
-    }
-    const auto& s2 = state_.status.value;
-    if (s2.error != protocol::ErrorCode::none)
-      co_return Error(HostErrc::board_error, fmt::format("{}: board error {}", options_.name, protocol::name(s2.error)));
-    if (ready(s2)) co_return ok();
+    if (state_.undocumented_error() || state_.status.value.error != protocol::ErrorCode::none) co_return status_error();
+    if (ready(state_.status.value)) co_return ok();
   }
 }
 
@@ -310,12 +312,50 @@ asio::awaitable<Result<void>> Board::disable() {
     auto r = co_await stop_cyclic();
     if (!r) first = r;
   }
-  for (const auto& f : disable_frames()) {
+  for (const auto& f : shutdown_frames()) {
     auto r = co_await send_frame(f);
     if (!r && first) first = r;
   }
   if (first) motors_on_ = false;
   co_return first;
+}
+
+// ---- the board's own controller and switches ---------------------------------------------------
+
+asio::awaitable<Result<void>> Board::send_onboard(Result<std::vector<can::Frame>> frames) {
+  if (cyclic_) co_return Error(HostErrc::cyclic_active, fmt::format("{}: on-board controller", options_.name));
+  if (!frames) co_return Error(frames.error().code, fmt::format("{}: {}", options_.name, frames.error().detail));
+  onboard_used_ = true;
+  for (const auto& f : frames.value()) {
+    auto r = co_await send_frame(f);
+    if (!r) co_return r;
+  }
+  co_return ok();
+}
+
+asio::awaitable<Result<void>> Board::set_onboard_gains(OnboardGains gains) {
+  auto r = co_await send_onboard(onboard_frames(gains));
+  co_return r;
+}
+
+asio::awaitable<Result<void>> Board::set_onboard_references(OnboardReferences refs) {
+  auto r = co_await send_onboard(onboard_frames(refs, state_.unwrap));
+  co_return r;
+}
+
+asio::awaitable<Result<void>> Board::set_onboard_current_limits(OnboardCurrentLimits limits) {
+  auto r = co_await send_onboard(onboard_frames(limits));
+  co_return r;
+}
+
+asio::awaitable<Result<void>> Board::set_virtual_springs(std::array<bool, 2> on) {
+  auto r = co_await send_onboard(virtual_spring_frames(on));
+  co_return r;
+}
+
+asio::awaitable<Result<void>> Board::set_rollover_error(bool on) {
+  auto r = co_await send_frame(rollover_error_frame(on));
+  co_return r;
 }
 
 // ---- cyclic mode --------------------------------------------------------------------------------

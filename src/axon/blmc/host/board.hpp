@@ -29,6 +29,7 @@
 #pragma once
 
 #include "axon/blmc/host/measurements.hpp"
+#include "axon/blmc/host/onboard.hpp"
 #include "axon/blmc/host/rt_link.hpp"
 #include "axon/blmc/protocol/command.hpp"
 #include "axon/blmc/protocol/frames.hpp"
@@ -113,10 +114,11 @@ class Board {
   // wait_ready(ready_timeout).
   asio::awaitable<Result<void>> enable();
   // Waits for a status frame newer than the call showing the system and the used motors enabled
-  // and ready. board_error (naming the code) when it carries an error, not_ready after the timeout
-  // (timeout when no status came at all).
+  // and ready. board_error (naming the code, or the undocumented code 6) when it carries an
+  // error, not_ready after the timeout (timeout when no status came at all).
   asio::awaitable<Result<void>> wait_ready(core::Duration timeout);
-  // The next status frame.
+  // The next status frame; board_error when it carries the undocumented error code 6 (which a
+  // protocol::Status cannot hold).
   asio::awaitable<Result<protocol::Status>> wait_status(core::Duration timeout);
   // Waits until `n` more measurement frames (current, position, velocity, ADC) arrived.
   asio::awaitable<Result<void>> wait_data(core::Duration timeout, std::uint64_t n = 1);
@@ -136,6 +138,17 @@ class Board {
   void interrupt() noexcept;
   void clear_interrupt() noexcept { interrupted_ = false; }
   [[nodiscard]] bool interrupted() const noexcept { return interrupted_; }
+  // ---- the board's own controller and switches (onboard.hpp), coroutine mode. Each checks its
+  // values first (HostErrc::invalid_argument in words; nothing is sent then) and sends its frames
+  // in order. Once one of them went out, disable() and the destructor's queued disable also send
+  // onboard_reset_frames() (controller limits 0, springs off) after the usual frames.
+  asio::awaitable<Result<void>> set_onboard_gains(OnboardGains gains);
+  // Position references in the host's positions (latest().position), see onboard.hpp.
+  asio::awaitable<Result<void>> set_onboard_references(OnboardReferences refs);
+  asio::awaitable<Result<void>> set_onboard_current_limits(OnboardCurrentLimits limits);
+  asio::awaitable<Result<void>> set_rollover_error(bool on);
+  asio::awaitable<Result<void>> set_virtual_springs(std::array<bool, 2> on);
+
   // The state decoded so far (coroutine mode; in cyclic mode port().latest() is current).
   [[nodiscard]] const Measurements& latest() const noexcept { return state_; }
 
@@ -155,6 +168,10 @@ class Board {
 
  private:
   asio::awaitable<Result<void>> wait_until(core::TimePoint deadline, const std::function<bool()>& done);
+  asio::awaitable<Result<void>> send_onboard(Result<std::vector<can::Frame>> frames);
+  [[nodiscard]] std::vector<can::Frame> shutdown_frames() const;
+  // board_error naming the latest status frame's error code (documented or not).
+  [[nodiscard]] Error status_error() const;
   asio::awaitable<void> tx_pump(std::shared_ptr<Shared> shared);
 
   can::Bus* bus_;
@@ -171,6 +188,7 @@ class Board {
   bool closed_ = false;
   bool motors_on_ = false;  // we enabled motors and did not disable them yet
   bool interrupted_ = false;
+  bool onboard_used_ = false;  // a set_onboard_* / set_virtual_springs call sent its frames
 };
 
 }  // namespace axon::blmc::host

@@ -109,16 +109,12 @@ void ControlLoop::step(core::TimePoint deadline, core::TimePoint now) noexcept {
       trip = true;
     }
   }
-  if (halted_ && !trip && fault_.fault.board_error == protocol::ErrorCode::none) {
-    // Learn the board's own reason from a status that came after the trip.
-    const auto& st = inputs_[fault_.board].status;
-    if (st.count > status_at_trip_) fault_.fault.board_error = st.value.error;
-  }
+  if (halted_ && !trip) learn_board_reason();
   if (trip) {
     // Stop everything: zero current and disable the motors of every board, then publish.
     for (std::size_t i = 0; i < n; ++i) disable_queued_[i] = ports_[i]->send_disable();
     halted_ = true;
-    status_at_trip_ = inputs_[fault_.board].status.count;
+    status_at_trip_ = inputs_[fault_.board].status_byte.count;
     faulted_.store(true, std::memory_order_release);
   } else {
     for (std::size_t i = 0; i < n; ++i) {
@@ -150,6 +146,16 @@ void ControlLoop::step(core::TimePoint deadline, core::TimePoint now) noexcept {
   if (!records_.push(rec)) dropped_.fetch_add(1, std::memory_order_relaxed);
   cycles_.store(timing_.cycles(), std::memory_order_relaxed);
   overruns_.store(timing_.overruns(), std::memory_order_relaxed);
+}
+
+void ControlLoop::learn_board_reason() noexcept {
+  auto& f = fault_.fault;
+  if (f.board_error != protocol::ErrorCode::none || f.undocumented_code != 0) return;
+  // The board's own reason, from a status (decodable or not) that came after the trip.
+  const auto& m = inputs_[fault_.board];
+  if (m.status_byte.count <= status_at_trip_) return;
+  if (m.undocumented_error()) f.undocumented_code = protocol::error_bits(m.status_byte.value);
+  else f.board_error = m.status.value.error;
 }
 
 bool ControlLoop::wait_for_trigger(core::TimePoint deadline) noexcept {
@@ -203,8 +209,9 @@ void ControlLoop::run() noexcept {
       }
     }
     if (halted_ && options_.stop_on_fault) {
-      const auto& st = ports_[fault_.board]->latest().status;
-      const bool answered = st.count > status_at_trip_ || fault_.fault.kind == FaultKind::board_error;
+      const auto& st = ports_[fault_.board]->latest().status_byte;
+      const bool answered = st.count > status_at_trip_ || fault_.fault.kind == FaultKind::board_error ||
+                            fault_.fault.kind == FaultKind::undocumented_error;
       if (answered || now - fault_.fault.at >= options_.fault_grace) break;
     }
   }

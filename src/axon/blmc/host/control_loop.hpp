@@ -13,9 +13,9 @@
 // zero current and ENABLE_MTRx=0 in that same cycle (queued again in later cycles if the link was
 // full), the fault is published (fault()) and the loop ends (or keeps sending zeros if
 // LoopOptions::stop_on_fault is false). The caller reports it off the real-time thread:
-// fault()->fault.describe() names the board's error code. A loop stopped on request queues zero
-// current to every board as its last frame; disabling the boards is the caller's next step
-// (MotorSession does it on every way out).
+// fault()->fault.describe() names the board's error code (or the undocumented code it sent). A
+// loop stopped on request queues zero current to every board as its last frame; disabling the
+// boards is the caller's next step (MotorSession does it on every way out).
 //
 // Pacing. Pacing::clock wakes at absolute deadlines (clock_nanosleep, TIMER_ABSTIME) and skips
 // deadlines it missed (counted). Pacing::measurements starts a cycle as soon as every board
@@ -156,6 +156,7 @@ class ControlLoop {
  private:
   void run() noexcept;
   bool wait_for_trigger(core::TimePoint deadline) noexcept;
+  void learn_board_reason() noexcept;
 
   std::vector<CyclicPort*> ports_;
   Controller* controller_;
@@ -180,7 +181,7 @@ class ControlLoop {
   bool started_controller_ = false;
   bool halted_ = false;  // a fault zeroed everything
   std::array<bool, kMaxBoards> disable_queued_{};  // the fault's disable frames went into the link
-  std::uint64_t status_at_trip_ = 0;
+  std::uint64_t status_at_trip_ = 0;  // status frames (any byte) seen when the fault tripped
 };
 
 }  // namespace axon::blmc::host

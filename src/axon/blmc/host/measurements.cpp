@@ -93,8 +93,13 @@ FrameOutcome apply_frame(Measurements& m, const can::Frame& f, core::TimePoint n
   }
   switch (*id) {
     case MessageId::status: {
-      // Error code 6 is undefined: check the bits here so the common path never builds an error.
-      if ((f.payload()[0] >> 5) == 6) break;
+      // Error code 6 is undefined, but it is still the board reporting an error (see Safety).
+      store(m.status_byte, f.payload()[0], now);
+      if (protocol::error_bits(f.payload()[0]) == protocol::kUndocumentedErrorCode) {
+        ++m.undocumented_errors;
+        ++m.frames;
+        return FrameOutcome::undocumented_error;
+      }
       auto s = protocol::decode_status(f);
       if (!s) break;
       store(m.status, s.value(), now);

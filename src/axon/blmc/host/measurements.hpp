@@ -41,7 +41,10 @@ struct PositionUnwrap {
 };
 
 struct Measurements {
-  Stamped<protocol::Status> status;
+  Stamped<protocol::Status> status;  // the latest status frame that decoded
+  // The byte of the latest status frame of any kind, including one whose error code the spec
+  // does not define (6), which `status` cannot hold: Safety faults on such a byte at once.
+  Stamped<std::uint8_t> status_byte;
   Stamped<MotorPair> current;   // A
   Stamped<MotorPair> position;  // motor revolutions, unwrapped across the counter's rollover
   Stamped<MotorPair> velocity;  // krpm
@@ -52,12 +55,17 @@ struct Measurements {
 
   std::uint64_t frames = 0;    // board frames decoded
   std::uint64_t rejected = 0;  // frames with a board identifier that failed to decode
+  std::uint64_t undocumented_errors = 0;  // status frames carrying error code 6 (not in `rejected`)
   std::uint64_t foreign = 0;   // frames that are not board messages (host ids, other devices)
 
   [[nodiscard]] const Stamped<MotorPair>& pair(Quantity q) const noexcept;
   // The time of the last frame of this quantity (any motor for the encoder index).
   [[nodiscard]] core::TimePoint last(Quantity q) const noexcept;
   [[nodiscard]] std::uint64_t count(Quantity q) const noexcept;
+  // The latest status frame carried an error code the spec does not define (6).
+  [[nodiscard]] bool undocumented_error() const noexcept {
+    return status_byte.received() && protocol::error_bits(status_byte.value) == protocol::kUndocumentedErrorCode;
+  }
 };
 
 // Convenience conversions of the wire units.
@@ -70,12 +78,14 @@ enum class FrameOutcome : std::uint8_t {
   index,        // an encoder index tick stored
   foreign,      // not a board message: ignored
   rejected,     // a board identifier whose frame did not decode: counted, nothing stored
+  undocumented_error,  // a status frame with error code 6: status_byte stored, counted; a fault
 };
 
 // Decodes one frame from the bus into `m`, stamping it with `now`. The common checks (format,
 // identifier, length) run without allocating; only a frame that passes them and still fails the
-// codec's value checks (status error code 6, ADC outside 0..1, motor number above 1) builds the
-// codec's error text, a rare path for a broken board.
+// codec's value checks (ADC outside 0..1, motor number above 1) builds the codec's error text, a
+// rare path for a broken board. A status frame with the undefined error code 6 is not rejected:
+// it is the board reporting an error, kept in status_byte and counted in undocumented_errors.
 FrameOutcome apply_frame(Measurements& m, const can::Frame& f, core::TimePoint now);
 
 }  // namespace axon::blmc::host

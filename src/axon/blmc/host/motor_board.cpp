@@ -118,6 +118,12 @@ struct MotorBoard::Impl {
       throw Exception(Error(HostErrc::timeout, fmt::format("{}: {}: no result within {:.1f} s", options.name, what, seconds_of(timeout))));
     }
   }
+  // Sends one of the board's settings (Board::set_onboard_* ...) and waits for it.
+  template <class Send>
+  void setting(const char* what, Send send) {
+    if (run) throw Exception(Error(HostErrc::cyclic_active, fmt::format("{}: {}: stop_control first", options.name, what)));
+    wait([b = board.get(), send] { return send(*b); }, std::chrono::seconds(2), what).value();
+  }
   void interrupt() {
     boost::asio::post(loop.executor(), [b = board.get()] { b->interrupt(); });
   }
@@ -362,6 +368,26 @@ HomingReport MotorBoard::home(host::HomingOptions options, ControlSettings setti
   report.motors = run.motors;
   report.all_found = run.all_found;
   return report;
+}
+
+void MotorBoard::set_onboard_gains(const host::OnboardGains& gains) {
+  impl_->setting("set_onboard_gains", [gains](host::Board& b) { return b.set_onboard_gains(gains); });
+}
+
+void MotorBoard::set_onboard_references(const host::OnboardReferences& references) {
+  impl_->setting("set_onboard_references", [references](host::Board& b) { return b.set_onboard_references(references); });
+}
+
+void MotorBoard::set_onboard_current_limits(const host::OnboardCurrentLimits& limits) {
+  impl_->setting("set_onboard_current_limits", [limits](host::Board& b) { return b.set_onboard_current_limits(limits); });
+}
+
+void MotorBoard::set_rollover_error(bool on) {
+  impl_->setting("set_rollover_error", [on](host::Board& b) { return b.set_rollover_error(on); });
+}
+
+void MotorBoard::set_virtual_springs(std::array<bool, 2> on) {
+  impl_->setting("set_virtual_springs", [on](host::Board& b) { return b.set_virtual_springs(on); });
 }
 
 void MotorBoard::interrupt() { impl_->interrupt(); }

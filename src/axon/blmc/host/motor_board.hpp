@@ -30,6 +30,7 @@
 #include "axon/blmc/host/homing_options.hpp"
 #include "axon/blmc/host/loop_timing.hpp"
 #include "axon/blmc/host/measurements.hpp"
+#include "axon/blmc/host/onboard.hpp"
 #include "axon/blmc/host/safety.hpp"
 #include "axon/blmc/protocol/status.hpp"
 
@@ -158,6 +159,24 @@ class MotorBoard {
   // the motors in options.motors that the board uses. The motors must be enabled.
   HomingReport home(host::HomingOptions options = {}, ControlSettings settings = {},
                     std::chrono::milliseconds timeout = 20s);
+
+  // The board's own controller and switches, for work without the host in the loop: the optional
+  // on-board P/D controller (gains, references, its current limits), the rollover error and the
+  // virtual springs. host/onboard.hpp says what the board does with them, their units (the spec's:
+  // A/rev, A/krpm, rev, krpm, A) and why a position reference must lie on the counter's current
+  // turn. Each call checks its values before anything is sent (HostErrc::invalid_argument, in
+  // words), sends the frames and returns; HostErrc::cyclic_active while control runs. After one of
+  // the controller or spring calls, disable() also sets the controller's limits to 0 and the
+  // springs off, so that the next enable does not chase an old reference. The controller is absent
+  // from the firmware in service: such a board ignores these frames (the rollover error and the
+  // springs it has).
+  void set_onboard_gains(const host::OnboardGains& gains);
+  void set_onboard_references(const host::OnboardReferences& references);
+  void set_onboard_current_limits(const host::OnboardCurrentLimits& limits);
+  // On: the board raises POS_ROLLOVER and disables itself when a motor's position counter rolls
+  // over at +-100 rev (off after power-up, as the spec's default).
+  void set_rollover_error(bool on);
+  void set_virtual_springs(std::array<bool, 2> on);  // index 0 = motor 1
 
   // From any thread: the wait in progress (enable, wait_status, home) ends with
   // HostErrc::interrupted, and so do later ones until clear_interrupt().

@@ -13,6 +13,7 @@ const char* to_string(FaultKind k) noexcept {
   switch (k) {
     case FaultKind::none: return "none";
     case FaultKind::board_error: return "board error";
+    case FaultKind::undocumented_error: return "undocumented board error";
     case FaultKind::board_disabled: return "board disabled";
     case FaultKind::stale_data: return "stale data";
     case FaultKind::position_limit: return "position limit";
@@ -22,11 +23,18 @@ const char* to_string(FaultKind k) noexcept {
 }
 
 std::string Fault::describe() const {
-  if (kind != FaultKind::board_error && kind != FaultKind::none && board_error != protocol::ErrorCode::none)
+  const bool host_side =
+      kind != FaultKind::board_error && kind != FaultKind::undocumented_error && kind != FaultKind::none;
+  if (host_side && board_error != protocol::ErrorCode::none)
     return fmt::format("{} (board error {})", without_board_error().describe(), protocol::name(board_error));
+  if (host_side && undocumented_code != 0)
+    return fmt::format("{} (board sent undocumented error code {})", without_board_error().describe(),
+                       unsigned{undocumented_code});
   switch (kind) {
     case FaultKind::none: return "no fault";
     case FaultKind::board_error: return fmt::format("board error {}", protocol::name(board_error));
+    case FaultKind::undocumented_error:
+      return fmt::format("board sent undocumented error code {}", unsigned{undocumented_code});
     case FaultKind::board_disabled:
       return motor < 0 ? std::string("board reports the system disabled")
                        : fmt::format("board reports motor {} disabled", motor + 1);
@@ -67,6 +75,11 @@ void Safety::reset(core::TimePoint now) noexcept {
 Fault Safety::check(const Measurements& m, core::TimePoint now) const noexcept {
   Fault f;
   f.at = now;
+  if (m.undocumented_error()) {
+    f.kind = FaultKind::undocumented_error;
+    f.undocumented_code = protocol::error_bits(m.status_byte.value);
+    return f;
+  }
   const auto& st = m.status;
   if (st.received() && st.value.error != protocol::ErrorCode::none) {
     f.kind = FaultKind::board_error;

@@ -3,7 +3,9 @@
 // cycle can run it and tests can drive it frame by frame.
 //
 // Every cycle, in this order:
-//   1. faults (latched until reset): the board reports an error code; the board reports itself or
+//   1. faults (latched until reset): the board reports an error code, or one the spec does not
+//      define (6: the board says something is wrong; the host cannot tell what, so it stops at
+//      once rather than wait for the data to go stale); the board reports itself or
 //      a used motor disabled; a used quantity (current, position, velocity, optionally ADC, and the
 //      status) arrived longer ago than its stale limit, or never since arm(); a position outside
 //      its limits; a non-finite current from the controller. A fault makes every later output
@@ -52,6 +54,7 @@ struct SafetyLimits {
 enum class FaultKind : std::uint8_t {
   none,
   board_error,     // status error code != 0 (board_error holds it)
+  undocumented_error,  // status error code 6, which the spec does not define (undocumented_code)
   board_disabled,  // status shows the system or a used motor disabled
   stale_data,      // quantity holds which message is missing
   position_limit,  // motor, value, limit
@@ -63,19 +66,24 @@ struct Fault {
   FaultKind kind = FaultKind::none;
   int motor = -1;  // 0 or 1 when the fault concerns one motor
   protocol::ErrorCode board_error = protocol::ErrorCode::none;
+  // The raw code of an undocumented board error (6), for that fault or, like board_error, one
+  // learnt from the board's next status after a host-side fault; 0 = none.
+  std::uint8_t undocumented_code = 0;
   Quantity quantity = Quantity::status;
   double value = 0.0;  // the position or the age (seconds) that tripped
   double limit = 0.0;
   core::TimePoint at{};
 
   // For logs and users (allocates: call outside the real-time cycle), e.g.
-  // "board error ENCODER", "stale data: no velocity frame for 0.012 s (limit 0.010 s)".
+  // "board error ENCODER", "board sent undocumented error code 6",
+  // "stale data: no velocity frame for 0.012 s (limit 0.010 s)".
   // A stale-data or other host-side fault also names the board's error code when the board's
   // next status told it (ControlLoop waits for it briefly).
   [[nodiscard]] std::string describe() const;
   [[nodiscard]] Fault without_board_error() const noexcept {
     Fault f = *this;
     f.board_error = protocol::ErrorCode::none;
+    f.undocumented_code = 0;
     return f;
   }
 };

@@ -23,7 +23,7 @@ Result<ErrorCode> error_code_from_raw(std::uint8_t raw) {
   if (raw > 7) {
     return Error(ProtocolErrc::value_out_of_range, fmt::format("error code {} wider than 3 bits", raw));
   }
-  if (raw == 6) return Error(ProtocolErrc::unknown_error_code, "status error code 6");
+  if (raw == kUndocumentedErrorCode) return Error(ProtocolErrc::unknown_error_code, "status error code 6");
   return static_cast<ErrorCode>(raw);
 }
 

@@ -26,6 +26,14 @@ enum class ErrorCode : std::uint8_t {
 };
 
 std::string_view name(ErrorCode e) noexcept;  // e.g. "ENCODER", "CAN_RECV_TIMEOUT"
+
+// The 3-bit error field of a status byte (bits 5..7) as it arrived, defined or not.
+constexpr std::uint8_t error_bits(std::uint8_t status_byte) noexcept {
+  return static_cast<std::uint8_t>(status_byte >> 5);
+}
+// The one value of the field the spec leaves undefined. A board that sends it reports an error the
+// host cannot name (a newer firmware's code, a corrupted byte): hosts treat it as an error.
+inline constexpr std::uint8_t kUndocumentedErrorCode = 6;
 // The code for the 3-bit field value, or unknown_error_code for 6 and value_out_of_range above 7.
 Result<ErrorCode> error_code_from_raw(std::uint8_t raw);
 

@@ -39,13 +39,17 @@ BoardFaultPlan checked(BoardFaultPlan p) {
 
 Board::Board(BoardConfig config, BoardFaultPlan faults)
     : config_(checked(std::move(config))), plan_(checked(std::move(faults))), rng_(plan_.seed),
-      motors_{MotorModel(config_.motors[0]), MotorModel(config_.motors[1])} {}
+      motors_{MotorModel(config_.motors[0]), MotorModel(config_.motors[1])} {
+  settings_.system_enabled = config_.system_enabled_at_power_up;
+}
 
 void Board::reset_firmware() {
   state_ = {};
   settings_ = {};
+  settings_.system_enabled = config_.system_enabled_at_power_up;
   faults_ = {};
   over_current_ = false;
+  undocumented_ = false;
   cause_until_ = {};
   last_iq_ref_ = next_cycle_time();
   pending_.clear();
@@ -145,6 +149,7 @@ void Board::apply_command(const proto::Command& cmd, BoardTime at) {
       if (at >= cause_until_[kind_index(FaultKind::pos_converter)]) faults_.pos_converter = false;
       if (at >= cause_until_[kind_index(FaultKind::transmit)]) faults_.transmit = false;
       if (at >= cause_until_[kind_index(FaultKind::over_current)]) over_current_ = false;
+      if (at >= cause_until_[kind_index(FaultKind::undocumented)]) undocumented_ = false;
       if (any_fault()) {
         ++stats_.recoveries_refused;
         break;
@@ -182,7 +187,7 @@ void Board::apply_command(const proto::Command& cmd, BoardTime at) {
 
 bool Board::any_fault() const noexcept {
   return faults_.encoder || faults_.transmit || faults_.recv_timeout || faults_.pos_converter || faults_.pos_rollover ||
-         over_current_;
+         over_current_ || undocumented_;
 }
 
 void Board::disable_all() noexcept {
@@ -208,6 +213,7 @@ void Board::raise(FaultKind kind, core::Duration duration, bool persistent, Boar
     case FaultKind::pos_converter: latch(faults_.pos_converter); break;
     case FaultKind::transmit: latch(faults_.transmit); break;
     case FaultKind::over_current: latch(over_current_); break;
+    case FaultKind::undocumented: latch(undocumented_); break;
   }
 }
 
@@ -225,6 +231,12 @@ proto::Status Board::status() const noexcept {
   s.error = proto::reported_error(faults_);
   if (s.error == proto::ErrorCode::none && over_current_) s.error = proto::ErrorCode::other;
   return s;
+}
+
+std::uint8_t Board::status_byte() const noexcept {
+  const auto s = status();
+  if (s.error != proto::ErrorCode::none || !undocumented_) return s.to_byte();
+  return static_cast<std::uint8_t>(s.to_byte() | (proto::kUndocumentedErrorCode << 5));
 }
 
 // ---- the cycle -------------------------------------------------------------------------------
@@ -289,7 +301,10 @@ void Board::run_cycle(std::uint64_t k, bool send_data, std::vector<can::Frame>& 
   }
   for (std::size_t i = 0; i < 2; ++i) state_[i].command_a = cmd[i];
   // 5. What goes out this cycle: status, then the data in the documented order, then index marks.
-  if (k % kStatusEvery == 0) emit(proto::encode(status()), t, out);
+  if (k % kStatusEvery == 0) {
+    const std::array<std::uint8_t, 1> byte{status_byte()};
+    emit(can::Frame::standard(static_cast<std::uint32_t>(MessageId::status), byte), t, out);
+  }
   const bool data_on = settings_.system_enabled || config_.data_while_disabled;
   if (data_on && send_data) {
     const auto pair = [&](MessageId id, double a, double b) { emit(proto::encode(proto::PairMessage{id, {a, b}}), t, out); };

@@ -32,8 +32,9 @@
 //   while the system is on and an enabled motor has a non-zero IqRef; more than the timeout since
 //   the last IqRef raises CAN_RECV_TIMEOUT.
 // - Errors latch; any error disables the system and both motors. With several, the status reports
-//   encoder > transmit (as OTHER) > receive timeout > position converter > rollover, and an
-//   over-current trip (no code of its own) as OTHER below all of those.
+//   encoder > transmit (as OTHER) > receive timeout > position converter > rollover, an
+//   over-current trip (no code of its own) as OTHER below all of those, and last an undocumented
+//   error (FaultKind::undocumented, a fault hook for hosts) as the code 6 the spec leaves undefined.
 // - Recovery: ENABLE_SYS=1 clears the latched errors whose cause is gone (a fault plan event with a
 //   duration or marked persistent keeps its cause) and enables the system, unless one remains.
 //   Then IqRef=0 and ENABLE_MTRx=1, as the spec says (a stale non-zero IqRef would time out again).
@@ -132,7 +133,10 @@ class Board {
   // and their causes are gone, the encoders read their initial positions). Time goes on.
   void power_cycle();
 
+  // What the next status frame will say. An undocumented error (FaultKind::undocumented) shows
+  // only in status_byte(), as error code 6, which a protocol::Status cannot hold.
   [[nodiscard]] protocol::Status status() const noexcept;
+  [[nodiscard]] std::uint8_t status_byte() const noexcept;
   [[nodiscard]] const protocol::FaultSet& faults() const noexcept { return faults_; }
   [[nodiscard]] bool over_current_latched() const noexcept { return over_current_; }
   [[nodiscard]] const FirmwareSettings& settings() const noexcept { return settings_; }
@@ -171,8 +175,9 @@ class Board {
   FirmwareSettings settings_{};
   protocol::FaultSet faults_{};
   bool over_current_ = false;
+  bool undocumented_ = false;
   // When the cause of each FaultKind ends (zero: none; max: until power-cycled).
-  std::array<BoardTime, 4> cause_until_{};
+  std::array<BoardTime, 5> cause_until_{};
   BoardTime last_iq_ref_{0};
   std::uint64_t next_cycle_ = 0;
   std::deque<Pending> pending_;

@@ -25,7 +25,7 @@ Result<void> BoardConfig::validate() const {
 
 Result<BoardConfig> BoardConfig::from_config(const core::ConfigNode& node) {
   AXON_TRY(node.reject_unknown({"motor", "motors", "adc", "alignment_s", "vspring_gain_a_per_rev", "over_current_trip_a",
-                                "data_while_disabled", "receive_queue"}));
+                                "data_while_disabled", "system_enabled_at_power_up", "receive_queue"}));
   BoardConfig c;
   if (node.has("motor")) {
     AXON_TRY(m, node.child("motor"));
@@ -64,6 +64,8 @@ Result<BoardConfig> BoardConfig::from_config(const core::ConfigNode& node) {
   }
   AXON_TRY(dwd, node.get_or<bool>("data_while_disabled", c.data_while_disabled));
   c.data_while_disabled = dwd;
+  AXON_TRY(sys, node.get_or<bool>("system_enabled_at_power_up", c.system_enabled_at_power_up));
+  c.system_enabled_at_power_up = sys;
   if (node.has("receive_queue")) {
     AXON_TRY(q, node.get_in<std::size_t>("receive_queue", 1, 65536));
     c.receive_queue = q;

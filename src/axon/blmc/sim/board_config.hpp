@@ -9,6 +9,7 @@
 //   vspring_gain_a_per_rev: 1.0              virtual spring mode (ENABLE_VSPRINGx)
 //   over_current_trip_a: 0                   trip (error 7) above this commanded current; 0 = off
 //   data_while_disabled: false               send the 1 kHz data with the system disabled too
+//   system_enabled_at_power_up: false        true: ENABLE_SYS=1 after power-up, the spec's default
 //   receive_queue: 64                        frames the firmware buffers between cycles
 #pragma once
 
@@ -29,6 +30,10 @@ struct BoardConfig {
   double vspring_gain_a_per_rev = 1.0;
   double over_current_trip_a = 0.0;
   bool data_while_disabled = false;
+  // The spec's command table gives ENABLE_SYS a default of 1. The simulated firmware powers up with
+  // the system off unless this is set: the stricter board for a host, which must send ENABLE_SYS=1
+  // itself (axon's does; docs/blmc-host.md, "ENABLE_SYS at power-up").
+  bool system_enabled_at_power_up = false;
   std::size_t receive_queue = 64;
 
   [[nodiscard]] Result<void> validate() const;

@@ -34,6 +34,7 @@ std::string_view name(FaultKind k) noexcept {
     case FaultKind::pos_converter: return "pos_converter";
     case FaultKind::transmit: return "transmit";
     case FaultKind::over_current: return "over_current";
+    case FaultKind::undocumented: return "undocumented";
   }
   return "?";
 }
@@ -79,10 +80,11 @@ Result<BoardFaultPlan> BoardFaultPlan::from_config(const core::ConfigNode& node,
       else if (kind == "pos_converter") e.kind = FaultKind::pos_converter;
       else if (kind == "transmit") e.kind = FaultKind::transmit;
       else if (kind == "over_current") e.kind = FaultKind::over_current;
+      else if (kind == "undocumented") e.kind = FaultKind::undocumented;
       else {
         AXON_TRY(c, it.child("kind"));
         return c.error(CoreErrc::config_bad_value,
-                       "expected encoder, pos_converter, transmit or over_current, got '" + kind + "'");
+                       "expected encoder, pos_converter, transmit, over_current or undocumented, got '" + kind + "'");
       }
       if (it.has("duration_s")) {
         AXON_TRY(d, seconds_at(it, "duration_s"));

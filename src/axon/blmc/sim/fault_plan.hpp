@@ -4,7 +4,7 @@
 // YAML (docs/blmc-simulator.md):
 //   seed: 1
 //   events:                       # the firmware raises the error at at_s
-//     - { at_s: 2.0, kind: encoder }                      # encoder | pos_converter | transmit | over_current
+//     - { at_s: 2.0, kind: encoder }      # encoder | pos_converter | transmit | over_current | undocumented
 //     - { at_s: 5.0, kind: over_current, duration_s: 1 }  # the cause lasts 1 s: recovery is refused meanwhile
 //     - { at_s: 9.0, kind: pos_converter, persistent: true }  # until power-cycled
 //   stalls:                       # the board's CAN link is dead for a window
@@ -31,7 +31,9 @@ enum class FaultKind : std::uint8_t {
   encoder,        // error 1
   pos_converter,  // error 4
   transmit,       // reported as 7 (OTHER), ranked second
-  over_current,   // the board has no code for it: reported as 7 (OTHER), ranked last
+  over_current,   // the board has no code for it: reported as 7 (OTHER), ranked below the others
+  undocumented,   // an error reported with code 6, which the spec does not define (a newer
+                  // firmware's code, say): latched and disabling like any error, ranked last
 };
 std::string_view name(FaultKind k) noexcept;
 

@@ -107,6 +107,7 @@ SimulatedBoardReport SimulatedBoard::report(unsigned board) const {
     const auto& b = i->runner->board(board);
     SimulatedBoardReport r;
     r.status = b.status();
+    r.status_byte = b.status_byte();
     r.motors = {b.motor_state(0), b.motor_state(1)};
     r.position_rev = {b.motor(0).position_rev(), b.motor(1).position_rev()};
     r.stats = b.stats();

@@ -46,6 +46,7 @@ struct SimulatedBoardOptions {
 // One board's state and counters at the moment of the call.
 struct SimulatedBoardReport {
   protocol::Status status{};
+  std::uint8_t status_byte = 0;        // the status as sent (shows an undocumented error code 6)
   std::array<MotorState, 2> motors{};  // enabled, ready, the last IqRef ...
   std::array<double, 2> position_rev{};
   BoardStats stats{};
