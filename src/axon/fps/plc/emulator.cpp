@@ -193,11 +193,12 @@ void PlcEmulator::Impl::close_conn(Conn& c) noexcept {
 }
 
 void PlcEmulator::Impl::reject(Conn& c, std::uint64_t EmulatorCounters::*counter, std::string_view what) {
+  // Logged before it is counted: whoever sees the count (a monitor, a test) finds the line in the log.
+  spdlog::warn("plc emulator: client {}: {}; connection closed", c.peer, what);
   {
     std::lock_guard lock(mu);
     ++(counters.*counter);
   }
-  spdlog::warn("plc emulator: client {}: {}; connection closed", c.peer, what);
   close_conn(c);
 }
 
