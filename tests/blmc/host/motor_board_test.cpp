@@ -185,8 +185,13 @@ TEST(BlmcMotorBoard, AnUndocumentedErrorCodeIsASafetyStopNamingIt) {
 }
 
 // Polls `done` every 10 ms for up to `limit` (the simulator runs on its own thread).
+// True as soon as one poll sees it (a motor passing through its band counts; callers that need it
+// to stay check again later).
 bool wait_for(const std::function<bool()>& done, std::chrono::milliseconds limit = 10s) {
-  for (auto t = 0ms; t < limit && !done(); t += 10ms) std::this_thread::sleep_for(10ms);
+  for (auto t = 0ms; t < limit; t += 10ms) {
+    if (done()) return true;
+    std::this_thread::sleep_for(10ms);
+  }
   return done();
 }
 
