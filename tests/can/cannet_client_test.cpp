@@ -601,3 +601,78 @@ TEST(CanNetClient, FramesKeepTheirOrderWhenTheOutputBufferIsFull) {
     gw.value()->close();
   });
 }
+
+// A reconnectable gateway (what fps::host::FocalPlaneArray opens) whose power is cut: its buses
+// stay open while it is away, and carry frames again once reconnect() found it back, on the same
+// port with every channel set up anew.
+TEST(CanNetClient, ReconnectableBusesSurviveAPowerCycleOfTheGateway) {
+  ClientBench b;
+  run(b.io, [&]() -> asio::awaitable<void> {
+    CanNetOptions o;
+    o.reconnectable = true;
+    auto gw = co_await b.connect_with(o, 1, 2);
+    CO_ASSERT_TRUE(gw);
+    auto bus = gw.value()->bus(2);
+    CO_ASSERT_TRUE(bus);
+    const net::Endpoint where = b.emulator->local_endpoint();
+    b.emulator->power_off();
+    // The host sees a failure, not the orderly close of a takeover; the bus is open, silent.
+    auto silent = co_await bus.value()->receive(300ms);
+    EXPECT_EQ(silent.error(), CanErrc::timeout);
+    EXPECT_FALSE(gw.value()->is_connected());
+    EXPECT_EQ(gw.value()->disconnect_kind(), DisconnectKind::failed);
+    EXPECT_TRUE(bus.value()->is_open());
+    EXPECT_EQ((co_await bus.value()->send(F("123#01"))).error(), CanErrc::io);
+    // Away: a reconnection fails and changes nothing.
+    auto early = co_await gw.value()->reconnect(500ms);
+    EXPECT_EQ(early.error(), CanErrc::connect_failed);
+    EXPECT_TRUE(bus.value()->is_open());
+
+    CanNetEmulatorOptions back;
+    back.port = where.port;
+    CanNetGatewayEmulator again(b.io.get_executor(), b.registry, std::vector<std::string>{"can0", "can1"}, back);
+    CO_ASSERT_TRUE(again.start());
+    auto r = co_await gw.value()->reconnect();
+    CO_ASSERT_TRUE(r);
+    EXPECT_TRUE(gw.value()->is_connected());
+    EXPECT_EQ(gw.value()->stats().reconnections, 1u);
+    EXPECT_FALSE(again.status(1).flags.stopped || again.status(2).flags.stopped);
+    CO_ASSERT_TRUE((co_await bus.value()->send(F("123#02"))).has_value());
+    auto out = co_await b.can1->receive(5s);
+    CO_ASSERT_TRUE(out);
+    EXPECT_EQ(out.value().to_string(), "123#02");
+    CO_ASSERT_TRUE((co_await b.can1->send(F("321#03"))).has_value());
+    auto in = co_await bus.value()->receive(5s);
+    CO_ASSERT_TRUE(in);
+    EXPECT_EQ(in.value().to_string(), "321#03");
+    gw.value()->close();
+    EXPECT_FALSE(bus.value()->is_open());
+    EXPECT_EQ((co_await gw.value()->reconnect()).error(), CanErrc::closed);
+  });
+}
+
+// Another client takes a reconnectable gateway over: the loss says so (an orderly close by the
+// gateway), the buses wait, and reconnect() takes the gateway back.
+TEST(CanNetClient, ATakenOverGatewayIsTakenBackOnlyByReconnect) {
+  ClientBench b;
+  run(b.io, [&]() -> asio::awaitable<void> {
+    CanNetOptions o;
+    o.reconnectable = true;
+    auto gw = co_await b.connect_with(o, 1);
+    CO_ASSERT_TRUE(gw);
+    auto bus = gw.value()->bus(1);
+    CO_ASSERT_TRUE(bus);
+    auto other = co_await b.connect(1);
+    CO_ASSERT_TRUE(other);
+    EXPECT_EQ((co_await bus.value()->receive(300ms)).error(), CanErrc::timeout);
+    EXPECT_EQ(gw.value()->disconnect_kind(), DisconnectKind::by_gateway);
+    EXPECT_TRUE(other.value()->is_connected());
+    CO_ASSERT_TRUE(co_await gw.value()->reconnect());
+    CO_ASSERT_TRUE((co_await b.can0->send(F("0AB#01"))).has_value());
+    auto in = co_await bus.value()->receive(5s);
+    CO_ASSERT_TRUE(in);
+    EXPECT_EQ(in.value().to_string(), "0AB#01");
+    EXPECT_EQ(b.emulator->stats().replaced, 2u);
+    gw.value()->close();
+  });
+}

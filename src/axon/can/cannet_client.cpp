@@ -17,6 +17,8 @@
 #include <algorithm>
 #include <array>
 #include <deque>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <optional>
 
 namespace axon::can {
@@ -67,6 +69,10 @@ struct CanNetGateway::Impl : std::enable_shared_from_this<CanNetGateway::Impl> {
   CanNetOptions options;
   tcp::socket socket;
   bool connected = false;
+  std::uint64_t generation = 0;  // of the connection; a reader or writer of an older one ends
+  bool host_closed = false;      // close() was called: no reconnection any more
+  bool reconnecting = false;
+  DisconnectKind down_kind = DisconnectKind::by_host;
   Error down_error{CanErrc::closed, "not connected"};
   CanNetGatewayStats stats;
   bool protocol_error_logged = false;
@@ -96,7 +102,9 @@ struct CanNetGateway::Impl : std::enable_shared_from_this<CanNetGateway::Impl> {
   void start();
   static asio::awaitable<void> run_reader(std::shared_ptr<Impl> self);
   static asio::awaitable<void> run_writer(std::shared_ptr<Impl> self);
-  void connection_down(Error why);
+  void connection_down(Error why, DisconnectKind kind);
+  void set_keepalive();
+  void close_buses();
 
   // ---- output ----
 
@@ -202,6 +210,11 @@ class CanNetBus final : public Bus {
 
 // ---- connection ----
 
+void CanNetGateway::Impl::close_buses() {
+  for (auto& c : chan)
+    if (c.bus) c.bus->on_connection_down();
+}
+
 asio::awaitable<Result<void>> CanNetGateway::Impl::open() {
   auto self = shared_from_this();
   auto resolver = std::make_shared<tcp::resolver>(executor);
@@ -227,8 +240,20 @@ asio::awaitable<Result<void>> CanNetGateway::Impl::open() {
   if (ec) co_return Error(CanErrc::connect_failed, fmt::format("{}: {}", where, ec.message()));
   boost::system::error_code ignored;
   socket.set_option(tcp::no_delay(true), ignored);
+  set_keepalive();
   connected = true;
   co_return ok();
+}
+
+void CanNetGateway::Impl::set_keepalive() {
+  const auto idle = std::chrono::duration_cast<std::chrono::seconds>(options.keepalive).count();
+  if (options.keepalive <= core::Duration::zero()) return;
+  boost::system::error_code ignored;
+  socket.set_option(asio::socket_base::keep_alive(true), ignored);
+  socket.set_option(asio::detail::socket_option::integer<IPPROTO_TCP, TCP_KEEPIDLE>(static_cast<int>(std::max<long long>(idle, 1))),
+                    ignored);
+  socket.set_option(asio::detail::socket_option::integer<IPPROTO_TCP, TCP_KEEPINTVL>(1), ignored);
+  socket.set_option(asio::detail::socket_option::integer<IPPROTO_TCP, TCP_KEEPCNT>(3), ignored);
 }
 
 void CanNetGateway::Impl::start() {
@@ -238,11 +263,13 @@ void CanNetGateway::Impl::start() {
 
 asio::awaitable<void> CanNetGateway::Impl::run_reader(std::shared_ptr<Impl> self) {
   Impl& s = *self;
+  const std::uint64_t generation = s.generation;
   std::array<char, 4096> buf{};
   LineSplitter lines;
-  while (s.connected) {
+  while (s.generation == generation) {
     boost::system::error_code ec;
     const std::size_t n = co_await s.socket.async_read_some(asio::buffer(buf), asio::redirect_error(asio::use_awaitable, ec));
+    if (s.generation != generation) co_return;  // that connection is gone (and maybe replaced)
     if (ec) {
       // An orderly close from the gateway's side: it serves one client at a time and closes the
       // older connection when another client connects (its protocol has no line to say so).
@@ -251,11 +278,12 @@ asio::awaitable<void> CanNetGateway::Impl::run_reader(std::shared_ptr<Impl> self
                                                              "has probably taken the gateway over (it serves one client "
                                                              "at a time), or it restarted",
                                                              s.where)
-                                               : fmt::format("{}: read failed: {}", s.where, ec.message())));
+                                               : fmt::format("{}: read failed: {}", s.where, ec.message())),
+                        ec == asio::error::eof ? DisconnectKind::by_gateway : DisconnectKind::failed);
       co_return;
     }
     lines.append(std::string_view(buf.data(), n));
-    while (s.connected) {
+    while (s.generation == generation) {
       auto piece = lines.next();
       if (!piece) break;
       if (piece->overlong)
@@ -268,12 +296,15 @@ asio::awaitable<void> CanNetGateway::Impl::run_reader(std::shared_ptr<Impl> self
 
 asio::awaitable<void> CanNetGateway::Impl::run_writer(std::shared_ptr<Impl> self) {
   Impl& s = *self;
+  const std::uint64_t generation = s.generation;
   std::string chunk;
-  while (s.connected) {
+  while (s.generation == generation) {
     if (s.out.empty()) {
       core::Wakeup idle(s.executor);
       s.writer_idle = &idle;
-      core::OnExit clear{[&s] { s.writer_idle = nullptr; }};
+      core::OnExit clear{[&s, &idle] {
+        if (s.writer_idle == &idle) s.writer_idle = nullptr;
+      }};
       co_await idle.wait();
       continue;
     }
@@ -281,17 +312,30 @@ asio::awaitable<void> CanNetGateway::Impl::run_writer(std::shared_ptr<Impl> self
     chunk.swap(s.out);
     boost::system::error_code ec;
     co_await asio::async_write(s.socket, asio::buffer(chunk), asio::redirect_error(asio::use_awaitable, ec));
+    if (s.generation != generation) co_return;
     if (ec) {
-      s.connection_down(Error(CanErrc::io, fmt::format("{}: write failed: {}", s.where, ec.message())));
+      s.connection_down(Error(CanErrc::io, fmt::format("{}: write failed: {}", s.where, ec.message())),
+                        DisconnectKind::failed);
       co_return;
     }
     s.admit_waiters();
   }
 }
 
-void CanNetGateway::Impl::connection_down(Error why) {
+void CanNetGateway::Impl::connection_down(Error why, DisconnectKind kind) {
+  if (kind == DisconnectKind::by_host) {
+    host_closed = true;
+    if (!connected) {  // down already (buses kept for a reconnection): now they close
+      down_kind = kind;
+      down_error = std::move(why);
+      close_buses();
+      return;
+    }
+  }
   if (!connected) return;
   connected = false;
+  ++generation;
+  down_kind = kind;
   if (why.code == CanErrc::closed)
     spdlog::debug("{}: connection closed", where);
   else
@@ -300,12 +344,14 @@ void CanNetGateway::Impl::connection_down(Error why) {
   boost::system::error_code ignored;
   socket.shutdown(tcp::socket::shutdown_both, ignored);
   socket.close(ignored);
+  // What was waiting for the wire goes with the connection: never sent on a later one.
+  stats.stale_lines_dropped += static_cast<std::uint64_t>(std::count(out.begin(), out.end(), '\n'));
+  out.clear();
   if (writer_idle) writer_idle->notify();
   for (auto* w : space_waiters) w->wake.abandon();
   for (auto* w : command_queue) w->abandon();  // woken without being granted the turn
   if (pending) pending->waiter.abandon();
-  for (auto& c : chan)
-    if (c.bus) c.bus->on_connection_down();
+  if (!options.reconnectable || kind == DisconnectKind::by_host) close_buses();
 }
 
 asio::awaitable<Result<void>> CanNetGateway::Impl::queue_in_turn(std::string_view line) {
@@ -485,7 +531,7 @@ asio::awaitable<Result<std::shared_ptr<CanNetGateway>>> CanNetGateway::connect(a
   for (const int ch : impl->channels) {
     auto r = co_await impl->set_up(ch);
     if (!r) {
-      impl->connection_down(Error(CanErrc::closed, "set-up failed"));
+      impl->connection_down(Error(CanErrc::closed, "set-up failed"), DisconnectKind::by_host);
       co_return r.error();
     }
   }
@@ -564,7 +610,57 @@ asio::awaitable<Result<void>> CanNetGateway::restart(int channel) {
   co_return ok();
 }
 
-void CanNetGateway::close() { impl_->connection_down(Error(CanErrc::closed, fmt::format("{}: closed by the host", impl_->where))); }
+asio::awaitable<Result<void>> CanNetGateway::reconnect(std::optional<core::Duration> timeout) {
+  auto impl = impl_;
+  Impl& s = *impl;
+  if (s.connected) co_return ok();
+  if (s.host_closed) co_return Error(CanErrc::closed, fmt::format("{}: closed by the host", s.where));
+  if (s.reconnecting) co_return Error(CanErrc::closed, fmt::format("{}: a reconnection is already under way", s.where));
+  s.reconnecting = true;
+  const core::Duration connect_timeout = s.options.connect_timeout;
+  const core::Duration reply_timeout = s.options.reply_timeout;
+  core::OnExit restore{[&s, connect_timeout, reply_timeout] {
+    s.options.connect_timeout = connect_timeout;
+    s.options.reply_timeout = reply_timeout;
+    s.reconnecting = false;
+  }};
+  if (timeout) s.options.connect_timeout = s.options.reply_timeout = *timeout;
+  AXON_CO_TRY(co_await s.open());
+  if (s.host_closed) {  // close() came while connecting
+    s.connection_down(Error(CanErrc::closed, fmt::format("{}: closed by the host", s.where)), DisconnectKind::by_host);
+    co_return Error(CanErrc::closed, fmt::format("{}: closed by the host", s.where));
+  }
+  s.start();
+  for (const int ch : s.channels) {
+    auto r = co_await s.set_up(ch);
+    if (!r) {
+      s.connection_down(r.error(), DisconnectKind::failed);
+      co_return r.error();
+    }
+  }
+  for (auto& c : s.chan)
+    if (c.bus) c.bus->on_state(c.state);
+  ++s.stats.reconnections;
+  spdlog::info("{}: reconnected, channel(s) {} set up again", s.where, fmt::join(s.channels, ", "));
+  co_return ok();
+}
+
+const char* to_string(DisconnectKind k) noexcept {
+  switch (k) {
+    case DisconnectKind::connected: return "connected";
+    case DisconnectKind::by_host: return "closed by the host";
+    case DisconnectKind::by_gateway: return "closed by the gateway";
+    case DisconnectKind::failed: return "failed";
+  }
+  return "?";
+}
+
+void CanNetGateway::close() {
+  impl_->connection_down(Error(CanErrc::closed, fmt::format("{}: closed by the host", impl_->where)), DisconnectKind::by_host);
+}
+DisconnectKind CanNetGateway::disconnect_kind() const noexcept {
+  return impl_->connected ? DisconnectKind::connected : impl_->down_kind;
+}
 bool CanNetGateway::is_connected() const noexcept { return impl_->connected; }
 const Error& CanNetGateway::disconnect_reason() const noexcept { return impl_->down_error; }
 const std::vector<int>& CanNetGateway::channels() const noexcept { return impl_->channels; }

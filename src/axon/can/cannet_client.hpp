@@ -14,6 +14,17 @@
 // connection stays up. When the connection drops, every bus closes: receive() returns the frames
 // already queued, then CanErrc::closed; send() fails with CanErrc::io.
 //
+// Reconnection (CanNetOptions::reconnectable): a host that keeps its buses for the life of the
+// program (fps::host::FocalPlaneArray) can have them survive a lost connection. They stay open
+// while it is down (send() fails with CanErrc::io, receive() just waits) and carry on once
+// reconnect() has opened a new connection and set every channel up again. Nothing queued before
+// the loss is sent on the new connection: a command that was waiting for the wire when the link
+// dropped is the caller's to repeat or not. The kind of loss (disconnect_kind()) tells a gateway
+// that closed the connection in order (another client took it over: a CAN@net NT serves one at a
+// time) from one that failed (reset, read or write error, keep-alive timeout: power cycled,
+// cable pulled). TCP keep-alive (CanNetOptions::keepalive) finds a gateway that died silently
+// while the host had nothing to send.
+//
 // The protocol has no request ids: replies are matched to commands by order, so commands are sent
 // one at a time (concurrent callers queue). Frames need no reply and are never held back by a
 // command in flight.
@@ -36,6 +47,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,7 +58,20 @@ struct CanNetOptions {
   core::Duration connect_timeout = std::chrono::seconds(5);                   // TCP connect (and name lookup)
   core::Duration reply_timeout = std::chrono::seconds(2);                     // per command
   BusOptions bus_options{};  // for each bus handed out; its bitrate is set from bitrate_kbit
+  bool reconnectable = false;  // buses survive a lost connection until reconnect() (see above)
+  // TCP keep-alive: first probe after this much silence, then one a second, 3 unanswered probes
+  // end the connection (a gateway that lost power is found in about keepalive + 3 s). 0: off.
+  core::Duration keepalive = std::chrono::seconds(2);
 };
+
+// How a connection ended.
+enum class DisconnectKind : std::uint8_t {
+  connected,          // it has not
+  by_host,            // close() (or a failed set-up)
+  by_gateway,         // an orderly close from the gateway: another client took it over, or it restarted
+  failed,             // reset, read or write error, keep-alive timeout
+};
+const char* to_string(DisconnectKind k) noexcept;
 
 // Answer to CAN b STATUS.
 struct CanNetStatus {
@@ -61,6 +86,8 @@ struct CanNetGatewayStats {
   std::uint64_t unrouted_frames = 0;     // frames for a channel with no open bus
   std::uint64_t commands = 0;            // commands answered (any reply)
   std::uint64_t device_errors = 0;       // R ERR replies
+  std::uint64_t reconnections = 0;       // successful reconnect() calls
+  std::uint64_t stale_lines_dropped = 0; // lines queued when the connection dropped, never sent
 };
 
 class CanNetGateway : public std::enable_shared_from_this<CanNetGateway> {
@@ -93,9 +120,16 @@ class CanNetGateway : public std::enable_shared_from_this<CanNetGateway> {
   // value). Errors: only transport ones (timeout, io, closed) and bad arguments.
   asio::awaitable<Result<cannet::Line>> command(const cannet::Line& line);
 
+  // Opens a new connection to the same endpoint and sets every channel up again (with
+  // CanNetOptions::reconnectable the buses already handed out carry on). `timeout` (when given)
+  // replaces connect_timeout and reply_timeout for this attempt. Already connected: nothing to do.
+  // Errors: closed (after close(), or a reconnect() already under way), and those of connect().
+  asio::awaitable<Result<void>> reconnect(std::optional<core::Duration> timeout = std::nullopt);
+
   // Closes the connection; every bus closes too. Safe to call twice.
   void close();
   [[nodiscard]] bool is_connected() const noexcept;
+  [[nodiscard]] DisconnectKind disconnect_kind() const noexcept;
   // Why the connection is down (meaningful once is_connected() is false): closed by the host, the
   // gateway's close (another client took the gateway over, or it restarted), a read or write error.
   [[nodiscard]] const Error& disconnect_reason() const noexcept;

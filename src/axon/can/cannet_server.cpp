@@ -104,7 +104,7 @@ struct CanNetGatewayEmulator::Impl : std::enable_shared_from_this<CanNetGatewayE
   bool stopped = false;
 
   Result<void> start();
-  void stop();
+  void stop(bool reset = false);
   // "HOST:PORT" where it listens, for log lines.
   [[nodiscard]] std::string local_text() const {
     boost::system::error_code ec;
@@ -118,7 +118,8 @@ struct CanNetGatewayEmulator::Impl : std::enable_shared_from_this<CanNetGatewayE
   static asio::awaitable<void> run_pump(std::shared_ptr<Impl> self, int channel);
 
   void attach(tcp::socket socket);
-  void drop(std::shared_ptr<Connection> conn, std::string_view why);
+  // reset: abort the connection (RST) instead of closing it in order (FIN).
+  void drop(std::shared_ptr<Connection> conn, std::string_view why, bool reset = false);
   void send(Connection& conn, std::string_view line) {
     if (!conn.open) return;
     conn.out.append(line);
@@ -201,12 +202,12 @@ Result<void> CanNetGatewayEmulator::Impl::start() {
   return ok();
 }
 
-void CanNetGatewayEmulator::Impl::stop() {
+void CanNetGatewayEmulator::Impl::stop(bool reset) {
   if (stopped) return;
   stopped = true;
   boost::system::error_code ignored;
   acceptor.close(ignored);
-  if (client) drop(client, "emulator stopped");
+  if (client) drop(client, reset ? "power lost" : "emulator stopped", reset);
   for (auto& c : chan)
     if (c.endpoint) c.endpoint->close();
 }
@@ -254,12 +255,15 @@ void CanNetGatewayEmulator::Impl::attach(tcp::socket socket) {
   asio::co_spawn(executor, run_writer(shared_from_this(), conn), asio::detached);
 }
 
-void CanNetGatewayEmulator::Impl::drop(std::shared_ptr<Connection> conn, std::string_view why) {
+void CanNetGatewayEmulator::Impl::drop(std::shared_ptr<Connection> conn, std::string_view why, bool reset) {
   if (!conn->open) return;
   conn->open = false;
   spdlog::debug("CAN@net emulator: connection {} ({}) closed: {}", conn->id, conn->peer, why);
   boost::system::error_code ignored;
-  conn->socket.shutdown(tcp::socket::shutdown_both, ignored);
+  if (reset)
+    conn->socket.set_option(asio::socket_base::linger(true, 0), ignored);  // close() then sends RST
+  else
+    conn->socket.shutdown(tcp::socket::shutdown_both, ignored);
   conn->socket.close(ignored);
   if (conn->writer_idle) conn->writer_idle->notify();
   if (conn->reader_blocked) conn->reader_blocked->notify();
@@ -478,6 +482,7 @@ CanNetGatewayEmulator::~CanNetGatewayEmulator() { stop(); }
 
 Result<void> CanNetGatewayEmulator::start() { return impl_->start(); }
 void CanNetGatewayEmulator::stop() { impl_->stop(); }
+void CanNetGatewayEmulator::power_off() { impl_->stop(true); }
 
 net::Endpoint CanNetGatewayEmulator::local_endpoint() const {
   boost::system::error_code ec;

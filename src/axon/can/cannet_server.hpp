@@ -88,6 +88,10 @@ class CanNetGatewayEmulator {
   Result<void> start();
   // Closes the client connection, the listening socket and the channel endpoints.
   void stop();
+  // The same as the device losing power: the client's connection is reset (RST), not closed in
+  // order. A host sees a read error (a real gateway's host sees it once it sends, or by TCP
+  // keep-alive), not the orderly close by which a gateway hands itself to a newer client.
+  void power_off();
 
   // Where it listens (the actual port when options.port was 0).
   [[nodiscard]] net::Endpoint local_endpoint() const;
