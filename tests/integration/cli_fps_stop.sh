@@ -74,7 +74,7 @@ rc=0
 wait "$pid" || rc=$?
 [ $rc = 4 ] || fail "take-over: exit code $rc, expected 4 (safety stop)"
 grep -q 'another client has probably taken the gateway over' "$TMP/move.out" || fail "take-over: not said"
-grep -q '^gateway 2: reconnected once and sent TRAJECTORY_ABORT on channel(s) 1, 2: 3 of 3 robots acknowledged' \
+grep -q '^gateway 2: reconnected and sent TRAJECTORY_ABORT on channel(s) 1, 2: 3 of 3 robots acknowledged' \
   "$TMP/move.out" || fail "take-over: the robots behind gateway 2 were not stopped through a reconnection"
 assert_stopped "take-over"
 

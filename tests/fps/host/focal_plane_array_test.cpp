@@ -205,7 +205,7 @@ TEST(FocalPlaneArray, GatewayTakenOverMidMoveIsStoppedThroughOneReconnectionBefo
     EXPECT_FALSE(r.value().completed);
     EXPECT_TRUE(rig.fpa->array().locked());
     EXPECT_EQ(rig.fpa->lost_gateways(), (std::vector<std::uint16_t>{2}));
-    const std::string stop = "gateway 2: reconnected once and sent TRAJECTORY_ABORT on channel(s) 1, 2: "
+    const std::string stop = "gateway 2: reconnected and sent TRAJECTORY_ABORT on channel(s) 1, 2: "
                              "6 of 6 robots acknowledged (6 had been moving)";
     EXPECT_EQ(rig.fpa->link_stops(), std::vector<std::string>{stop});
     EXPECT_TRUE(co_await eventually([&] {
@@ -214,6 +214,82 @@ TEST(FocalPlaneArray, GatewayTakenOverMidMoveIsStoppedThroughOneReconnectionBefo
       return true;
     }));
     for (auto* m : rig.sim->simulator().robots()) EXPECT_LT(m->physical_deg(sim::Arm::alpha), 80.0);
-    if (other) other->close();
+    // The host kept the link it took back to stop its robots.
+    EXPECT_TRUE(rig.fpa->gateways().at(1).gateway->is_connected());
+    EXPECT_FALSE(rig.fpa->gateways().at(1).down);
+    EXPECT_EQ(rig.fpa->gateways().at(1).restorations, 1u);
+    if (other) {
+      EXPECT_FALSE(other->is_connected());
+      other->close();
+    }
+  });
+}
+
+namespace {
+
+// Every robot of the rig's plane runs a short trajectory to the end (after an unlock).
+asio::awaitable<void> plane_moves_again(PlaneRig& rig) {
+  auto unlocked = co_await rig.fpa->array().unlock();
+  EXPECT_TRUE(unlocked.has_value()) << unlocked.error().message();
+  EXPECT_FALSE(rig.fpa->array().locked());
+  auto r = co_await rig.fpa->run_trajectories(everyone_to(rig, {20, 170}, 5, 1.0), {}, true);
+  EXPECT_TRUE(r.has_value());
+  if (r) {
+    EXPECT_TRUE(r.value().completed) << r.value().summary();
+  }
+}
+
+}  // namespace
+
+// The gateway of sextant 2 is power cycled through the PLC while nothing moves: everything stops
+// (array locked), the host finds the gateway back by itself once it answers again, and after an
+// unlock the whole plane, its 6 robots included, moves through the same array.
+TEST(FocalPlaneArray, GatewayPowerCycledComesBackByItselfAndThePlaneMovesAfterUnlock) {
+  PlaneRig rig;
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    auto* plc = rig.fpa->plc();
+    EXPECT_TRUE((co_await plc->set_gateway_power(2, false)).has_value());
+    EXPECT_TRUE(co_await eventually([&] { return rig.fpa->gateways().at(1).down; }));
+    EXPECT_TRUE(rig.fpa->array().locked());
+    // Away for longer than the first attempts (they fail: nobody listens).
+    co_await core::sleep_for(1200ms);
+    EXPECT_TRUE(rig.fpa->gateways().at(1).down);
+    EXPECT_TRUE((co_await plc->set_gateway_power(2, true)).has_value());
+    EXPECT_TRUE(co_await eventually([&] { return !rig.fpa->gateways().at(1).down; }, 20000));
+    EXPECT_EQ(rig.fpa->gateways().at(1).restorations, 1u);
+    EXPECT_EQ(rig.fpa->lost_gateways(), (std::vector<std::uint16_t>{2}));
+    EXPECT_EQ(rig.fpa->link_stops(),
+              std::vector<std::string>{"gateway 2: lost; none of its 6 robots was moving under this host"});
+    EXPECT_TRUE(rig.fpa->array().locked());  // the stop stands until unlocked
+    co_await plane_moves_again(rig);
+  });
+}
+
+// Another client takes gateway 2 over while nothing moves: the host leaves it to that client (no
+// tug of war), and takes it back only when asked to (restore_link).
+TEST(FocalPlaneArray, GatewayTakenOverWhileIdleIsLeftToTheOtherClientUntilRestoreLink) {
+  PlaneRig rig;
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    const std::vector<int> channels{1};
+    auto other = co_await can::CanNetGateway::connect(rig.runner.io.get_executor(), rig.sim->gateways().at(1).endpoint,
+                                                      channels);
+    EXPECT_TRUE(other.has_value());
+    if (!other) co_return;
+    EXPECT_TRUE(co_await eventually([&] { return rig.fpa->gateways().at(1).down; }));
+    // Several restore intervals later the other client still has it.
+    co_await core::sleep_for(rig.fpa->options().restore_interval * 3);
+    EXPECT_TRUE(other.value()->is_connected());
+    EXPECT_TRUE(rig.fpa->gateways().at(1).down);
+    auto back = co_await rig.fpa->restore_link(2);
+    EXPECT_TRUE(back.has_value()) << back.error().message();
+    EXPECT_FALSE(rig.fpa->gateways().at(1).down);
+    EXPECT_TRUE(co_await eventually([&] { return !other.value()->is_connected(); }));
+    EXPECT_EQ((co_await rig.fpa->restore_link(9)).error(), HostErrc::invalid_argument);
+    co_await plane_moves_again(rig);
+    other.value()->close();
   });
 }

@@ -26,6 +26,7 @@ asio::awaitable<Result<std::unique_ptr<FocalPlaneArray>>> FocalPlaneArray::conne
                                                                                    const FocalPlane& plane,
                                                                                    FocalPlaneArrayOptions options) {
   std::unique_ptr<FocalPlaneArray> self(new FocalPlaneArray(plane, std::move(options)));
+  self->options_.gateway.reconnectable = true;  // the array's buses outlive a lost connection
   const auto by_bus = plane.by_bus();
   if (by_bus.empty()) co_return Error(HostErrc::invalid_argument, fmt::format("layout '{}' has no robots", plane.name()));
 
@@ -113,9 +114,10 @@ asio::awaitable<void> FocalPlaneArray::watch(FocalPlaneArray* self, std::shared_
 }
 
 void FocalPlaneArray::check_links() {
-  for (const auto& link : gateways_) {
-    if (link.gateway->is_connected() || std::ranges::find(lost_, link.id) != lost_.end()) continue;
-    link_lost(link);
+  for (std::size_t i = 0; i < gateways_.size(); ++i) {
+    const auto& link = gateways_[i];
+    if (link.down || link.gateway->is_connected()) continue;
+    link_lost(i);
   }
 }
 
@@ -123,83 +125,145 @@ asio::awaitable<void> FocalPlaneArray::link_stops_done() {
   while (reconnecting_ > 0) co_await core::sleep_for(10ms);
 }
 
-void FocalPlaneArray::link_lost(const GatewayLink& link) {
+void FocalPlaneArray::link_lost(std::size_t index) {
+  auto& link = gateways_[index];
+  link.down = true;
+  ++link.losses;
   lost_.push_back(link.id);
   const auto reason = fmt::format("gateway {} at {} disconnected ({})", link.id, link.endpoint.to_string(),
                                   link.gateway->disconnect_reason().detail);
   spdlog::error("fps focal plane: {}: stopping every robot", reason);
   array_->request_stop(reason);
-  std::vector<std::uint16_t> behind;
+  std::size_t behind = 0;
   std::size_t moving = 0;
   for (auto b : link.buses) {
     for (auto id : array_->ids_on(b)) {
-      behind.push_back(id);
+      ++behind;
       moving += array_->moving().contains(id) ? 1 : 0;
     }
   }
-  if (moving == 0) {
-    link_stops_.push_back(fmt::format("gateway {}: lost; none of its {} robots was moving under this host", link.id,
-                                      behind.size()));
+  const bool takeover = link.gateway->disconnect_kind() == can::DisconnectKind::by_gateway;
+  const bool restore = options_.restore_links && (!takeover || options_.restore_after_takeover);
+  if (moving > 0 && options_.reconnect_to_stop) {
+    ++reconnecting_;
+    asio::co_spawn(array_->client(0).bus().get_executor(), stop_behind(index, behind, moving, restore),
+                   [this](std::exception_ptr) { --reconnecting_; });
     return;
   }
-  if (!options_.reconnect_to_stop) {
+  if (moving == 0)
+    link_stops_.push_back(fmt::format("gateway {}: lost; none of its {} robots was moving under this host", link.id, behind));
+  else
     link_stops_.push_back(fmt::format("gateway {}: lost with {} robots moving behind it: NOT stopped (no reconnection "
                                       "allowed)", link.id, moving));
-    return;
-  }
-  ++reconnecting_;
-  asio::co_spawn(array_->client(0).bus().get_executor(), stop_behind(link, std::move(behind), moving),
-                 [this](std::exception_ptr) { --reconnecting_; });
+  if (restore) spawn_restore(index);
 }
 
-// One reconnection to a lost gateway, a TRAJECTORY_ABORT broadcast on each of its channels
-// (acknowledgements collected briefly), and the connection closed again.
-asio::awaitable<void> FocalPlaneArray::stop_behind(GatewayLink link, std::vector<std::uint16_t> robots, std::size_t moving) {
-  const auto ex = co_await asio::this_coro::executor;
-  std::vector<int> channels;
-  for (auto b : link.buses) channels.push_back(refs_[b].channel);
-  can::CanNetOptions o = options_.gateway;
-  o.connect_timeout = options_.reconnect_timeout;
-  o.reply_timeout = options_.reconnect_timeout;
-  const net::Endpoint ep = link.endpoint;
-  spdlog::warn("fps focal plane: gateway {}: {} robots were moving behind it; reconnecting once to stop them", link.id, moving);
-  auto gw = co_await can::CanNetGateway::connect(ex, ep, channels, o);
-  if (!gw) {
+// A reconnection to a lost gateway at once, then a TRAJECTORY_ABORT broadcast on each of its
+// channels through the array's own clients (acknowledgements collected briefly).
+asio::awaitable<void> FocalPlaneArray::stop_behind(std::size_t index, std::size_t robots, std::size_t moving,
+                                                   bool restore_after) {
+  const auto alive = alive_;
+  auto& link = gateways_[index];
+  spdlog::warn("fps focal plane: gateway {}: {} robots were moving behind it; reconnecting at once to stop them", link.id, moving);
+  auto r = co_await link.gateway->reconnect(options_.reconnect_timeout);
+  if (!*alive) co_return;
+  if (!r) {
     link_stops_.push_back(fmt::format("gateway {}: {} robots were moving behind it: NOT stopped, the reconnection "
-                                      "failed: {}", link.id, moving, gw.error().message()));
+                                      "failed: {}", link.id, moving, r.error().message()));
     spdlog::error("fps focal plane: {}", link_stops_.back());
+    if (restore_after) spawn_restore(index);
     co_return;
   }
-  std::size_t acked = 0;
-  std::vector<std::string> failures;
-  for (auto b : link.buses) {
-    const int ch = refs_[b].channel;
-    const auto ids = array_->ids_on(b);
-    const std::set<std::uint16_t> expected(ids.begin(), ids.end());
-    auto bus = gw.value()->bus(ch);
-    if (!bus) {
-      failures.push_back(bus.error().message());
-      continue;
-    }
-    CommandClient client(*bus.value(), {}, array_->motion_lock());  // the array's lock, as on every bus
-    BroadcastOptions bo;
-    bo.expected_ids = expected;
-    bo.window = options_.reconnect_window;
-    auto r = co_await client.broadcast(protocol::CommandId::trajectory_abort, {}, bo);
-    if (r) {
-      for (const auto& reply : r.value().replies) acked += expected.contains(reply.positioner) ? 1 : 0;
-    } else {
-      failures.push_back(r.error().message());
-    }
-    co_await client.stop();
-    bus.value()->close();
-  }
-  gw.value()->close();
-  link_stops_.push_back(fmt::format("gateway {}: reconnected once and sent TRAJECTORY_ABORT on channel(s) {}: {} of {} "
+  link_up(index, "reconnected to stop its robots");
+  std::vector<int> channels;
+  for (auto b : link.buses) channels.push_back(refs_[b].channel);
+  const auto stops = co_await broadcast_on_link(index, protocol::CommandId::trajectory_abort);
+  if (!*alive) co_return;
+  link_stops_.push_back(fmt::format("gateway {}: reconnected and sent TRAJECTORY_ABORT on channel(s) {}: {} of {} "
                                     "robots acknowledged ({} had been moving){}{}",
-                                    link.id, fmt::join(channels, ", "), acked, robots.size(), moving,
-                                    failures.empty() ? "" : "; failed: ", fmt::join(failures, "; ")));
+                                    link.id, fmt::join(channels, ", "), stops.acknowledged, robots, moving,
+                                    stops.failures.empty() ? "" : "; failed: ", fmt::join(stops.failures, "; ")));
   spdlog::warn("fps focal plane: {}", link_stops_.back());
+}
+
+asio::awaitable<FocalPlaneArray::LinkBroadcast> FocalPlaneArray::broadcast_on_link(std::size_t index, protocol::CommandId c) {
+  LinkBroadcast out;
+  std::vector<std::size_t> buses = gateways_[index].buses;
+  co_await for_each_concurrently(buses.size(), [&](std::size_t k) -> asio::awaitable<void> {
+    const auto ids = array_->ids_on(buses[k]);
+    BroadcastOptions bo;
+    bo.expected_ids = std::set<std::uint16_t>(ids.begin(), ids.end());
+    bo.window = options_.reconnect_window;
+    auto r = co_await array_->client(buses[k]).broadcast(c, {}, bo);
+    if (!r) {
+      out.failures.push_back(r.error().message());
+      co_return;
+    }
+    for (const auto& reply : r.value().replies) out.acknowledged += bo.expected_ids->contains(reply.positioner) ? 1 : 0;
+  });
+  co_return out;
+}
+
+void FocalPlaneArray::spawn_restore(std::size_t index) {
+  ++restoring_;
+  asio::co_spawn(array_->client(0).bus().get_executor(), restore_loop(index, alive_), [this, alive = alive_](std::exception_ptr) {
+    if (*alive) --restoring_;
+  });
+}
+
+// Attempts to reconnect a lost gateway until it answers or the array closes, the wait between
+// attempts doubling from restore_interval up to restore_max_interval.
+asio::awaitable<void> FocalPlaneArray::restore_loop(std::size_t index, std::shared_ptr<bool> alive) {
+  core::Duration wait = options_.restore_interval;
+  const std::uint16_t id = gateways_[index].id;
+  for (std::size_t attempt = 1;; ++attempt) {
+    if (!co_await wait_unless_closed(wait, alive)) co_return;
+    auto& link = gateways_[index];
+    if (!link.down) co_return;  // restored meanwhile (restore_link())
+    auto r = co_await link.gateway->reconnect(options_.reconnect_timeout);
+    if (!*alive || closed_) co_return;
+    if (r) {
+      link_up(index, fmt::format("after {} attempt(s)", attempt));
+      co_return;
+    }
+    if (link.gateway->disconnect_kind() == can::DisconnectKind::by_host) co_return;
+    if (attempt == 1)
+      spdlog::warn("fps focal plane: gateway {} not reachable yet ({}); trying again, every {} ms at most", id,
+                   r.error().message(), std::chrono::duration_cast<std::chrono::milliseconds>(options_.restore_max_interval).count());
+    else
+      spdlog::debug("fps focal plane: gateway {}: attempt {}: {}", id, attempt, r.error().message());
+    wait = std::min(wait * 2, options_.restore_max_interval);
+  }
+}
+
+asio::awaitable<bool> FocalPlaneArray::wait_unless_closed(core::Duration d, std::shared_ptr<bool> alive) {
+  const auto until = core::steady_now() + d;
+  while (*alive && !closed_) {
+    const auto now = core::steady_now();
+    if (now >= until) co_return true;
+    co_await core::sleep_for(std::min<core::Duration>(until - now, 50ms));
+  }
+  co_return false;
+}
+
+void FocalPlaneArray::link_up(std::size_t index, std::string_view how) {
+  auto& link = gateways_[index];
+  if (!link.down) return;
+  link.down = false;
+  ++link.restorations;
+  spdlog::warn("fps focal plane: gateway {} at {} is back ({}){}", link.id, link.endpoint.to_string(), how,
+               array_->locked() ? "; the array stays locked until unlock()" : "");
+}
+
+asio::awaitable<Result<void>> FocalPlaneArray::restore_link(std::uint16_t gateway) {
+  for (std::size_t i = 0; i < gateways_.size(); ++i) {
+    if (gateways_[i].id != gateway) continue;
+    auto gw = gateways_[i].gateway;
+    AXON_CO_TRY(co_await gw->reconnect(options_.reconnect_timeout));
+    if (gateways_[i].down) link_up(i, "on request");
+    co_return ok();
+  }
+  co_return Error(HostErrc::invalid_argument, fmt::format("gateway {} is not a gateway of layout '{}'", gateway, plane_.name()));
 }
 
 asio::awaitable<LayoutCheck> FocalPlaneArray::check_layout() {
@@ -238,8 +302,9 @@ asio::awaitable<Result<TrajectoryReport>> FocalPlaneArray::run_trajectories(
 asio::awaitable<void> FocalPlaneArray::close() {
   if (closed_) co_return;
   closed_ = true;
-  *alive_ = false;
   co_await link_stops_done();
+  while (restoring_ > 0) co_await core::sleep_for(10ms);  // each ends within one attempt's timeout
+  *alive_ = false;
   co_await array_->close();
   for (auto& b : buses_) b->close();
   for (auto& l : gateways_)

@@ -16,13 +16,20 @@
 // checks the connections every `connection_poll`.
 //
 // The robots behind the lost gateway cannot hear that stop. When some of them were moving under
-// this host, it reconnects to that gateway once (reconnect_to_stop) and broadcasts TRAJECTORY_ABORT
-// on its channels, then closes again. Why: their neighbours behind the other gateways have just been
+// this host, it reconnects to that gateway at once (reconnect_to_stop) and broadcasts
+// TRAJECTORY_ABORT on its channels. Why: their neighbours behind the other gateways have just been
 // stopped, and paths planned to be collision-free together are no longer so when half the plane
 // stops and the other half follows its trajectories to the end. The price is that a client that
-// took the gateway over (a CAN@net NT serves one client at a time) loses its connection for that
-// moment; stopping moving robots comes first. Only once: a gateway that cannot be reached again is
-// reported (link_stops()), not retried.
+// took the gateway over (a CAN@net NT serves one client at a time) loses its connection; stopping
+// moving robots comes first. What was done is in link_stops(), one line per loss.
+//
+// Links come back by themselves. The buses of the array survive a lost connection (they are
+// opened reconnectable): a gateway whose connection failed (reset, keep-alive timeout: power cycled,
+// network cut) is tried again every restore_interval, doubling up to restore_max_interval, and once
+// it answers its channels are set up again and its robots are reachable through the same array.
+// A gateway that closed the connection in order (another client took it over) is left to that
+// client unless restore_after_takeover; restore_link() takes it back on request. A restored link
+// leaves the array locked: the stop stands until unlock(), as after a collision.
 #pragma once
 
 #include "axon/can/cannet_client.hpp"
@@ -36,6 +43,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 namespace axon::fps::host {
@@ -51,10 +59,15 @@ struct FocalPlaneArrayOptions {
   core::Duration connection_poll = 20ms;    // how often the gateway connections are checked
   // Replaces the layout's gateway addresses (e.g. emulators on other ports), by gateway id.
   std::map<std::uint16_t, net::Endpoint> addresses;
-  // A lost gateway behind which robots were moving: reconnect once to stop them (see above).
+  // A lost gateway behind which robots were moving: reconnect at once to stop them (see above).
   bool reconnect_to_stop = true;
-  core::Duration reconnect_timeout = 1s;    // connect and set-up of that one reconnection
+  core::Duration reconnect_timeout = 1s;    // connect and set-up of each reconnection attempt
   core::Duration reconnect_window = 300ms;  // collecting the robots' acknowledgements of the abort
+  // Bringing lost links back (see above).
+  bool restore_links = true;
+  core::Duration restore_interval = 500ms;   // first wait before another attempt
+  core::Duration restore_max_interval = 8s;  // the wait doubles up to this
+  bool restore_after_takeover = false;       // also take back a gateway another client took over
 };
 
 struct GatewayLink {
@@ -62,6 +75,9 @@ struct GatewayLink {
   net::Endpoint endpoint;
   std::shared_ptr<can::CanNetGateway> gateway;
   std::vector<std::size_t> buses;  // array bus indices
+  bool down = false;               // lost and not (yet) restored
+  std::uint32_t losses = 0;
+  std::uint32_t restorations = 0;  // reconnections that brought it back (the stop's one included)
 };
 
 class FocalPlaneArray {
@@ -94,7 +110,12 @@ class FocalPlaneArray {
   asio::awaitable<Result<TrajectoryReport>> run_trajectories(std::map<std::uint16_t, protocol::Trajectory> trajectories,
                                                              TrajectoryOptions options = {}, bool by_sync_line = false);
 
-  // Gateways whose connection dropped (by id), in the order noticed.
+  // Reconnects a lost gateway now (e.g. one another client took over) and sets its channels up
+  // again. Already connected: nothing to do. Errors: invalid_argument (not a gateway of the
+  // layout), the connection's (CanErrc: connect_failed, timeout, device_error ...).
+  asio::awaitable<Result<void>> restore_link(std::uint16_t gateway);
+
+  // Gateways whose connection dropped (by id), in the order noticed (again for each loss).
   [[nodiscard]] const std::vector<std::uint16_t>& lost_gateways() const noexcept { return lost_; }
   // What was done for the robots behind each lost gateway (one line each): the stop sent through
   // a reconnection, or why they could not be stopped.
@@ -107,9 +128,19 @@ class FocalPlaneArray {
   FocalPlaneArray(const FocalPlane& plane, FocalPlaneArrayOptions options);
   static asio::awaitable<void> watch(FocalPlaneArray* self, std::shared_ptr<bool> alive);
   void check_links();  // link_lost() for each gateway newly disconnected
-  void link_lost(const GatewayLink& link);
+  void link_lost(std::size_t link);
   asio::awaitable<void> link_stops_done();  // once every stop_behind() has ended
-  asio::awaitable<void> stop_behind(GatewayLink link, std::vector<std::uint16_t> robots, std::size_t moving);
+  asio::awaitable<void> stop_behind(std::size_t link, std::size_t robots, std::size_t moving, bool restore_after);
+  struct LinkBroadcast {
+    std::size_t acknowledged = 0;       // known robots of the link's buses that answered
+    std::vector<std::string> failures;  // buses where the broadcast failed
+  };
+  asio::awaitable<LinkBroadcast> broadcast_on_link(std::size_t link, protocol::CommandId c);
+  void spawn_restore(std::size_t link);
+  asio::awaitable<void> restore_loop(std::size_t link, std::shared_ptr<bool> alive);
+  void link_up(std::size_t link, std::string_view how);
+  // Waits `d` in short slices, returning early (false) once the array closes.
+  asio::awaitable<bool> wait_unless_closed(core::Duration d, std::shared_ptr<bool> alive);
 
   FocalPlane plane_;
   FocalPlaneArrayOptions options_;
@@ -121,6 +152,7 @@ class FocalPlaneArray {
   std::vector<std::uint16_t> lost_;
   std::vector<std::string> link_stops_;
   std::size_t reconnecting_ = 0;  // stop_behind() coroutines running
+  std::size_t restoring_ = 0;     // restore_loop() coroutines running
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
   bool closed_ = false;
 };

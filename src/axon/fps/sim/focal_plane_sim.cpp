@@ -179,7 +179,7 @@ struct FocalPlaneSimulator::Impl {
       if (on) {
         AXON_TRY(start_gateway(i));
       } else {
-        emulators[i]->stop();
+        emulators[i]->power_off();
         g.powered = false;
       }
     }
