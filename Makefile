@@ -1,6 +1,6 @@
 # axon: the two set-up commands are `make run` and `make test` (see README.md).
 # Each installs missing Debian packages, configures with CMake presets and builds with Ninja.
-.PHONY: all deps release debug run test bench asan test-asan tsan test-tsan fuzz fuzz-smoke clean
+.PHONY: all deps release debug run test bench soak asan test-asan tsan test-tsan fuzz fuzz-smoke clean
 
 JOBS ?= $(shell nproc)
 # ccache (when installed) shares compiled objects between clones of the project on one machine.
@@ -29,6 +29,12 @@ test: release
 
 bench: release
 	@bash bench/run-all.sh build/release
+
+# The soak programs (soak/, docs/reliability.md), each for SOAK_MINUTES, one after the other.
+SOAK_MINUTES ?= 30
+SOAK_SEED ?= 1
+soak: release
+	@bash soak/run.sh build/release $(SOAK_MINUTES) $(SOAK_SEED)
 
 # The sanitizer builds (clang) compile only the unit tests, the libraries they use and, in the
 # asan build, the libFuzzer targets: one instrumented build serves both.
