@@ -293,3 +293,41 @@ TEST(FocalPlaneArray, GatewayTakenOverWhileIdleIsLeftToTheOtherClientUntilRestor
     other.value()->close();
   });
 }
+
+// Channel 2 of gateway 1 goes bus-off while every robot moves: the robots there cannot hear the
+// host, so everything stops, the channel is restarted at once and its robots get the abort, and
+// after an unlock the plane moves again.
+TEST(FocalPlaneArray, ABusOffChannelStopsEverythingIsRestartedAndItsRobotsAreStopped) {
+  PlaneRig rig;
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect();
+    if (!rig.fpa) co_return;
+    asio::co_spawn(
+        rig.runner.io,
+        [&]() -> asio::awaitable<void> {
+          co_await eventually([&] { return rig.sim->simulator().find(7)->moving(); }, 20000);
+          rig.sim->gateway_emulator(1)->inject_bus_off(2);
+        },
+        asio::detached);
+    auto r = co_await rig.fpa->run_trajectories(everyone_to(rig, {90, 120}, 10, 40.0), {}, true);
+    EXPECT_TRUE(r.has_value());
+    if (!r) co_return;
+    EXPECT_FALSE(r.value().completed);
+    EXPECT_TRUE(rig.fpa->array().locked());
+    EXPECT_NE(rig.fpa->array().lock_state().reason.find("went bus-off"), std::string::npos)
+        << rig.fpa->array().lock_state().reason;
+    EXPECT_EQ(rig.fpa->bus_off_restarts(), 1u);
+    EXPECT_EQ(rig.fpa->link_stops().size(), 1u);
+    if (rig.fpa->link_stops().empty()) co_return;
+    EXPECT_NE(rig.fpa->link_stops()[0].find("bus-off; channel restarted and TRAJECTORY_ABORT sent: 3 of 3 robots"),
+              std::string::npos)
+        << rig.fpa->link_stops()[0];
+    EXPECT_TRUE(co_await eventually([&] {
+      for (auto* m : rig.sim->simulator().robots())
+        if (m->moving()) return false;
+      return true;
+    }));
+    for (auto* m : rig.sim->simulator().robots()) EXPECT_LT(m->physical_deg(sim::Arm::alpha), 80.0);
+    co_await plane_moves_again(rig);
+  });
+}

@@ -84,6 +84,7 @@ asio::awaitable<Result<std::unique_ptr<FocalPlaneArray>>> FocalPlaneArray::conne
     }
   }
   self->array_ = std::make_unique<Array>(raw, self->options_.array);
+  self->bus_off_.assign(self->refs_.size(), false);
   for (std::size_t i = 0; i < self->refs_.size(); ++i) {
     for (auto id : by_bus.at(self->refs_[i])) {
       const auto* site = plane.find(id);
@@ -116,9 +117,48 @@ asio::awaitable<void> FocalPlaneArray::watch(FocalPlaneArray* self, std::shared_
 void FocalPlaneArray::check_links() {
   for (std::size_t i = 0; i < gateways_.size(); ++i) {
     const auto& link = gateways_[i];
-    if (link.down || link.gateway->is_connected()) continue;
-    link_lost(i);
+    if (!link.down && !link.gateway->is_connected()) link_lost(i);
+    if (link.down) continue;
+    for (auto b : link.buses) {
+      if (buses_[b]->state() != can::BusState::bus_off || bus_off_[b]) continue;
+      bus_off_[b] = true;
+      const auto reason = fmt::format("{} (gateway {} channel {}) went bus-off", buses_[b]->name(), link.id,
+                                      int{refs_[b].channel});
+      spdlog::error("fps focal plane: {}: stopping every robot", reason);
+      array_->request_stop(reason);
+      ++reconnecting_;
+      asio::co_spawn(array_->client(0).bus().get_executor(), restart_bus(i, b), [this](std::exception_ptr) { --reconnecting_; });
+    }
   }
+}
+
+// A channel that went bus-off hears nothing and says nothing: the robots on it cannot be told to
+// stop until the channel is restarted (CAN b STOP, CAN b START), which is done at once, followed by
+// a TRAJECTORY_ABORT broadcast there. A restart that fails is tried again on a later watch.
+asio::awaitable<void> FocalPlaneArray::restart_bus(std::size_t index, std::size_t bus) {
+  const auto alive = alive_;
+  auto gw = gateways_[index].gateway;
+  const int channel = refs_[bus].channel;
+  auto r = co_await gw->restart(channel);
+  if (!*alive) co_return;
+  ++bus_off_count_;
+  if (!r) {
+    link_stops_.push_back(fmt::format("{}: bus-off; restarting the channel failed ({}): its robots are NOT stopped",
+                                      buses_[bus]->name(), r.error().message()));
+    spdlog::error("fps focal plane: {}", link_stops_.back());
+    co_await wait_unless_closed(options_.restore_interval, alive);
+    if (*alive) bus_off_[bus] = false;
+    co_return;
+  }
+  std::vector<std::size_t> one{bus};
+  const auto stops = co_await broadcast_on(std::move(one), protocol::CommandId::trajectory_abort);
+  if (!*alive) co_return;
+  link_stops_.push_back(fmt::format("{}: bus-off; channel restarted and TRAJECTORY_ABORT sent: {} of {} robots "
+                                    "acknowledged{}{}",
+                                    buses_[bus]->name(), stops.acknowledged, array_->ids_on(bus).size(),
+                                    stops.failures.empty() ? "" : "; failed: ", fmt::join(stops.failures, "; ")));
+  spdlog::warn("fps focal plane: {}", link_stops_.back());
+  bus_off_[bus] = false;
 }
 
 asio::awaitable<void> FocalPlaneArray::link_stops_done() {
@@ -177,7 +217,7 @@ asio::awaitable<void> FocalPlaneArray::stop_behind(std::size_t index, std::size_
   link_up(index, "reconnected to stop its robots");
   std::vector<int> channels;
   for (auto b : link.buses) channels.push_back(refs_[b].channel);
-  const auto stops = co_await broadcast_on_link(index, protocol::CommandId::trajectory_abort);
+  const auto stops = co_await broadcast_on(link.buses, protocol::CommandId::trajectory_abort);
   if (!*alive) co_return;
   link_stops_.push_back(fmt::format("gateway {}: reconnected and sent TRAJECTORY_ABORT on channel(s) {}: {} of {} "
                                     "robots acknowledged ({} had been moving){}{}",
@@ -186,9 +226,9 @@ asio::awaitable<void> FocalPlaneArray::stop_behind(std::size_t index, std::size_
   spdlog::warn("fps focal plane: {}", link_stops_.back());
 }
 
-asio::awaitable<FocalPlaneArray::LinkBroadcast> FocalPlaneArray::broadcast_on_link(std::size_t index, protocol::CommandId c) {
+asio::awaitable<FocalPlaneArray::LinkBroadcast> FocalPlaneArray::broadcast_on(std::vector<std::size_t> buses,
+                                                                          protocol::CommandId c) {
   LinkBroadcast out;
-  std::vector<std::size_t> buses = gateways_[index].buses;
   co_await for_each_concurrently(buses.size(), [&](std::size_t k) -> asio::awaitable<void> {
     const auto ids = array_->ids_on(buses[k]);
     BroadcastOptions bo;

@@ -10,10 +10,11 @@
 // started by the sync line instead of the START_TRAJECTORY broadcast (run_trajectories with
 // by_sync_line), and sextants powered off and on.
 //
-// Faults: the array already stops every bus on a collision anywhere. Here, besides, a gateway
-// whose connection drops stops everything too (TRAJECTORY_ABORT broadcast on every bus still
-// reachable, array locked, the reason naming the gateway and why its connection ended): a watch
-// checks the connections every `connection_poll`.
+// Faults: the array already stops every bus on a collision anywhere. Here, besides, a channel that
+// goes bus-off stops everything (it is then restarted at once and its robots are sent the abort;
+// link_stops() says so), and a gateway whose connection drops stops everything too
+// (TRAJECTORY_ABORT broadcast on every bus still reachable, array locked, the reason naming the
+// gateway and why its connection ended): a watch checks the connections every `connection_poll`.
 //
 // The robots behind the lost gateway cannot hear that stop. When some of them were moving under
 // this host, it reconnects to that gateway at once (reconnect_to_stop) and broadcasts
@@ -115,6 +116,9 @@ class FocalPlaneArray {
   // layout), the connection's (CanErrc: connect_failed, timeout, device_error ...).
   asio::awaitable<Result<void>> restore_link(std::uint16_t gateway);
 
+  // Channels restarted after a bus-off (each stops every robot first, like a lost link).
+  [[nodiscard]] std::uint64_t bus_off_restarts() const noexcept { return bus_off_count_; }
+
   // Gateways whose connection dropped (by id), in the order noticed (again for each loss).
   [[nodiscard]] const std::vector<std::uint16_t>& lost_gateways() const noexcept { return lost_; }
   // What was done for the robots behind each lost gateway (one line each): the stop sent through
@@ -135,7 +139,8 @@ class FocalPlaneArray {
     std::size_t acknowledged = 0;       // known robots of the link's buses that answered
     std::vector<std::string> failures;  // buses where the broadcast failed
   };
-  asio::awaitable<LinkBroadcast> broadcast_on_link(std::size_t link, protocol::CommandId c);
+  asio::awaitable<LinkBroadcast> broadcast_on(std::vector<std::size_t> buses, protocol::CommandId c);
+  asio::awaitable<void> restart_bus(std::size_t link, std::size_t bus);
   void spawn_restore(std::size_t link);
   asio::awaitable<void> restore_loop(std::size_t link, std::shared_ptr<bool> alive);
   void link_up(std::size_t link, std::string_view how);
@@ -153,6 +158,8 @@ class FocalPlaneArray {
   std::vector<std::string> link_stops_;
   std::size_t reconnecting_ = 0;  // stop_behind() coroutines running
   std::size_t restoring_ = 0;     // restore_loop() coroutines running
+  std::vector<bool> bus_off_;      // per bus: a bus-off being handled
+  std::uint64_t bus_off_count_ = 0;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
   bool closed_ = false;
 };

@@ -365,6 +365,11 @@ Simulator& FocalPlaneSimulator::simulator() noexcept { return *impl_->simulator;
 can::VirtualBusRegistry& FocalPlaneSimulator::registry() noexcept { return impl_->registry; }
 const std::vector<GatewayInfo>& FocalPlaneSimulator::gateways() const noexcept { return impl_->gateways; }
 plc::PlcEmulator* FocalPlaneSimulator::plc() noexcept { return impl_->plc.get(); }
+can::CanNetGatewayEmulator* FocalPlaneSimulator::gateway_emulator(std::uint16_t id) noexcept {
+  for (std::size_t i = 0; i < impl_->gateways.size(); ++i)
+    if (impl_->gateways[i].id == id && impl_->gateways[i].powered) return impl_->emulators[i].get();
+  return nullptr;
+}
 std::shared_ptr<can::VirtualBus> FocalPlaneSimulator::medium(const BusRef& bus) const {
   const auto it = impl_->media.find(bus);
   return it == impl_->media.end() ? nullptr : it->second;

@@ -126,6 +126,9 @@ class FocalPlaneSimulator {
   [[nodiscard]] const std::vector<GatewayInfo>& gateways() const noexcept;
   // nullptr without the PLC.
   [[nodiscard]] plc::PlcEmulator* plc() noexcept;
+  // The emulator of a gateway (fault hooks: inject_bus_off ...); nullptr for an unknown id or while
+  // its power is off.
+  [[nodiscard]] can::CanNetGatewayEmulator* gateway_emulator(std::uint16_t id) noexcept;
   // The virtual medium of a bus ("gw1c2").
   [[nodiscard]] static std::string medium_name(const BusRef& bus);
   [[nodiscard]] std::shared_ptr<can::VirtualBus> medium(const BusRef& bus) const;
