@@ -5,6 +5,7 @@
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/connect.hpp>
 #include <boost/asio/detached.hpp>
+#include <boost/asio/post.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/redirect_error.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -270,6 +271,13 @@ asio::awaitable<void> CanNetGateway::Impl::run_reader(std::shared_ptr<Impl> self
     boost::system::error_code ec;
     const std::size_t n = co_await s.socket.async_read_some(asio::buffer(buf), asio::redirect_error(asio::use_awaitable, ec));
     if (s.generation != generation) co_return;  // that connection is gone (and maybe replaced)
+    if (ec == asio::error::eof) {
+      // A reset that a write saw first leaves the read only an end-of-stream (the write took the
+      // socket's error): let that write's completion, already queued, say so before calling this
+      // an orderly close.
+      co_await asio::post(s.executor, asio::use_awaitable);
+      if (s.generation != generation) co_return;
+    }
     if (ec) {
       // An orderly close from the gateway's side: it serves one client at a time and closes the
       // older connection when another client connects (its protocol has no line to say so).
