@@ -121,11 +121,11 @@ class BackEnd {
     a.cycle = state.cycle;
     a.time_s = state.time_s;
     a.source = source(state.time_s);
-    if (a.source == ActionSource::action) {
-      a.command = current_.command;
+    if (a.source == ActionSource::action) a.command = current_.command;
+    if (have_) {
       a.action = current_.number;
+      a.age_s = state.time_s - taken_at_;
     }
-    if (have_) a.age_s = state.time_s - taken_at_;
     count(a.source);
     s_->mirror.write(Mirror{a, state, stats_});
     return a.command;

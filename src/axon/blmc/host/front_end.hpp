@@ -58,7 +58,8 @@ struct AppliedAction {
   double time_s = 0;  // since the loop started
   Command command{};  // what the law handed the loop (zeros when idle), before the safety clamp
   ActionSource source = ActionSource::waiting;
-  std::uint64_t action = 0;  // the number of the action applied (set() counts from 1; 0: none)
+  std::uint64_t action = 0;  // the latest action taken (set() counts from 1; 0: none), applied
+                             // when source is ActionSource::action
   double age_s = 0;          // since the back end first took that action
 };
 
