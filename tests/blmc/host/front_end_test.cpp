@@ -7,6 +7,7 @@
 #include "axon/blmc/host/front_end.hpp"
 #include "axon/blmc/host/motor_board.hpp"
 #include "axon/blmc/sim/simulated_board.hpp"
+#include "motor_board_rig.hpp"
 
 #include <gtest/gtest.h>
 
@@ -50,6 +51,7 @@ namespace axon::blmc::front_end_tests {  // named: the unity build joins test fi
 namespace {
 
 using host::HostErrc;
+using namespace board_rig;
 
 ControlState at(double t_s, std::uint64_t cycle = 0) {
   ControlState s;
@@ -201,32 +203,6 @@ TEST(BlmcFrontEnd, TheBackEndAllocatesNothing) {
 
 // Against the simulated board.
 
-sim::SimulatedBoardOptions sim_options() {
-  sim::SimulatedBoardOptions o;
-  o.config.alignment_time = 200ms;
-  return o;
-}
-
-MotorBoardOptions board_options() {
-  MotorBoardOptions o;
-  o.recv_timeout_ms = 500;  // slack for a loaded machine (motor_board_test.cpp says why)
-  return o;
-}
-
-ControlSettings settings() {
-  ControlSettings s;
-  s.realtime = false;
-  s.limits.stale_after = 500ms;
-  return s;
-}
-
-template <class F>
-bool wait_for(F condition, std::chrono::milliseconds limit = 5s) {
-  const auto end = std::chrono::steady_clock::now() + limit;
-  while (!condition() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(5ms);
-  return condition();
-}
-
 TEST(BlmcFrontEndBoard, NoFirstActionInTimeEndsTheRunWithTheMotorsDisabled) {
   sim::SimulatedBoard sim(sim_options());
   MotorBoard board(sim.bus_spec(), board_options());
@@ -240,12 +216,7 @@ TEST(BlmcFrontEndBoard, NoFirstActionInTimeEndsTheRunWithTheMotorsDisabled) {
   EXPECT_EQ(report.actions.actions, 0u);
   EXPECT_EQ(report.actions.idle_cycles, report.actions.cycles);
   EXPECT_FALSE(board.enabled());
-  const auto off = [&] {
-    const auto r = sim.report();
-    return !r.status.system_enabled && !r.motors[0].enabled && !r.motors[1].enabled;
-  };
-  EXPECT_TRUE(wait_for(off));
-  EXPECT_EQ(sim.report().motors[0].iq_ref_a, 0.0);
+  expect_board_off(sim);
 }
 
 TEST(BlmcFrontEndBoard, TheSafetyClampsTheActionAndTheIdleActionFollowsTheFrontEndsEnd) {
