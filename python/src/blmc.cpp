@@ -374,7 +374,11 @@ void bind_board(py::module_& m) {
         return measurements_of(m.measurements());
       }, "The latest measurements (during control: the latest cycle's).")
       .def("interrupt", [](Board& b) { b.get().interrupt(); }, "From any thread: the wait in progress ends (Interrupted).")
-      .def("clear_interrupt", [](Board& b) { b.get().clear_interrupt(); })
+      .def("clear_interrupt", [](Board& b) {
+        auto& m = b.get();
+        py::gil_scoped_release release;
+        m.clear_interrupt();
+      })
       .def("close", &Board::close, "Stops control, disables the motors and closes the bus (also at the end of a with block).")
       .def("__enter__", [](py::object self) { return self; })
       .def("__exit__", [](Board& b, py::args) { b.close(); });
@@ -415,15 +419,16 @@ void bind_sim(py::module_& m) {
            py::kw_only(), py::arg("boards") = 1, py::arg("alignment_time_s") = 2.0,
            "alignment_time_s: how long the first enable after power-up aligns the motors.")
       .def_property_readonly("bus_spec", [](const SimulatedBoard& s) { return s.bus_spec(0); }, "Board 0's bus spec.")
-      .def("bus_spec_of", [](const SimulatedBoard& s, unsigned board) { return s.bus_spec(board); }, py::arg("board"))
+      .def("bus_spec_of", [](const SimulatedBoard& s, unsigned board) { return s.bus_spec(board); }, py::arg("board"),
+           py::call_guard<py::gil_scoped_release>())
       .def_property_readonly("endpoint", &SimulatedBoard::endpoint, "The socketcand server, HOST:PORT.")
       .def("inject", [](SimulatedBoard& s, const std::string& kind, unsigned board, double duration_s) {
              s.inject(fault_kind(kind), board, duration_of<core::Duration>(duration_s, "duration_s", false));
-           }, py::arg("kind"), py::arg("board") = 0, py::arg("duration_s") = 0.0,
+           }, py::arg("kind"), py::arg("board") = 0, py::arg("duration_s") = 0.0, py::call_guard<py::gil_scoped_release>(),
            "The firmware raises this fault at its next cycle and disables itself: encoder, pos_converter, transmit, "
            "over_current, undocumented (duration_s: how long its cause lasts; 0: a glitch).")
-      .def("power_cycle", &SimulatedBoard::power_cycle, py::arg("board") = 0)
-      .def("report", &SimulatedBoard::report, py::arg("board") = 0)
+      .def("power_cycle", &SimulatedBoard::power_cycle, py::arg("board") = 0, py::call_guard<py::gil_scoped_release>())
+      .def("report", &SimulatedBoard::report, py::arg("board") = 0, py::call_guard<py::gil_scoped_release>())
       .def("stop", &SimulatedBoard::stop, py::call_guard<py::gil_scoped_release>())
       .def("__enter__", [](py::object self) { return self; })
       .def("__exit__", [](SimulatedBoard& s, py::args) {

@@ -244,7 +244,7 @@ TEST(BlmcFrontEndBoard, TheSafetyClampsTheActionAndTheIdleActionFollowsTheFrontE
   EXPECT_EQ(report.end, ControlEnd::requested);
   EXPECT_FALSE(report.fault) << report.fault_text;
   EXPECT_GT(report.actions.stale_cycles, 0u);
-  EXPECT_EQ(report.actions.stale_episodes, 1u);
+  EXPECT_GE(report.actions.stale_episodes, 1u);  // the end's, and any stall of this thread before
   EXPECT_GE(report.actions.first_action_s, 0.0);
   EXPECT_TRUE(board.enabled());  // a requested end leaves the motors on, at zero current
 }
