@@ -5,6 +5,8 @@
 // `code` (the enum's value), `reason` (the category's message for it) and `detail` (the context).
 #include "bindings.hpp"
 
+#include "axon/blmc/host/error.hpp"
+#include "axon/blmc/protocol/error.hpp"
 #include "axon/can/error.hpp"
 #include "axon/core/error.hpp"
 #include "axon/fps/host/error.hpp"
@@ -164,12 +166,33 @@ void bind_fps_errors(py::module_& fps, const Common& k) {
             make_class(fps, "PlanCollision", {plan}, "Poses that collide, or robots that cannot reach their targets."));
 }
 
+void bind_blmc_errors(py::module_& blmc, const Common& k) {
+  using blmc::host::HostErrc;
+  auto* error = make_class(blmc, "Error", {k.error}, "A motor driver board error (protocol or host).");
+  map_category(HostErrc::timeout, error);
+  map_category(blmc::protocol::ProtocolErrc::wrong_id, error);
+  map_codes({HostErrc::timeout}, make_class(blmc, "Timeout", {error, k.timeout}, "The board did not answer in time."));
+  map_codes({HostErrc::not_ready}, make_class(blmc, "NotReady", {error}, "The motors did not finish their alignment in time."));
+  map_codes({HostErrc::board_error}, make_class(blmc, "BoardError", {error}, "The board reports an error code (the motors are off)."));
+  map_codes({HostErrc::safety_fault, HostErrc::stale_data},
+            make_class(blmc, "SafetyFault", {error}, "A safety check stopped the motors (zero current, disabled)."));
+  map_codes({HostErrc::invalid_argument},
+            make_class(blmc, "InvalidArgument", {error, k.invalid}, "A bad setting, action or input."));
+  map_codes({HostErrc::not_enabled}, make_class(blmc, "NotEnabled", {error}, "The call needs the motors enabled (enable() first)."));
+  map_codes({HostErrc::cyclic_active}, make_class(blmc, "ControlRunning", {error}, "The control loop owns the board (stop() first)."));
+  map_codes({HostErrc::not_cyclic}, make_class(blmc, "NotRunning", {error}, "The call needs a control run (start() first)."));
+  map_codes({HostErrc::interrupted}, make_class(blmc, "Interrupted", {error}, "The wait was interrupted (interrupt())."));
+  map_codes({HostErrc::closed}, make_class(blmc, "Closed", {error, k.closed}, "The bus or the board was closed."));
+  map_codes({HostErrc::homing_failed}, make_class(blmc, "HomingFailed", {error}, "No encoder index found."));
+}
+
 }  // namespace
 
-void bind_errors(py::module_& m, py::module_& can, py::module_& fps) {
+void bind_errors(py::module_& m, py::module_& can, py::module_& fps, py::module_& blmc) {
   const Common k = bind_common(m);
   bind_can_errors(can, k);
   bind_fps_errors(fps, k);
+  bind_blmc_errors(blmc, k);
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

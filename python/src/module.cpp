@@ -7,8 +7,10 @@ PYBIND11_MODULE(_axon, m) {
   m.attr("__version__") = AXON_VERSION;
   auto can = m.def_submodule("can", "CAN buses, frames and candump logs");
   auto fps = m.def_submodule("fps", "fiber positioner arrays: layouts, planner, client, simulated plane");
-  axon::python::bind_errors(m, can, fps);
+  auto blmc = m.def_submodule("blmc", "motor driver boards: enable, measurements, a Python front end to the 1 kHz loop, simulated board");
+  axon::python::bind_errors(m, can, fps, blmc);
   axon::python::bind_can(can);
   axon::python::bind_fps_plan(fps);
   axon::python::bind_fps_client(fps);
+  axon::python::bind_blmc(blmc);
 }

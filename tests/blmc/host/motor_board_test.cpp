@@ -7,6 +7,7 @@
 #include "axon/blmc/host/motor_session.hpp"
 #include "axon/blmc/sim/simulated_board.hpp"
 #include "axon/can/bus_spec.hpp"
+#include "motor_board_rig.hpp"
 
 #include <gtest/gtest.h>
 
@@ -24,43 +25,7 @@ namespace axon::blmc {
 namespace {
 
 using host::HostErrc;
-
-sim::SimulatedBoardOptions sim_options() {
-  sim::SimulatedBoardOptions o;
-  o.config.alignment_time = 200ms;
-  return o;
-}
-
-// Loaded machines (two cores for several builds) hold threads for longer than a real board's
-// timing allows (10 ms stale data, a 50 ms receive timeout): the tests that are not about those
-// limits give them slack.
-ControlSettings settings() {
-  ControlSettings s;
-  s.realtime = false;
-  s.limits.stale_after = 500ms;
-  return s;
-}
-
-MotorBoardOptions board_options() {
-  MotorBoardOptions o;
-  o.recv_timeout_ms = 500;
-  return o;
-}
-
-// The disable travels over socketcand: the board applies it a moment after the host sent it.
-void expect_board_off(const sim::SimulatedBoard& sim) {
-  const auto off = [&] {
-    const auto r = sim.report();
-    return !r.status.system_enabled && !r.motors[0].enabled && !r.motors[1].enabled;
-  };
-  for (int i = 0; i < 300 && !off(); ++i) std::this_thread::sleep_for(10ms);
-  const auto r = sim.report();
-  EXPECT_FALSE(r.status.system_enabled);
-  EXPECT_FALSE(r.motors[0].enabled);
-  EXPECT_FALSE(r.motors[1].enabled);
-  EXPECT_EQ(r.motors[0].iq_ref_a, 0.0);
-  EXPECT_EQ(r.motors[1].iq_ref_a, 0.0);
-}
+using namespace board_rig;
 
 // Both motors to a target 0.5 rev and -0.3 rev away from where they start.
 ControlLaw move_by(std::array<double, 2> delta, std::array<std::atomic<double>, 2>& start) {
@@ -184,16 +149,6 @@ TEST(BlmcMotorBoard, AnUndocumentedErrorCodeIsASafetyStopNamingIt) {
   expect_board_off(sim);
 }
 
-// Polls `done` every 10 ms for up to `limit` (the simulator runs on its own thread).
-// True as soon as one poll sees it (a motor passing through its band counts; callers that need it
-// to stay check again later).
-bool wait_for(const std::function<bool()>& done, std::chrono::milliseconds limit = 10s) {
-  for (auto t = 0ms; t < limit; t += 10ms) {
-    if (done()) return true;
-    std::this_thread::sleep_for(10ms);
-  }
-  return done();
-}
 
 // The board's own P/D controller (optional in the spec, modelled by the simulator) moves each motor
 // to a position reference and holds it with no current from the host: after the enable the host

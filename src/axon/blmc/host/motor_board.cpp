@@ -3,11 +3,14 @@
 #include "axon/blmc/host/board.hpp"
 #include "axon/blmc/host/control_run.hpp"
 #include "axon/blmc/host/error.hpp"
+#include "axon/blmc/host/front_end.hpp"
 #include "axon/blmc/host/session_log.hpp"
 #include "axon/can/open.hpp"
 #include "axon/core/loop_thread.hpp"
 #include "axon/core/wakeup.hpp"
 
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/detached.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -65,6 +68,7 @@ struct ControlRun {
   std::optional<host::CycleRecord> last;
   std::atomic<bool> stop{false};
   std::unique_ptr<LawController> law;
+  std::optional<FrontEnd> front_end;  // when the law is its back end
   std::optional<host::CycleCsv> csv;
 };
 
@@ -72,6 +76,7 @@ ControlReport to_report(const host::ControlOutcome& o) {
   ControlReport r;
   r.stats = o.stats;
   if (o.fault) {
+    r.end = ControlEnd::fault;
     r.fault = o.fault->fault;
     r.fault_text = o.fault->fault.describe();
   }
@@ -129,8 +134,9 @@ struct MotorBoard::Impl {
   }
   void open(const std::string& spec_text);
   host::ControlOptions control_options(const ControlSettings& s) const;
-  void start(ControlLaw law, const ControlSettings& settings);
+  void start(ControlLaw law, const ControlSettings& settings, const FrontEnd* front_end = nullptr);
   ControlReport stop();
+  ControlReport finish(std::chrono::milliseconds duration);  // waits for the run's end, then stop()
   void disable();
   void close() noexcept;
 };
@@ -165,13 +171,14 @@ host::ControlOptions MotorBoard::Impl::control_options(const ControlSettings& s)
   return o;
 }
 
-void MotorBoard::Impl::start(ControlLaw law, const ControlSettings& settings) {
+void MotorBoard::Impl::start(ControlLaw law, const ControlSettings& settings, const FrontEnd* front_end) {
   if (!enabled) throw Exception(Error(HostErrc::not_enabled, fmt::format("{}: start_control", options.name)));
   if (run) throw Exception(Error(HostErrc::cyclic_active, fmt::format("{}: start_control", options.name)));
   if (!law) throw Exception(Error(HostErrc::invalid_argument, fmt::format("{}: start_control: no control law", options.name)));
   const auto opts = control_options(settings);
   auto r = std::make_shared<ControlRun>();
   r->law = std::make_unique<LawController>(std::move(law));
+  if (front_end) r->front_end = *front_end;
   if (!settings.csv.empty()) r->csv.emplace(host::CycleCsv::create(settings.csv).value());
   host::ControlHooks hooks;
   hooks.record = [r](const host::CycleRecord& rec) {
@@ -188,14 +195,19 @@ void MotorBoard::Impl::start(ControlLaw law, const ControlSettings& settings) {
     return true;
   };
   hooks.stop = [r] { return r->stop.load(); };
+  if (r->front_end) hooks.done = [r] { return r->front_end->gave_up(); };
   boost::asio::co_spawn(
       loop.executor(),
-      [b = board.get(), r, opts, hooks]() -> boost::asio::awaitable<void> {
+      [b = board.get(), r, opts, hooks, name = options.name]() -> boost::asio::awaitable<void> {
         std::optional<Result<host::ControlOutcome>> out;
         std::exception_ptr failure;
         try {
           auto o = co_await host::run_control(*b, *r->law, opts, hooks);
           out.emplace(std::move(o));
+          // A front end that never acted: nobody is steering, so the motors go off now.
+          if (r->front_end && r->front_end->gave_up()) {
+            if (auto d = co_await b->disable(); !d) spdlog::error("{}: disable after no first action: {}", name, d.error().message());
+          }
         } catch (...) {
           failure = std::current_exception();
         }
@@ -230,6 +242,13 @@ ControlReport MotorBoard::Impl::stop() {
   }
   if (r->failure) std::rethrow_exception(r->failure);
   auto report = to_report(r->outcome->value());
+  if (r->front_end) {
+    report.actions = r->front_end->stats();
+    if (!report.fault && r->front_end->gave_up()) {
+      report.end = ControlEnd::no_first_action;
+      enabled = false;
+    }
+  }
   if (r->csv) {
     report.csv_lines = r->csv->lines();
     r->csv->flush().value();
@@ -342,14 +361,36 @@ bool MotorBoard::control_running() {
 
 ControlReport MotorBoard::stop_control() { return impl_->stop(); }
 
+const char* to_string(ControlEnd e) noexcept {
+  switch (e) {
+    case ControlEnd::requested: return "requested";
+    case ControlEnd::fault: return "fault";
+    case ControlEnd::no_first_action: return "no_first_action";
+  }
+  return "?";
+}
+
+void MotorBoard::start_control(const FrontEnd& front_end, ControlSettings settings) {
+  impl_->start(front_end.law(), settings, &front_end);
+}
+
+ControlReport MotorBoard::run_control(const FrontEnd& front_end, std::chrono::milliseconds duration, ControlSettings settings) {
+  impl_->start(front_end.law(), settings, &front_end);
+  return impl_->finish(duration);
+}
+
 ControlReport MotorBoard::run_control(ControlLaw law, std::chrono::milliseconds duration, ControlSettings settings) {
   impl_->start(std::move(law), settings);
+  return impl_->finish(duration);
+}
+
+ControlReport MotorBoard::Impl::finish(std::chrono::milliseconds duration) {
   {
-    auto r = impl_->run;
+    auto r = run;
     std::unique_lock lock(r->mutex);
     r->changed.wait_for(lock, duration, [&] { return r->finished; });
   }
-  return impl_->stop();
+  return stop();
 }
 
 HomingReport MotorBoard::home(host::HomingOptions options, ControlSettings settings, std::chrono::milliseconds timeout) {

@@ -102,11 +102,31 @@ struct ControlSettings {
   std::string csv;                            // write one line per cycle to this file (host::CycleCsv)
 };
 
+// Why a control run ended.
+enum class ControlEnd : std::uint8_t {
+  requested,        // its duration passed, or stop_control() / disable() / the destructor
+  fault,            // a safety stop (ControlReport::fault)
+  no_first_action,  // a FrontEnd's first action did not come in time: the motors were disabled
+};
+const char* to_string(ControlEnd e) noexcept;
+
+// What a FrontEnd's back end (front_end.hpp) did in a run; zeros for a plain ControlLaw.
+struct ActionStats {
+  std::uint64_t cycles = 0;          // cycles the back end ran
+  std::uint64_t actions = 0;         // distinct actions it applied (a faster front end overwrites some)
+  std::uint64_t idle_cycles = 0;     // cycles with the idle action (waiting, stale or gave up)
+  std::uint64_t stale_cycles = 0;    // idle because the latest action was older than stale_after
+  std::uint64_t stale_episodes = 0;  // times the action went stale
+  double first_action_s = -1;        // when it first took an action, since the start (-1: never)
+};
+
 struct ControlReport {
   host::LoopStats stats;            // cycles, period, jitter, overruns, missed deadlines
   std::optional<host::Fault> fault; // the safety stop that ended the loop, if any
   std::string fault_text;           // its description, e.g. "stale data: no velocity frame for ..."
   std::uint64_t csv_lines = 0;
+  ControlEnd end = ControlEnd::requested;
+  ActionStats actions;              // with a FrontEnd
 };
 
 struct HomingReport {
@@ -114,6 +134,8 @@ struct HomingReport {
   std::array<host::MotorHoming, 2> motors{};  // index_rev: each found motor's offset
   bool all_found = false;
 };
+
+class FrontEnd;  // front_end.hpp
 
 class MotorBoard {
  public:
@@ -154,6 +176,11 @@ class MotorBoard {
   ControlReport stop_control();
   // start_control, wait `duration` (or until a safety stop), stop_control.
   ControlReport run_control(ControlLaw law, std::chrono::milliseconds duration, ControlSettings settings = {});
+  // The same with a FrontEnd's back end as the law (front_end.hpp; the board keeps a copy of the
+  // handle). The run also ends when the front end gives up (no first action in time): then the
+  // motors are disabled at once and the report says ControlEnd::no_first_action.
+  void start_control(const FrontEnd& front_end, ControlSettings settings = {});
+  ControlReport run_control(const FrontEnd& front_end, std::chrono::milliseconds duration, ControlSettings settings = {});
 
   // Homing on the encoder index (host::HomingController under the same loop and safety), for
   // the motors in options.motors that the board uses. The motors must be enabled.
