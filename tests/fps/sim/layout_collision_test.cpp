@@ -6,10 +6,14 @@
 #include "axon/fps/sim/focal_plane_sim.hpp"
 #include "axon/fps/sim/simulated_plane.hpp"
 
+#include "axon/core/error.hpp"
+
 #include <boost/asio/io_context.hpp>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <map>
 #include <random>
 #include <set>
 #include <string>
@@ -50,9 +54,13 @@ FocalPlane facing_pair(std::optional<double> beta_length_mm) {
 struct MoveResult {
   bool completed = false;
   std::uint64_t collisions = 0;
+  std::string refused;     // why the client would not move
+  std::string notes;       // the plan's
+  bool at_targets = true;  // where the simulator has the arms
 };
 
-MoveResult stretch_towards_each_other(const FocalPlane& layout) {
+// Both robots stretched towards each other: straight there (goto) or planned by the host.
+MoveResult stretch_towards_each_other(const FocalPlane& layout, bool planned) {
   SimulatedPlaneOptions po;
   po.time_scale = 50;
   po.plc = false;
@@ -64,8 +72,25 @@ MoveResult stretch_towards_each_other(const FocalPlane& layout) {
   Client fps(cc);
   fps.open(plane.plane());
   fps.discover();
-  const auto out = fps.goto_absolute({{1, {0, 0}}, {2, {180, 0}}});
-  return {out.completed, plane.collisions()};
+  const std::map<std::uint16_t, Angles> targets{{1, {0, 0}}, {2, {180, 0}}};
+  MoveResult r;
+  try {
+    if (planned) {
+      const auto out = fps.plan_and_move(targets);
+      r.completed = out.move.completed;
+      r.notes = out.plan.notes;
+    } else {
+      r.completed = fps.goto_absolute(targets).completed;
+    }
+  } catch (const Exception& e) {
+    r.refused = e.what();
+  }
+  r.collisions = plane.collisions();
+  for (const auto& [id, t] : targets) {
+    const auto at = plane.arms(id);
+    r.at_targets = r.at_targets && at && std::abs(at->alpha - t.alpha) < 0.1 && std::abs(at->beta - t.beta) < 0.1;
+  }
+  return r;
 }
 
 TEST(FpsSimLayoutGeometry, LongerBetaArmsCollideWhereNominalOnesDoNot) {
@@ -79,12 +104,28 @@ TEST(FpsSimLayoutGeometry, LongerBetaArmsCollideWhereNominalOnesDoNot) {
     model.find_contacts(segs, contacts);
     EXPECT_EQ(contacts.size(), plane == &longer ? 1u : 0u);
   }
-  const auto n = stretch_towards_each_other(nominal);
-  EXPECT_TRUE(n.completed);
+  // Straight there: the simulator feels the contact of the longer arms only.
+  const auto n = stretch_towards_each_other(nominal, false);
+  EXPECT_TRUE(n.completed) << n.refused;
   EXPECT_EQ(n.collisions, 0u);
-  const auto l = stretch_towards_each_other(longer);
+  const auto l = stretch_towards_each_other(longer, false);
   EXPECT_FALSE(l.completed);
   EXPECT_GE(l.collisions, 1u);
+}
+
+TEST(FpsSimLayoutGeometry, TheHostPlansOnTheSameLongerArms) {
+  // The host's plan-and-move checks the targets on the layout's model: with the nominal arms both
+  // robots get there; with the longer ones one target would touch, so that robot is parked (folded)
+  // with the reason, and the move runs without a collision.
+  const auto n = stretch_towards_each_other(facing_pair(std::nullopt), true);
+  EXPECT_TRUE(n.completed) << n.refused;
+  EXPECT_TRUE(n.at_targets);
+  EXPECT_EQ(n.collisions, 0u);
+  const auto l = stretch_towards_each_other(facing_pair(17.2), true);
+  EXPECT_TRUE(l.completed) << l.refused;
+  EXPECT_FALSE(l.at_targets);
+  EXPECT_NE(l.notes.find("park"), std::string::npos) << l.notes;
+  EXPECT_EQ(l.collisions, 0u);
 }
 
 // 19 robots on the hex grid, each with its own orientation, arm lengths and zero offsets; the
