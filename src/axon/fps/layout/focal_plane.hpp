@@ -109,7 +109,8 @@ struct NeighbourOptions {
   double robot_radius_mm = 48.26;
   // The robots right next to one (one pitch plus tolerance): 6 for an interior robot.
   double adjacent_radius_mm = kDefaultPitchMm * 1.1;
-  // Fiducials a robot's beta arm can reach: arm reach (7.4 + 16.2 mm) plus both collision buffers.
+  // Fiducials a robot's beta arm can reach: arm reach (ArmLengths: alpha arm + beta tip) plus both
+  // collision buffers.
   double fiducial_radius_mm = 30.0;
 };
 
