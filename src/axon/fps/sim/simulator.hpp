@@ -128,7 +128,8 @@ class Simulator {
   // it lists collide with their geometry there, others with their config's; its fiducials and
   // obstacles join those add_obstacle() adds. Without it, every robot's config gives its geometry.
   void set_geometry(plan::ModelSpec geometry);
-  // The collision model the check uses (robots in the order added; rebuilt after changes).
+  // The collision model the check uses (robots in the order added). Rebuilt after a change of
+  // robots, obstacles or geometry: the reference holds until then.
   [[nodiscard]] const plan::CollisionModel& collision_model();
   void set_reply_faults(can::FaultPlan plan);
 
