@@ -138,7 +138,7 @@ std::string FpsSimView::info_json() const {
     const auto& c = m->config();
     const auto* site = impl_->plane.find(c.id);
     fmt::format_to(o, "{}{{\"id\":{},\"x\":{},\"y\":{},\"orientation\":{},\"alpha_mm\":{},\"beta_mm\":{},\"bus\":{},\"sextant\":{}}}",
-                   first ? "" : ",", c.id, c.x_mm, c.y_mm, c.orientation_deg, c.alpha_arm_mm, c.beta_arm_mm,
+                   first ? "" : ",", c.id, c.x_mm, c.y_mm, c.orientation_deg, c.arms.alpha_length_mm, c.arms.beta_collision_mm,
                    json_quote(site ? site->bus.to_string() : ""), site ? site->sextant : 0);
     first = false;
   }

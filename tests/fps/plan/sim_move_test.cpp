@@ -1,7 +1,8 @@
 // A planned reconfiguration of the default focal plane played by the fps simulator: every robot
 // model gets its planned trajectory through the firmware's own upload commands, the sync line
-// starts them all at once, and the simulator's geometric collision check (its own capsules and
-// fiducials, independent of the planner's) watches the whole move. Nobody may touch, and every
+// starts them all at once, and the simulator's geometric collision check (the planner's capsules,
+// but its own robots' configs, fiducial sizes and stepping in time, independent of the planner's
+// checker) watches the whole move. Nobody may touch, and every
 // robot must end at its target.
 //
 // 500 robots in a Release build (a few seconds); under sanitizers the robots within 70 mm of the
@@ -105,7 +106,7 @@ TEST(PlannedMoveInSimulator, NoCollisionAndEveryRobotAtItsTarget) {
   }
   for (const auto& f : layout.fiducials()) {
     const sim::Vec2 at{f.x_mm, f.y_mm};
-    sc.obstacles.push_back(sim::Obstacle{sim::Segment{at, at}, 1.5, fmt::format("fiducial {}", f.id)});
+    sc.obstacles.push_back(sim::Obstacle{fmt::format("fiducial {}", f.id), sim::Segment{at, at}, 1.5});
   }
   auto made = sim::make_simulator(io.get_executor(), sc, registry);
   ASSERT_TRUE(made) << made.error().message();

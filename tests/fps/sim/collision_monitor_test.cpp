@@ -1,49 +1,38 @@
-// Geometry and the collision monitor: segment distances, beta capsules, and which contacts count.
+// The collision monitor on the planner's model: which contacts count (moving into one, not standing
+// still or backing away), obstacles with their own buffer, and robots' config geometry reaching
+// the simulator's model.
 #include "axon/fps/sim/collision_monitor.hpp"
+#include "axon/fps/sim/simulator.hpp"
 
+#include "axon/can/virtual_bus.hpp"
+
+#include <boost/asio/io_context.hpp>
 #include <gtest/gtest.h>
-
-#include <cmath>
 
 #include <vector>
 
+using namespace axon::fps;
 using namespace axon::fps::sim;
 using Pose = CollisionMonitor::Pose;
 
-TEST(FpsSimGeometry, SegmentDistance) {
-  EXPECT_DOUBLE_EQ(segment_distance({{0, 0}, {10, 0}}, {{0, 3}, {10, 3}}), 3);
-  EXPECT_DOUBLE_EQ(segment_distance({{0, 0}, {10, 0}}, {{5, -1}, {5, 1}}), 0);  // crossing
-  EXPECT_DOUBLE_EQ(segment_distance({{0, 0}, {10, 0}}, {{13, 4}, {13, 4}}), 5);  // point
-  EXPECT_DOUBLE_EQ(segment_distance({{0, 0}, {0, 0}}, {{3, 4}, {3, 4}}), 5);
-}
+namespace {
 
-TEST(FpsSimGeometry, SurelyApartNeverHidesAContact) {
-  const Segment s{{0, 0}, {10, 0}};
-  EXPECT_TRUE(surely_apart(s, {{30, 0}, {40, 0}}, 4));
-  EXPECT_FALSE(surely_apart(s, {{13, 0}, {23, 0}}, 4));  // 3 mm apart: must not be skipped
-  // Whenever the exact distance is below the limit, the quick test says "maybe".
-  for (int i = 0; i < 200; ++i) {
-    const double a = i * 0.1, x = 5 + (i % 17);
-    const Segment t{{x, 0.5 * (i % 9)}, {x + 10 * std::cos(a), 0.5 * (i % 9) + 10 * std::sin(a)}};
-    if (segment_distance(s, t) < 4) {
-      EXPECT_FALSE(surely_apart(s, t, 4)) << i;
-    }
+// Nominal robots at the given centres (ids 1, 2, ...).
+plan::CollisionModel robots_at(const std::vector<Vec2>& centres, const std::vector<Obstacle>& obstacles = {}) {
+  std::vector<plan::RobotSpec> specs;
+  for (const Vec2& c : centres) {
+    plan::RobotSpec s;
+    s.id = static_cast<std::int32_t>(specs.size() + 1);
+    s.centre = c;
+    specs.push_back(s);
   }
+  return plan::CollisionModel::build(specs, {}, {}, obstacles).value();
 }
 
-TEST(FpsSimGeometry, BetaSegmentFollowsTheArms) {
-  const RobotGeometry g{{100, 0}, 90};  // alpha = 0 points along +y
-  const auto folded = beta_segment(g, 0, 180);
-  EXPECT_NEAR(folded.a.x, 100, 1e-9);
-  EXPECT_NEAR(folded.a.y, 7.4, 1e-9);
-  EXPECT_NEAR(folded.b.y, 7.4 - 14.7, 1e-9);
-  const auto out = beta_segment(g, 90, 0);  // alpha towards -x, beta stretched
-  EXPECT_NEAR(out.b.x, 100 - 22.1, 1e-9);
-  EXPECT_NEAR(out.b.y, 0, 1e-9);
-}
+}  // namespace
 
 TEST(FpsSimMonitor, ReportsOnlyTheRobotThatMovedIntoContact) {
-  CollisionMonitor m({RobotGeometry{{0, 0}}, RobotGeometry{{22.4, 0}}});
+  CollisionMonitor m(robots_at({{0, 0}, {22.4, 0}}));
   EXPECT_EQ(m.neighbour_pairs(), 1u);
   std::vector<Pose> p{{0, 180}, {0, 180}};
   EXPECT_TRUE(m.update(p).empty());  // first call records
@@ -57,11 +46,11 @@ TEST(FpsSimMonitor, ReportsOnlyTheRobotThatMovedIntoContact) {
   EXPECT_EQ(*c[0].other, 1u);
   EXPECT_TRUE(c[0].beta_moved);
   EXPECT_FALSE(c[0].alpha_moved);
-  EXPECT_LT(c[0].distance_mm, 4.0);
+  EXPECT_LT(c[0].clearance_mm, 0.0);
 }
 
 TEST(FpsSimMonitor, BackingAwayFromAContactIsAllowed) {
-  CollisionMonitor m({RobotGeometry{{0, 0}}, RobotGeometry{{22.4, 0}}});
+  CollisionMonitor m(robots_at({{0, 0}, {22.4, 0}}));
   std::vector<Pose> p{{0, 0}, {0, 180}};  // already in contact
   (void)m.update(p);
   p[0].beta_deg = 20;  // moving apart
@@ -69,15 +58,18 @@ TEST(FpsSimMonitor, BackingAwayFromAContactIsAllowed) {
 }
 
 TEST(FpsSimMonitor, FarRobotsAreNotNeighbours) {
-  CollisionMonitor m({RobotGeometry{{0, 0}}, RobotGeometry{{60, 0}}});
+  CollisionMonitor m(robots_at({{0, 0}, {60, 0}}));
   EXPECT_EQ(m.neighbour_pairs(), 0u);
-  CollisionMonitor off({RobotGeometry{{0, 0}}, RobotGeometry{{22.4, 0}}}, false);
+  CollisionMonitor off(robots_at({{0, 0}, {22.4, 0}}), false);
   EXPECT_EQ(off.neighbour_pairs(), 0u);
+  std::vector<Pose> p{{0, 180}, {0, 180}};
+  (void)off.update(p);
+  p[0].beta_deg = 0;
+  EXPECT_TRUE(off.update(p).empty());
 }
 
-TEST(FpsSimMonitor, ObstaclesUseTheirOwnRadius) {
-  CollisionMonitor m({RobotGeometry{{0, 0}}});
-  m.set_obstacles({Obstacle{{{7.4, 19}, {7.4, 19}}, 3.0, "fid"}});
+TEST(FpsSimMonitor, ObstaclesUseTheirOwnBuffer) {
+  CollisionMonitor m(robots_at({{0, 0}}, {Obstacle{"fid", {{7.4, 19}, {7.4, 19}}, 3.0}}));
   std::vector<Pose> p{{0, 80}};  // beta arm pointing up from (7.4, 0): tip at about (9.95, 14.5)
   (void)m.update(p);
   p[0].beta_deg = 90;  // tip at (7.4, 14.7): 4.3 mm from the point < 2 + 3
@@ -85,4 +77,35 @@ TEST(FpsSimMonitor, ObstaclesUseTheirOwnRadius) {
   ASSERT_EQ(c.size(), 1u);
   EXPECT_FALSE(c[0].other);
   EXPECT_EQ(c[0].obstacle, 0u);
+  EXPECT_NEAR(c[0].clearance_mm, 4.3 - 5.0, 1e-9);
+}
+
+TEST(FpsSimMonitor, TheSimulatorsModelTakesEachRobotsConfigGeometry) {
+  boost::asio::io_context io;
+  auto medium = axon::can::VirtualBus::create(io.get_executor(), "fps0");
+  Simulator sim(io.get_executor());
+  PositionerConfig c;
+  c.id = 7;
+  c.x_mm = 100;
+  c.orientation_deg = 90;  // alpha = 0 points along +y
+  c.arms.alpha_length_mm = 7.5;
+  c.arms.beta_collision_mm = 15.0;
+  c.collision_buffer_mm = 1.5;
+  ASSERT_TRUE(sim.add(c, *medium).has_value());
+  sim.add_obstacle(Obstacle{"fid", {{0, 0}, {0, 0}}, 1.0});
+  const auto& model = sim.collision_model();
+  ASSERT_EQ(model.size(), 1u);
+  EXPECT_EQ(model.obstacles().size(), 1u);
+  const auto& r = model.robot(0);
+  EXPECT_EQ(r.id(), 7);
+  EXPECT_EQ(r.buffer_mm(), 1.5);
+  const Segment folded = r.collision_segment({0, 180});
+  EXPECT_NEAR(folded.a.x, 100, 1e-9);
+  EXPECT_NEAR(folded.a.y, 7.5, 1e-9);
+  EXPECT_NEAR(folded.b.y, 7.5 - 15.0, 1e-9);
+  const Segment out = r.collision_segment({90, 0});  // alpha towards -x, beta stretched
+  EXPECT_NEAR(out.b.x, 100 - 22.5, 1e-9);
+  EXPECT_NEAR(out.b.y, 0, 1e-9);
+  sim.clear_obstacles();
+  EXPECT_TRUE(sim.collision_model().obstacles().empty());
 }

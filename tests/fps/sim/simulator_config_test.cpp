@@ -62,7 +62,7 @@ obstacles:
   EXPECT_DOUBLE_EQ(c.robots[5].config.gear_ratio, 1024);
   ASSERT_EQ(c.obstacles.size(), 2u);
   EXPECT_EQ(c.obstacles[0].name, "fid");
-  EXPECT_DOUBLE_EQ(c.obstacles[0].radius_mm, 3.0);
+  EXPECT_DOUBLE_EQ(c.obstacles[0].buffer_mm, 3.0);
   EXPECT_DOUBLE_EQ(c.obstacles[1].shape.b.x, 10);
 }
 

@@ -241,12 +241,16 @@ TEST(FpsSimulator, NeighboursCollideWhenTheirBetaArmsMeet) {
   EXPECT_FALSE(b->status().collided());      // B stood still
   EXPECT_EQ(rig.sim.stats().neighbour_collisions, 1u);
   EXPECT_EQ(rig.sim.stats().unsolicited, 1u);
-  // The capsules touch (< 4 mm) but the step resolution keeps them from passing through.
-  const auto sa = beta_segment(RobotGeometry{{0, 0}}, a->physical_deg(Arm::alpha), a->physical_deg(Arm::beta));
-  const auto sb = beta_segment(RobotGeometry{{22.4, 0}}, 0, 180);
-  const double d = segment_distance(sa, sb);
-  EXPECT_LT(d, 4.0);
-  EXPECT_GT(d, 2.0);
+  // The capsules touch (segments < 4 mm apart) but the step resolution keeps them from passing
+  // through.
+  const auto& model = rig.sim.collision_model();
+  ASSERT_EQ(model.robot_pairs().size(), 1u);
+  const std::vector<plan::Pose> poses{{a->physical_deg(Arm::alpha), a->physical_deg(Arm::beta)}, {0, 180}};
+  std::vector<Segment> segs(2);
+  model.segments(poses, segs);
+  const double c = model.clearance(model.robot_pairs()[0], segs);
+  EXPECT_LT(c, 0.0);
+  EXPECT_GT(c, -2.0);
 }
 
 TEST(FpsSimulator, NeighbourCheckCanBeSwitchedOff) {
@@ -276,7 +280,7 @@ TEST(FpsSimulator, ObstacleStopsTheRobotThatRunsIntoIt) {
   Rig rig(o);
   auto* a = rig.add(1, 0, 0);
   // A fiducial-like point 3 mm in radius, 20 mm out along +x.
-  rig.sim.add_obstacle(Obstacle{{{20, 0}, {20, 0}}, 3.0, "fiducial"});
+  rig.sim.add_obstacle(Obstacle{"fiducial", {{20, 0}, {20, 0}}, 3.0});
   rig.sim.start();
   std::vector<protocol::Message> seen;
   run(rig.io, [&]() -> asio::awaitable<void> {
@@ -459,8 +463,8 @@ struct Chase {
   static constexpr double a_from = 225, a_to = 345, b_from = 180, b_to = 300, seconds = 10, pitch = 22.4;
   static double distance(double ta, double tb) {
     const auto at = [](double from, double to, double t) { return from + (to - from) * std::clamp(t / seconds, 0.0, 1.0); };
-    return segment_distance(beta_segment(RobotGeometry{{0, 0}}, at(a_from, a_to, ta), 0),
-                            beta_segment(RobotGeometry{{pitch, 0}}, at(b_from, b_to, tb), 0));
+    const plan::Positioner a({1, {0, 0}}, {}), b({2, {pitch, 0}}, {});
+    return plan::segment_distance(a.collision_segment({at(a_from, a_to, ta), 0}), b.collision_segment({at(b_from, b_to, tb), 0}));
   }
 };
 

@@ -39,7 +39,7 @@ struct CalibrationOptions {
   double pitch_mm = kDefaultPitchMm;
   // The arms every robot shares: alpha arm and beta tip as designed, the collision segment as the
   // installation's planner models it (beta axis to 14.7276 mm).
-  ArmLengths arms{7.4, 16.2, 14.7276};
+  ArmLengths arms{.beta_collision_mm = 14.7276};
   // A guide camera's edge in the camera's frame: from -half_length to +half_length along its i
   // axis, `inset` towards the plane's centre along -j (the in-service planner's six edges lie
   // 51.34 mm inside the camera centres and are 113.08 mm long).

@@ -13,6 +13,7 @@
 #pragma once
 
 #include "axon/core/error.hpp"
+#include "axon/fps/layout/arm_lengths.hpp"
 
 #include <compare>
 #include <cstdint>
@@ -85,15 +86,6 @@ struct Fiducial {
   double y_mm = 0;
 };
 
-// The nominal arms of every robot of the plane (the planner's collision body is the segment from
-// the beta axis to beta_collision_mm along the beta arm).
-struct ArmLengths {
-  double alpha_length_mm = 7.4;     // alpha axis to beta axis
-  double beta_tip_mm = 16.2;        // beta axis to the end of the beta arm
-  double beta_collision_mm = 14.7;  // beta axis to the end of the collision segment
-  bool operator==(const ArmLengths&) const = default;
-};
-
 // A guide camera's edge as the robots see it: a fixed segment obstacle with its own buffer (the
 // beta arm's capsule must stay farther than its buffer + this one from the segment).
 struct GuideCamera {
@@ -117,7 +109,8 @@ struct NeighbourOptions {
   double robot_radius_mm = 48.26;
   // The robots right next to one (one pitch plus tolerance): 6 for an interior robot.
   double adjacent_radius_mm = kDefaultPitchMm * 1.1;
-  // Fiducials a robot's beta arm can reach: arm reach (7.4 + 16.2 mm) plus both collision buffers.
+  // Fiducials a robot's beta arm can reach: arm reach (ArmLengths: alpha arm + beta tip) plus both
+  // collision buffers.
   double fiducial_radius_mm = 30.0;
 };
 
@@ -132,7 +125,7 @@ struct FocalPlaneSpec {
   double pitch_mm = kDefaultPitchMm;
   NeighbourOptions neighbours;
   std::vector<GatewaySite> gateways;
-  ArmLengths arms;
+  ArmLengths arms;  // every robot's nominal arms (a robot's own lengths override them)
   std::vector<RobotSite> robots;
   std::vector<Fiducial> fiducials;
   std::vector<GuideCamera> guide_cameras;

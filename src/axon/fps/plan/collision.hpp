@@ -2,7 +2,7 @@
 // obstacles as buffered points or segments, and the neighbour pairs that can touch at all.
 //
 // Only the beta arm is a collision body: a capsule around the segment from the beta axis to
-// ArmDesign::beta_collision_mm along the arm, radius = the robot's buffer. Two robots collide when
+// ArmLengths::beta_collision_mm (the robot's own, Positioner::arms()) along the arm, radius = the robot's buffer. Two robots collide when
 // their segments come closer than the sum of their buffers; a robot and an obstacle when the
 // distance is below the robot's buffer plus the obstacle's. "Clearance" is that distance minus
 // the limit: negative means collision.
@@ -66,12 +66,24 @@ struct Contact {
   double clearance_mm = 0;
 };
 
+// Everything a CollisionModel is built from: what model_from_layout (layout_model.hpp) derives from
+// a layout, and what the simulator builds its collision check from (fps/sim/collision_monitor.hpp).
+struct ModelSpec {
+  std::vector<RobotSpec> robots;
+  ArmDesign design;
+  std::vector<FiducialSpec> fiducials;
+  std::vector<ObstacleSpec> obstacles;
+};
+
 class CollisionModel {
  public:
   // Fails with PlanErrc::unknown_robot detail "duplicate robot id" when two robots share an id.
   static Result<CollisionModel> build(std::span<const RobotSpec> robots, const ArmDesign& design = {},
                                       std::span<const FiducialSpec> fiducials = {},
                                       std::span<const ObstacleSpec> obstacles = {});
+  static Result<CollisionModel> build(const ModelSpec& spec) {
+    return build(spec.robots, spec.design, spec.fiducials, spec.obstacles);
+  }
 
   [[nodiscard]] std::size_t size() const noexcept { return robots_.size(); }
   [[nodiscard]] const Positioner& robot(std::size_t i) const noexcept { return robots_[i]; }

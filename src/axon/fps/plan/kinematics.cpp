@@ -28,8 +28,8 @@ std::vector<Fibre> ArmDesign::default_fibres() {
   // apart; the science fibre at full extension reaches one hex pitch (22.4 mm) from the centre,
   // and the metrology fibre lies on the arm's axis one fibre spacing behind the pair.
   const double half = 0.375;
-  const double science_x = std::sqrt(22.4 * 22.4 - half * half) - 7.4;    // 14.9969
-  const double metrology_x = science_x - std::sqrt(0.75 * 0.75 - half * half);  // 14.3473
+  const double science_x = std::sqrt(22.4 * 22.4 - half * half) - ArmLengths{}.alpha_length_mm;  // 14.9969
+  const double metrology_x = science_x - std::sqrt(0.75 * 0.75 - half * half);                  // 14.3473
   return {{"metrology", {metrology_x, 0.0}}, {"apogee", {science_x, half}}, {"boss", {science_x, -half}}};
 }
 
@@ -58,9 +58,9 @@ Positioner::Positioner(const RobotSpec& spec, const ArmDesign& design)
       limits_(spec.limits),
       alpha_zero_rad_((spec.calibration.orientation_deg + spec.calibration.alpha_offset_deg) * kRad),
       beta_zero_rad_(spec.calibration.beta_offset_deg * kRad),
-      alpha_len_(design.alpha_length_mm + spec.calibration.alpha_length_delta_mm),
-      collision_len_(design.beta_collision_mm + spec.calibration.beta_length_delta_mm),
-      tip_len_(design.beta_tip_mm + spec.calibration.beta_length_delta_mm) {
+      arms_{design.alpha_length_mm + spec.calibration.alpha_length_delta_mm,
+            design.beta_tip_mm + spec.calibration.beta_length_delta_mm,
+            design.beta_collision_mm + spec.calibration.beta_length_delta_mm} {
   fibres_.reserve(design.fibres.size());
   for (const auto& f : design.fibres) {
     Vec2 o{f.offset.x + spec.calibration.beta_length_delta_mm, f.offset.y};
@@ -71,34 +71,34 @@ Positioner::Positioner(const RobotSpec& spec, const ArmDesign& design)
 }
 
 Vec2 Positioner::beta_axis(Pose p) const noexcept {
-  return centre_ + alpha_len_ * unit(alpha_zero_rad_ + p.alpha_deg * kRad);
+  return centre_ + arms_.alpha_length_mm * unit(alpha_zero_rad_ + p.alpha_deg * kRad);
 }
 
 Segment Positioner::collision_segment(Pose p) const noexcept {
   const double a = alpha_zero_rad_ + p.alpha_deg * kRad;
   const double b = a + beta_zero_rad_ + p.beta_deg * kRad;
-  const Vec2 axis = centre_ + alpha_len_ * unit(a);
-  return {axis, axis + collision_len_ * unit(b)};
+  const Vec2 axis = centre_ + arms_.alpha_length_mm * unit(a);
+  return {axis, axis + arms_.beta_collision_mm * unit(b)};
 }
 
 Vec2 Positioner::tip(Pose p) const noexcept {
   const double a = alpha_zero_rad_ + p.alpha_deg * kRad;
   const double b = a + beta_zero_rad_ + p.beta_deg * kRad;
-  return centre_ + alpha_len_ * unit(a) + tip_len_ * unit(b);
+  return centre_ + arms_.alpha_length_mm * unit(a) + arms_.beta_tip_mm * unit(b);
 }
 
 Vec2 Positioner::fibre(Pose p, std::size_t fibre) const noexcept {
   const double a = alpha_zero_rad_ + p.alpha_deg * kRad;
   const double b = a + beta_zero_rad_ + p.beta_deg * kRad;
   const Vec2 o = fibres_[fibre].offset;
-  return centre_ + alpha_len_ * unit(a) + rotate(o, std::cos(b), std::sin(b));
+  return centre_ + arms_.alpha_length_mm * unit(a) + rotate(o, std::cos(b), std::sin(b));
 }
 
 double Positioner::min_reach_mm(std::size_t fibre) const noexcept {
-  return std::abs(alpha_len_ - fibres_[fibre].radius);
+  return std::abs(arms_.alpha_length_mm - fibres_[fibre].radius);
 }
 
-double Positioner::max_reach_mm(std::size_t fibre) const noexcept { return alpha_len_ + fibres_[fibre].radius; }
+double Positioner::max_reach_mm(std::size_t fibre) const noexcept { return arms_.alpha_length_mm + fibres_[fibre].radius; }
 
 bool Positioner::within_limits(Pose p) const noexcept {
   return p.alpha_deg >= limits_.alpha_min_deg - kEpsDeg && p.alpha_deg <= limits_.alpha_max_deg + kEpsDeg &&
@@ -110,7 +110,7 @@ IkSolutions Positioner::inverse(Vec2 target, std::size_t fibre) const noexcept {
   const FibrePolar& f = fibres_[fibre];
   const Vec2 d = target - centre_;
   const double dist = norm(d);
-  const double l1 = alpha_len_;
+  const double l1 = arms_.alpha_length_mm;
   const double l2 = f.radius;
   if (dist > l1 + l2 + kEpsMm) {
     out.reason = PlanErrc::too_far;

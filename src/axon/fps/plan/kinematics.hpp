@@ -17,6 +17,7 @@
 // and inverse kinematics never allocate.
 #pragma once
 
+#include "axon/fps/layout/arm_lengths.hpp"
 #include "axon/fps/plan/distance.hpp"
 #include "axon/fps/plan/error.hpp"
 #include "axon/fps/plan/vec2.hpp"
@@ -42,11 +43,9 @@ inline constexpr std::size_t kMetrologyFibre = 0;
 inline constexpr std::size_t kApogeeFibre = 1;
 inline constexpr std::size_t kBossFibre = 2;
 
-// The nominal mechanical design shared by every robot of one focal plane.
-struct ArmDesign {
-  double alpha_length_mm = 7.4;      // alpha axis to beta axis
-  double beta_tip_mm = 16.2;         // beta axis to the end of the beta arm
-  double beta_collision_mm = 14.7;   // the collision segment runs from the beta axis to here
+// The nominal mechanical design shared by every robot of one focal plane: the arm lengths (the
+// layout's ArmLengths, fps/layout/arm_lengths.hpp) and the fibres the beta arm carries.
+struct ArmDesign : ArmLengths {
   std::vector<Fibre> fibres = default_fibres();
 
   // metrology (14.347, 0), apogee (14.997, +0.375), boss (14.997, -0.375): see docs/fps-plan.md.
@@ -119,10 +118,12 @@ class Positioner {
   [[nodiscard]] Vec2 centre() const noexcept { return centre_; }
   [[nodiscard]] double buffer_mm() const noexcept { return buffer_; }
   [[nodiscard]] const AngleLimits& limits() const noexcept { return limits_; }
-  [[nodiscard]] double alpha_length_mm() const noexcept { return alpha_len_; }
-  [[nodiscard]] double collision_length_mm() const noexcept { return collision_len_; }
+  // This robot's arms: the design's with its calibration's length corrections.
+  [[nodiscard]] const ArmLengths& arms() const noexcept { return arms_; }
+  [[nodiscard]] double alpha_length_mm() const noexcept { return arms_.alpha_length_mm; }
+  [[nodiscard]] double collision_length_mm() const noexcept { return arms_.beta_collision_mm; }
   // Farthest the collision segment gets from the centre (alpha arm + collision segment).
-  [[nodiscard]] double reach_mm() const noexcept { return alpha_len_ + collision_len_; }
+  [[nodiscard]] double reach_mm() const noexcept { return arms_.alpha_length_mm + arms_.beta_collision_mm; }
   [[nodiscard]] std::size_t fibre_count() const noexcept { return fibres_.size(); }
 
   [[nodiscard]] Vec2 beta_axis(Pose p) const noexcept;
@@ -157,9 +158,7 @@ class Positioner {
   AngleLimits limits_;
   double alpha_zero_rad_ = 0;  // orientation + alpha offset
   double beta_zero_rad_ = 0;   // beta offset
-  double alpha_len_ = 7.4;
-  double collision_len_ = 14.7;
-  double tip_len_ = 16.2;
+  ArmLengths arms_;
   std::vector<FibrePolar> fibres_;
 };
 

@@ -6,9 +6,7 @@ namespace axon::fps::plan {
 
 ArmDesign design_of(const FocalPlane& plane, const LayoutModelOptions& o) {
   ArmDesign d;
-  d.alpha_length_mm = plane.arms().alpha_length_mm;
-  d.beta_tip_mm = plane.arms().beta_tip_mm;
-  d.beta_collision_mm = plane.arms().beta_collision_mm;
+  static_cast<ArmLengths&>(d) = plane.arms();
   d.fibres = o.fibres;
   return d;
 }
@@ -26,9 +24,9 @@ RobotCalibration calibration_of(const RobotSite& r, const ArmLengths& arms) {
   return c;
 }
 
-Result<CollisionModel> model_from_layout(const FocalPlane& plane, const LayoutModelOptions& o) {
-  std::vector<RobotSpec> robots;
-  robots.reserve(plane.robots().size());
+ModelSpec model_spec_from_layout(const FocalPlane& plane, const LayoutModelOptions& o) {
+  ModelSpec m;
+  m.robots.reserve(plane.robots().size());
   for (const auto& r : plane.robots()) {
     RobotSpec s;
     s.id = r.id;
@@ -36,14 +34,17 @@ Result<CollisionModel> model_from_layout(const FocalPlane& plane, const LayoutMo
     s.calibration = calibration_of(r, plane.arms());
     s.limits = o.limits;
     s.buffer_mm = o.buffer_mm;
-    robots.push_back(std::move(s));
+    m.robots.push_back(std::move(s));
   }
-  std::vector<FiducialSpec> fiducials;
-  for (const auto& f : plane.fiducials()) fiducials.push_back({f.id, {f.x_mm, f.y_mm}, o.fiducial_buffer_mm});
-  std::vector<ObstacleSpec> cameras;
+  m.design = design_of(plane, o);
+  for (const auto& f : plane.fiducials()) m.fiducials.push_back({f.id, {f.x_mm, f.y_mm}, o.fiducial_buffer_mm});
   for (const auto& g : plane.guide_cameras())
-    cameras.push_back({fmt::format("guide camera {}", g.id), {{g.x1_mm, g.y1_mm}, {g.x2_mm, g.y2_mm}}, g.buffer_mm});
-  return CollisionModel::build(robots, design_of(plane, o), fiducials, cameras);
+    m.obstacles.push_back({fmt::format("guide camera {}", g.id), {{g.x1_mm, g.y1_mm}, {g.x2_mm, g.y2_mm}}, g.buffer_mm});
+  return m;
+}
+
+Result<CollisionModel> model_from_layout(const FocalPlane& plane, const LayoutModelOptions& o) {
+  return CollisionModel::build(model_spec_from_layout(plane, o));
 }
 
 std::vector<bool> frozen_robots(const FocalPlane& plane) {

@@ -2,8 +2,9 @@
 // geometry, the plane's arms, fiducials, guide cameras, and which robots must not move.
 //
 // One geometry model: the CollisionModel built here is what the planner, the checker, target
-// validation and the host's plan-and-move use, so a layout's per-robot orientation, arm lengths,
-// measured fibres and its guide cameras reach every one of them.
+// validation, the host's plan-and-move and position corrections, and the simulator of a layout
+// (fps/sim/focal_plane_sim.hpp) use, so a layout's per-robot orientation, arm lengths, zero
+// offsets, measured fibres and its guide cameras reach every one of them.
 #pragma once
 
 #include "axon/fps/layout/focal_plane.hpp"
@@ -29,6 +30,8 @@ RobotCalibration calibration_of(const RobotSite& robot, const ArmLengths& arms);
 
 // Robots in layout order; fiducials become point obstacles (fiducial_buffer_mm), guide cameras
 // segment obstacles named "guide camera <id>" with their own buffers.
+ModelSpec model_spec_from_layout(const FocalPlane& plane, const LayoutModelOptions& options = {});
+// CollisionModel::build(model_spec_from_layout(plane, options)).
 Result<CollisionModel> model_from_layout(const FocalPlane& plane, const LayoutModelOptions& options = {});
 // Disabled and offline robots, in layout order: they stay where they are.
 std::vector<bool> frozen_robots(const FocalPlane& plane);

@@ -2,6 +2,7 @@
 
 #include "axon/core/deadline_queue.hpp"
 #include "axon/core/error.hpp"
+#include "axon/fps/plan/layout_model.hpp"
 #include "axon/fps/sim/simulator_config.hpp"
 
 #include <boost/asio/co_spawn.hpp>
@@ -288,19 +289,27 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
     p.channel = medium_name(bus);
     config.robots.push_back(std::move(p));
   };
-  for (const auto& r : plane.robots()) {
+  // The planner's geometry of the layout: every robot's own arms, orientation and zero offsets,
+  // the fiducials, the guide cameras.
+  plan::LayoutModelOptions geometry;
+  geometry.buffer_mm = o.defaults.collision_buffer_mm;
+  geometry.fiducial_buffer_mm = o.fiducial_radius_mm;
+  config.geometry = plan::model_spec_from_layout(plane, geometry);
+  for (std::size_t i = 0; i < plane.robots().size(); ++i) {
+    const auto& r = plane.robots()[i];
     if (r.offline || sc.absent.contains(r.id)) continue;
     place(r.id, r.x_mm, r.y_mm, r.bus);
+    // The same figures in the robot's config, for whoever shows it (the collision check uses the
+    // geometry above).
+    auto& c = config.robots.back().config;
+    c.orientation_deg = r.orientation_deg;
+    c.arms = plan::Positioner(config.geometry->robots[i], config.geometry->design).arms();
     s.sextants[r.sextant].push_back(r.id);
   }
   for (const auto& [id, bus] : sc.extra) {
     // Far off the plate: it answers on the bus but touches nobody.
     place(id, 10000.0 + 100.0 * id, 0.0, bus);
     s.sextants[0].push_back(id);
-  }
-  for (const auto& f : plane.fiducials()) {
-    const Vec2 at{f.x_mm, f.y_mm};
-    config.obstacles.push_back(Obstacle{Segment{at, at}, 1.5, fmt::format("fiducial {}", f.id)});
   }
   AXON_TRY(sim, make_simulator(executor, config, s.registry));
   s.simulator = std::move(sim);

@@ -16,6 +16,10 @@
 //     drops, nothing is forwarded); power back starts them again on the same port. A gateway of
 //     sextant 0 (a bench-top one) has no relay and stays on.
 //
+// Geometry: the collision check uses the planner's model of the layout (plan::model_spec_from_layout):
+// each robot's own arm lengths, orientation and zero offsets, the fiducials and the guide cameras,
+// so the simulated plane touches exactly where the planner says it does.
+//
 // Start state: robots are calibrated, datums initialised; alpha is random (per the seed) or 0,
 // beta folded (180, with a little scatter when random): a folded beta keeps every arm inside its
 // own cell, so no start state is a collision. A scenario (YAML, see docs/fps-simulator.md) can mark
@@ -96,7 +100,10 @@ struct FocalPlaneSimOptions {
   bool plc = true;                       // run the PLC emulator
   plc::EmulatorOptions plc_options;      // bind address and port, register map, sensor script
   can::CanNetEmulatorOptions gateway_options;  // bind address and port are set per gateway (binding)
-  PositionerConfig defaults;             // for every robot (id, position, seed are set per robot)
+  PositionerConfig defaults;             // for every robot (id, geometry, seed are set per robot)
+  // The fiducials' buffer in the collision check (the planner keeps 3 mm off them; the simulator
+  // models the fibre's body). Robots' buffer: defaults.collision_buffer_mm.
+  double fiducial_radius_mm = 1.5;
   Scenario scenario;
 };
 

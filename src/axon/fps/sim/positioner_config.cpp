@@ -113,7 +113,7 @@ Result<void> PositionerConfig::validate() const {
   for (double v : {x_mm, y_mm, orientation_deg}) {
     if (!std::isfinite(v)) return bad("position on the plane", "must be finite");
   }
-  if (!finite_in(alpha_arm_mm, 0, 1000) || !finite_in(beta_arm_mm, 0, 1000) ||
+  if (!finite_in(arms.alpha_length_mm, 0, 1000) || !finite_in(arms.beta_collision_mm, 0, 1000) ||
       !finite_in(collision_buffer_mm, 0, 100)) {
     return bad("arm geometry", "must be finite and not negative");
   }
@@ -218,8 +218,8 @@ Result<PositionerConfig> PositionerConfig::from_config(const core::ConfigNode& n
   AXON_TRY(num("x_mm", c.x_mm));
   AXON_TRY(num("y_mm", c.y_mm));
   AXON_TRY(num("orientation_deg", c.orientation_deg));
-  AXON_TRY(num("alpha_arm_mm", c.alpha_arm_mm));
-  AXON_TRY(num("beta_arm_mm", c.beta_arm_mm));
+  AXON_TRY(num("alpha_arm_mm", c.arms.alpha_length_mm));
+  AXON_TRY(num("beta_arm_mm", c.arms.beta_collision_mm));
   AXON_TRY(num("collision_buffer_mm", c.collision_buffer_mm));
   AXON_TRY(num("seed", c.seed));
   if (auto v = c.validate(); !v) return node.error(CoreErrc::config_bad_value, v.error().detail);

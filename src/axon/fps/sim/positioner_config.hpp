@@ -8,6 +8,7 @@
 
 #include "axon/core/config.hpp"
 #include "axon/core/error.hpp"
+#include "axon/fps/layout/arm_lengths.hpp"
 #include "axon/fps/protocol/commands.hpp"
 #include "axon/fps/protocol/firmware_version.hpp"
 #include "axon/fps/sim/sim_time.hpp"
@@ -97,12 +98,13 @@ struct PositionerConfig {
   std::uint32_t cogging_vector_length = 1024;
   std::uint32_t raw_temperature = 2100;                    // raw sensor reading, idle
 
-  // Focal-plane geometry for the neighbour collision check (millimetres, degrees).
+  // Focal-plane geometry for the neighbour collision check (millimetres, degrees). A simulator
+  // given a plane's geometry (SimulatorConfig::geometry, a layout's) takes that for the robots it
+  // lists instead; a plane simulated from a layout fills these with the layout's figures.
   double x_mm = 0;
   double y_mm = 0;
   double orientation_deg = 0;                              // direction of alpha = 0 on the plane
-  double alpha_arm_mm = 7.4;
-  double beta_arm_mm = 14.7;                               // collision segment along the beta arm
+  ArmLengths arms;                                         // the collision segment: beta_collision_mm
   double collision_buffer_mm = 2.0;                        // capsule radius around that segment
 
   // Seed of the deterministic "noise" (datum hits, calibration errors, cogging tables).
@@ -121,7 +123,8 @@ struct PositionerConfig {
   // sync_line_low_at_power_on, receive_buffer, boot_time_s, bootloader_timeout_s,
   // watchdog_timeout_s, hall_wake_up_s, led_blink_s, motor_calibration_time_s,
   // cogging_calibration_time_s, max_firmware_size, cogging_vector_length, raw_temperature, x_mm,
-  // y_mm, orientation_deg, alpha_arm_mm, beta_arm_mm, collision_buffer_mm, seed.
+  // y_mm, orientation_deg, alpha_arm_mm (arms.alpha_length_mm), beta_arm_mm (arms.beta_collision_mm),
+  // collision_buffer_mm, seed.
   // `also_allowed` names keys the caller reads itself (e.g. "bus" in a simulator's robot list).
   static Result<PositionerConfig> from_config(const core::ConfigNode& node, const PositionerConfig& base,
                                               std::span<const std::string_view> also_allowed = {});

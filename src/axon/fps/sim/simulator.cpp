@@ -74,7 +74,8 @@ struct Simulator::State final : std::enable_shared_from_this<State>, core::Deadl
   can::FaultInjector faults;
   CollisionMonitor monitor;
   bool monitor_dirty = true;
-  std::vector<Obstacle> obstacles;
+  std::optional<plan::ModelSpec> geometry;  // set_geometry
+  std::vector<Obstacle> obstacles;          // add_obstacle
   SimTime last_step{};
   bool running = false;
   bool stopped = false;
@@ -119,6 +120,8 @@ struct Simulator::State final : std::enable_shared_from_this<State>, core::Deadl
   void on_deadline() override { run_due(); }
   SimTime event_time();
   void step();
+  // The monitor, rebuilt first when robots, obstacles or the geometry changed.
+  const CollisionMonitor& current_monitor();
   void check_collisions(SimTime t);
 
   static asio::awaitable<void> serve(std::shared_ptr<State> self, Robot* r);
@@ -315,21 +318,48 @@ SimTime Simulator::State::event_time() {
   return last_step;
 }
 
+namespace {
+
+// A robot's geometry from its config, against the plane's arm design.
+plan::RobotSpec spec_of(const PositionerConfig& c, const ArmLengths& design) {
+  plan::RobotSpec s;
+  s.id = c.id;
+  s.centre = {c.x_mm, c.y_mm};
+  s.calibration.orientation_deg = c.orientation_deg;
+  s.calibration.alpha_length_delta_mm = c.arms.alpha_length_mm - design.alpha_length_mm;
+  s.calibration.beta_length_delta_mm = c.arms.beta_collision_mm - design.beta_collision_mm;
+  s.buffer_mm = c.collision_buffer_mm;
+  return s;
+}
+
+}  // namespace
+
+const CollisionMonitor& Simulator::State::current_monitor() {
+  if (!monitor_dirty) return monitor;
+  plan::ModelSpec spec;
+  std::unordered_map<std::int32_t, const plan::RobotSpec*> listed;
+  if (geometry) {
+    spec.design = geometry->design;
+    spec.fiducials = geometry->fiducials;
+    spec.obstacles = geometry->obstacles;
+    for (const auto& r : geometry->robots) listed.emplace(r.id, &r);
+  }
+  spec.obstacles.insert(spec.obstacles.end(), obstacles.begin(), obstacles.end());
+  spec.robots.reserve(robots.size());
+  for (const auto& r : robots) {
+    const auto it = listed.find(r->model.id());
+    spec.robots.push_back(it != listed.end() ? *it->second : spec_of(r->model.config(), spec.design));
+  }
+  // Ids are unique (add() refuses a second one), the one thing build() checks.
+  monitor = CollisionMonitor(plan::CollisionModel::build(spec).value(), options.neighbour_collisions);
+  monitor_dirty = false;
+  return monitor;
+}
+
 void Simulator::State::step() {
   const SimTime target = std::max(now(), last_step);
-  const bool check = options.neighbour_collisions || !obstacles.empty();
-  if (monitor_dirty) {
-    std::vector<RobotGeometry> g;
-    g.reserve(robots.size());
-    for (const auto& r : robots) {
-      const auto& c = r->model.config();
-      g.push_back(RobotGeometry{{c.x_mm, c.y_mm}, c.orientation_deg, c.alpha_arm_mm, c.beta_arm_mm,
-                                c.collision_buffer_mm});
-    }
-    monitor = CollisionMonitor(std::move(g), options.neighbour_collisions);
-    monitor.set_obstacles(obstacles);
-    monitor_dirty = false;
-  }
+  const bool has_obstacles = !current_monitor().model().obstacles().empty();  // rebuilt here when needed
+  const bool check = options.neighbour_collisions || has_obstacles;
   SimTime t = last_step;
   do {
     const bool any_moving =
@@ -521,13 +551,20 @@ Result<void> Simulator::set_friction_fault(std::uint16_t id, Arm arm, std::optio
 
 void Simulator::add_obstacle(Obstacle obstacle) {
   state_->obstacles.push_back(std::move(obstacle));
-  state_->monitor.set_obstacles(state_->obstacles);
+  state_->monitor_dirty = true;
 }
 
 void Simulator::clear_obstacles() {
   state_->obstacles.clear();
-  state_->monitor.set_obstacles({});
+  state_->monitor_dirty = true;
 }
+
+void Simulator::set_geometry(plan::ModelSpec geometry) {
+  state_->geometry = std::move(geometry);
+  state_->monitor_dirty = true;
+}
+
+const plan::CollisionModel& Simulator::collision_model() { return state_->current_monitor().model(); }
 
 void Simulator::set_reply_faults(can::FaultPlan plan) { state_->faults = can::FaultInjector(std::move(plan)); }
 

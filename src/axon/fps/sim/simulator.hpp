@@ -123,6 +123,14 @@ class Simulator {
   Result<void> set_friction_fault(std::uint16_t id, Arm arm, std::optional<std::int32_t> level);
   void add_obstacle(Obstacle obstacle);
   void clear_obstacles();
+
+  // Geometry. The plane's collision geometry (a layout's: plan::model_spec_from_layout): the robots
+  // it lists collide with their geometry there, others with their config's; its fiducials and
+  // obstacles join those add_obstacle() adds. Without it, every robot's config gives its geometry.
+  void set_geometry(plan::ModelSpec geometry);
+  // The collision model the check uses (robots in the order added). Rebuilt after a change of
+  // robots, obstacles or geometry: the reference holds until then.
+  [[nodiscard]] const plan::CollisionModel& collision_model();
   void set_reply_faults(can::FaultPlan plan);
 
   [[nodiscard]] const SimulatorStats& stats() const noexcept;

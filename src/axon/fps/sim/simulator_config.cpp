@@ -33,7 +33,7 @@ Result<Obstacle> read_obstacle(const core::ConfigNode& node) {
   AXON_TRY(name, node.get_or<std::string>("name", ""));
   if (!std::isfinite(r) || r < 0) return node.error(CoreErrc::config_bad_value, "radius_mm must be >= 0");
   o.shape = {{x, y}, {x2, y2}};
-  o.radius_mm = r;
+  o.buffer_mm = r;
   o.name = name;
   return o;
 }
@@ -163,6 +163,7 @@ Result<std::unique_ptr<Simulator>> make_simulator(asio::any_io_executor executor
                                                   can::BusProvider& provider) {
   AXON_TRY(config.options.validate());
   auto sim = std::make_unique<Simulator>(std::move(executor), config.options);
+  if (config.geometry) sim->set_geometry(*config.geometry);
   for (const auto& r : config.robots) {
     auto added = sim->add(r.config, provider, r.channel);
     if (!added) {

@@ -22,7 +22,7 @@
 //     first_id: 1
 //     pitch_mm: 22.4
 //   obstacles:                              # points (x_mm, y_mm) or segments (x2_mm, y2_mm too)
-//     - {x_mm: 30, y_mm: 0, radius_mm: 3, name: fiducial1}
+//     - {x_mm: 30, y_mm: 0, radius_mm: 3, name: fiducial1}   # radius_mm: the obstacle's buffer
 #pragma once
 
 #include "axon/can/provider.hpp"
@@ -30,6 +30,7 @@
 #include "axon/fps/sim/simulator.hpp"
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,8 @@ struct SimulatorConfig {
   SimulatorOptions options;
   std::vector<RobotPlacement> robots;
   std::vector<Obstacle> obstacles;
+  // The plane's collision geometry (Simulator::set_geometry), e.g. a layout's; not read from YAML.
+  std::optional<plan::ModelSpec> geometry;
 
   static Result<SimulatorConfig> from_config(const core::ConfigNode& node);
 
