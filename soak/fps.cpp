@@ -27,6 +27,7 @@
 #include <boost/asio/detached.hpp>
 #include <boost/asio/io_context.hpp>
 #include <fmt/format.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -64,10 +65,7 @@ class FpsSoak {
     sum_.name = "fps";
   }
   asio::awaitable<void> run(asio::any_io_executor ex);
-  int finish(std::chrono::steady_clock::duration ran) {
-    sum_.finish(baseline_, ran);
-    return sum_.report();
-  }
+  int report() const { return sum_.report(); }
 
  private:
   template <class F>
@@ -101,6 +99,7 @@ class FpsSoak {
   Baseline baseline_;
   std::map<Fault, std::uint64_t> injected_, reported_;
   bool last_clean_ok_ = false;
+  std::uint64_t clean_failures_ = 0;   // cycles without an injected fault that did not complete
   unsigned failed_clean_ = 0;           // cycles in a row without an injected fault that failed
   std::uint64_t collision_locks_ = 0;   // the array's count when the cycle began
 };
@@ -110,7 +109,7 @@ void FpsSoak::start_sim() {
   so.simulator.time_scale = kTimeScale;
   so.seed = args_.seed;
   can::FaultRule drop{can::FaultRule::Action::drop};
-  drop.probability = 0.0;
+  drop.probability = 0.000005;  // about one lost reply in 5 cycles: that run must not start
   can::FaultRule delay{can::FaultRule::Action::delay};
   delay.probability = 0.0005;
   delay.delay = 3ms;
@@ -275,6 +274,7 @@ asio::awaitable<void> FpsSoak::judge(Fault f, const Result<host::PlanAndMoveRepo
   if (f == Fault::none || f == Fault::power_cycle) {
     last_clean_ok_ = r && (run == nullptr || run->completed);
     failed_clean_ = last_clean_ok_ ? 0 : failed_clean_ + 1;
+    clean_failures_ += last_clean_ok_ ? 0 : 1;
     if (!last_clean_ok_)
       spdlog::warn("soak fps: a cycle without an injected fault did not complete (reply faults?): {}",
                    r ? run->outcome : r.error().message());
@@ -301,6 +301,7 @@ asio::awaitable<void> FpsSoak::judge(Fault f, const Result<host::PlanAndMoveRepo
 }
 
 asio::awaitable<void> FpsSoak::run(asio::any_io_executor ex) {
+  const auto t0 = Clock::now();
   start_sim();
   co_await connect(ex);
   const auto end = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(args_.minutes * 60));
@@ -338,7 +339,9 @@ asio::awaitable<void> FpsSoak::run(asio::any_io_executor ex) {
                {"link_losses", std::to_string(losses)},
                {"reconnections", std::to_string(restorations)},
                {"bus_off_restarts", std::to_string(fpa_->bus_off_restarts())},
+               {"runs_refused_without_fault", std::to_string(clean_failures_)},
                {"reply_faults", fmt::format("{}/{}/{}", st.faults_dropped, st.faults_delayed, st.faults_duplicated)}};
+  sum_.finish(baseline_, Clock::now() - t0);  // before anything closes
   co_await fpa_->close();
   on_sim([&] { sim_->stop(); });
 }
@@ -350,6 +353,7 @@ int main(int argc, char** argv) {
   using namespace axon;
   namespace asio = boost::asio;
   const auto args = soak::parse_args(argc, argv, "fps");
+  spdlog::set_default_logger(spdlog::stderr_color_mt("soak"));  // stdout: the summary line only
   spdlog::set_level(spdlog::level::warn);
   auto plane = fps::resolve_layout("default");
   if (!plane) {
@@ -359,7 +363,6 @@ int main(int argc, char** argv) {
   soak::FpsSoak soak(args, std::move(plane).value());
   asio::io_context io;
   std::exception_ptr failed;
-  const auto t0 = std::chrono::steady_clock::now();
   asio::co_spawn(io, soak.run(io.get_executor()), [&](std::exception_ptr e) { failed = e; });
   io.run();
   if (failed) {
@@ -370,5 +373,5 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  return soak.finish(std::chrono::steady_clock::now() - t0);
+  return soak.report();
 }
