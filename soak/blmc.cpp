@@ -186,8 +186,13 @@ struct Outcome {
 // Injects one fault at its time and measures: time to zero current and motors off on the board,
 // then whether the host reported it.
 void run_fault(const PlannedFault& f, Clock::time_point t0, bsim::SimulatedBoard& sim, Driver& d, Outcome& out) {
-  const auto at = t0 + f.at;
+  auto at = t0 + f.at;
   std::this_thread::sleep_until(at);
+  const bool planned = f.kind == Kind::frame_loss || f.kind == Kind::bus_off;  // windows of the board's plan
+  if (!planned) {  // a board still recovering from a (spurious) stop gets its fault once it runs again
+    while (!d.in_control && Clock::now() < at + 2s) std::this_thread::sleep_for(1ms);
+    at = Clock::now();
+  }
   ++out.injected;
   const bool in_control = d.in_control;  // else still recovering from an earlier stop: no loop to report it
   const auto reported_before = d.faults_reported.load();
@@ -197,7 +202,7 @@ void run_fault(const PlannedFault& f, Clock::time_point t0, bsim::SimulatedBoard
     case Kind::board_reset: sim.power_cycle(f.board); break;
     case Kind::host_stall: d.stall_request = true; break;
     case Kind::frame_loss:
-    case Kind::bus_off: break;  // windows of the board's fault plan
+    case Kind::bus_off: break;
   }
   auto stopped_at = Clock::time_point::max();
   while (Clock::now() < at + 1s) {

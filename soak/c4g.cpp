@@ -5,7 +5,8 @@
 //   late_app           the application sleeps 1.5 ms (past the 1 ms cycle) three cycles in a row
 //   wrong_app          the application puts NaN into its reply
 //   controller_restart the controller's program is stopped and started again (a new socket)
-//   server_restart     the server is stopped and started again on the same port
+//   server_restart     the server is stopped and started again on the same port (it asks the
+//                      controller for the initialization packet with 506 and must get it)
 //
 // Checked: every packet the relay delivered to a running server was answered (late answers are
 // counted), those lost in a server restart are counted apart; every reply from the moment the
@@ -260,7 +261,7 @@ class FaultyApp final : public c4g::host::Controller {
 
 struct Outcome {
   std::uint64_t injected = 0, resumed = 0, not_tripped = 0, comm_errors = 0, server_restarts = 0;
-  std::uint64_t server_restart_drops = 0, dropped_sessions = 0;
+  std::uint64_t server_restart_drops = 0, dropped_sessions = 0, server_restart_inits = 0;
   Clock::duration worst_server_gap{0};
   std::vector<std::string> failures;
   c4g::sim::ControllerStats ctl{};  // summed over the controller's runs
@@ -365,8 +366,12 @@ void server_restart(Session& s, Outcome& out) {
   ++out.server_restarts;
   const bool answered = wait_for([&] { return s.server->counters().cyclic_packets.load() > 0; }, 2s);
   out.worst_server_gap = std::max(out.worst_server_gap, Clock::now() - began);
-  std::this_thread::sleep_for(300ms);
+  // The new server asks for the initialization packet (506) and gets it: Safety and the
+  // application know the robot again.
+  const bool init = wait_for([&] { return s.server->init().has_value(); }, 1s);
   if (answered && s.controller->running()) {
+    if (init) ++out.server_restart_inits;
+    else out.failures.push_back("a restarted server did not get the initialization packet");
     ++out.resumed;
     return;
   }
@@ -405,7 +410,8 @@ void summarize(axon::soak::Summary& sum, const Session& s, const Outcome& out) {
               {"sessions_dropped_by_load", num(out.dropped_sessions)},
               {"server_restart_ms", std::to_string(std::chrono::duration<double, std::milli>(out.worst_server_gap).count())},
               {"server_restarts_kept", num(out.server_restarts - out.server_restart_drops)},
-              {"server_restarts_dropped", num(out.server_restart_drops)}};
+              {"server_restarts_dropped", num(out.server_restart_drops)},
+              {"init_after_server_restart", num(out.server_restart_inits)}};
   sum.failures = out.failures;
 }
 
