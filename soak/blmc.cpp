@@ -173,8 +173,11 @@ void drive(const std::string& bus, Driver& d, const std::atomic<bool>& stop) {
   board.disable();
 }
 
-bool safe(const bsim::SimulatedBoardReport& r) {
-  return std::all_of(r.motors.begin(), r.motors.end(), [](const bsim::MotorState& m) { return !m.enabled && m.command_a == 0; });
+// Zero current and both motors off; a board being recovered (enabled at zero current, no loop yet)
+// must only carry no current.
+bool safe(const bsim::SimulatedBoardReport& r, bool in_control) {
+  return std::all_of(r.motors.begin(), r.motors.end(),
+                     [&](const bsim::MotorState& m) { return (!m.enabled || !in_control) && m.command_a == 0; });
 }
 
 struct Outcome {
@@ -206,7 +209,7 @@ void run_fault(const PlannedFault& f, Clock::time_point t0, bsim::SimulatedBoard
   }
   auto stopped_at = Clock::time_point::max();
   while (Clock::now() < at + 1s) {
-    if (safe(sim.report(f.board))) {
+    if (safe(sim.report(f.board), in_control)) {
       stopped_at = Clock::now();
       break;
     }
