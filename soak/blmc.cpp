@@ -257,7 +257,11 @@ void summarize(axon::soak::Summary& s, const Outcome& out, const std::array<Driv
   for (unsigned b = 0; b < kBoards; ++b)  // what the host reported, for the log
     for (const auto& t : drivers[b].fault_texts) std::fprintf(stderr, "blmc soak: board %u stopped: %s\n", b, t.c_str());
   if (failures > 0) s.failures.push_back(std::to_string(failures) + " recoveries failed");
-  if (recoveries + 1 < reported) s.failures.push_back("fewer recoveries than stops");
+  for (unsigned b = 0; b < kBoards; ++b) {  // only a stop the end of the soak cut short may go unrecovered
+    const auto& d = drivers[b];
+    if (d.faults_reported > d.recoveries + d.recovery_failures + 1)
+      s.failures.push_back("board " + std::to_string(b) + ": stops without a recovery attempt");
+  }
   // A run is allowed a few cycles of start and stop overhead, never a hidden skip of a whole stall.
   if (uncounted > 20) s.failures.push_back("cycles neither run nor counted as missed: " + std::to_string(uncounted));
 }
