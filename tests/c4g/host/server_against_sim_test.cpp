@@ -560,6 +560,41 @@ TEST(ServerAgainstSim, ControllerThatFallsSilentIsReportedAndANewOneIsServed) {
   EXPECT_EQ(pc.inits.load(), 2);
 }
 
+TEST(ServerAgainstSim, ARestartedServerAsksForTheInitializationPacketWith506AndTheSessionGoesOn) {
+  TestController pc;
+  std::atomic<int> cycles{0};
+  pc.cycle = [&](const H::CycleContext&, H::ReplyBuilder&) { ++cycles; };
+  auto first = start_server(pc);
+  const auto port = first->local_address().port;
+  std::unique_ptr<H::Server> second;
+  std::uint64_t first_requests = 99;
+  std::thread restarter([&] {
+    while (cycles.load() < 100) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    first_requests = first->counters().init_requests.load();
+    first.reset();  // closes the port
+    H::ServerOptions o;
+    o.listen = net::Endpoint{"127.0.0.1", port};
+    o.max_late_cycles = 0;
+    o.verify_reply_fields = true;
+    auto s = H::Server::start(pc, o);
+    ASSERT_TRUE(s) << s.error().detail;
+    second = std::move(s).value();
+  });
+  const auto run = run_sim(port, "steps:\n  - drive_on\n  - run\n", 1.5);
+  restarter.join();
+  ASSERT_TRUE(second);
+  EXPECT_FALSE(run.c->communication_error()) << run.log();
+  // The first server got the initialization packet from the controller's start-up, the second
+  // asked for it (506) and got it without sync packets.
+  EXPECT_TRUE(run.has(S::event::kInitSent, "restart (506) asked by the PC")) << run.log();
+  EXPECT_GE(second->counters().init_requests.load(), 1u);
+  EXPECT_EQ(second->counters().init_packets.load(), 1u);
+  EXPECT_TRUE(second->init().has_value());
+  EXPECT_EQ(pc.inits.load(), 2);
+  EXPECT_EQ(first_requests, 0u);
+  EXPECT_EQ(second->counters().unused_fields.load(), 0u);
+}
+
 // ---- malformed and reordered datagrams --------------------------------------------------------------
 
 // A UDP relay between the simulator and the server that tampers with chosen datagrams.

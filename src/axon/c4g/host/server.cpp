@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 #include <time.h>
 
+#include <algorithm>
 #include <cstring>
 #include <iterator>
 #include <thread>
@@ -220,6 +221,7 @@ std::size_t Server::answer_init(std::span<const std::byte> in, std::span<std::by
     exit_sent_ = {};
     switch_.reset();
     cyclic_count_ = 0;
+    init_requested_at_ = 0;
     state_.store(ServerState::running, std::memory_order_release);
     if (have_axes_) {
       try {
@@ -314,6 +316,20 @@ void Server::enforce_mode_rules(const protocol::Packet& req, protocol::Packet& r
     }
     if (protocol::exit_from_open(rep.infpar, arm)) exit_sent_[i] = true;
   }
+}
+
+void Server::request_missing_init(const protocol::Packet& req, protocol::Packet& rep) noexcept {
+  const auto every = static_cast<std::uint64_t>(std::max(options_.request_init_after, 0));
+  if (have_init_ || every == 0 || cyclic_count_ < every) return;
+  if (init_requested_at_ != 0 && cyclic_count_ - init_requested_at_ < every) return;
+  for (const auto& a : req.open_axes())
+    if (a.mode != code(Mode::mode0)) return;  // the controller takes 506 from mode 0 only
+  for (auto& a : rep.open_axes()) {
+    a = protocol::Axis{};
+    a.mode = code(Mode::server_restart);
+  }
+  init_requested_at_ = cyclic_count_;
+  bump(counters_.init_requests);
 }
 
 std::size_t Server::encode(const protocol::Packet& req, protocol::Packet& rep, std::span<std::byte> out) noexcept {
@@ -436,6 +452,7 @@ std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Data
     }
     if (used_controller && !freezing) enforce_mode_rules(request_, reply_);
   }
+  if (!freezing) request_missing_init(request_, reply_);
   if (freezing) {
     bump(counters_.frozen_cycles);
     build_freeze_reply(request_, reply_);
@@ -462,12 +479,12 @@ std::string Server::summary() const {
   fmt::format_to(it,
                  "Packets {} (init {}, cyclic {}), protocol errors {}, unanswered {}, controller exceptions {}, "
                  "late {}, refused mode changes {}, safe replies {}, frozen cycles {} (freezes {}, now {}), "
-                 "replies with unused fields set {}\n",
+                 "replies with unused fields set {}, initialization packets asked for (506) {}\n",
                  counters_.packets.load(), counters_.init_packets.load(), counters_.cyclic_packets.load(),
                  counters_.protocol_errors.load(), counters_.unanswered.load(), counters_.controller_exceptions.load(),
                  counters_.controller_late.load(), counters_.refused_mode_changes.load(), counters_.safe_replies.load(),
                  counters_.frozen_cycles.load(), counters_.freezes.load(), to_string(freeze_state()),
-                 counters_.unused_fields.load());
+                 counters_.unused_fields.load(), counters_.init_requests.load());
   fmt::format_to(it, "Safety: {} (axis {}), currents clamped {}, drive-off replies {}, following-error replies {}\n",
                  to_string(safety_.reason()), safety_.fault_axis(), safety_.counters().currents_clamped.load(),
                  safety_.counters().drive_off_replies.load(), safety_.counters().following_error_replies.load());

@@ -131,6 +131,12 @@ struct ServerOptions {
   // with this set, one is a safety fault (drive off). Off in production by default; the tests turn
   // it on, so that no built-in reply sends data the controller does not expect.
   bool verify_reply_fields = false;
+  // A session whose cyclic packets come without an initialization packet (this server was started
+  // or restarted while the controller ran) is served, but without the axis map its Safety and the
+  // applications need: after this many cyclic packets (past any sync phase) the server asks for the
+  // packet with RESTART (506) on every axis, from mode 0 as the controller requires, and again every
+  // as many packets until it comes. 0: never ask.
+  int request_init_after = 50;
   // Soft control switching intervals T1, T2, T3 of the controller (the PC infers the switch's phase
   // from the modes and these; they must match the controller's configuration).
   protocol::SwitchTimes soft_switch{};
@@ -161,6 +167,7 @@ struct ServerCounters {
   std::atomic<std::uint64_t> frozen_cycles{0};     // cycles answered under active freezing (500 .. back to 0)
   std::atomic<std::uint64_t> freezes{0};           // active freezings the controller entered
   std::atomic<std::uint64_t> unused_fields{0};     // replies with data in a field their mode does not use
+  std::atomic<std::uint64_t> init_requests{0};     // RESTART (506) sent to get a missing initialization packet
 };
 
 // Active freezing (special mode 500), as the Server drives it.
@@ -256,6 +263,8 @@ class Server : private CycleHandler {
   // Advances the freeze state for this request; true when the freeze owns this cycle's reply.
   bool update_freeze(const protocol::Packet& request) noexcept;
   void build_freeze_reply(const protocol::Packet& request, protocol::Packet& reply) noexcept;
+  // ServerOptions::request_init_after: RESTART (506) on every axis when the packet is missing.
+  void request_missing_init(const protocol::Packet& request, protocol::Packet& reply) noexcept;
   std::size_t encode(const protocol::Packet& request, protocol::Packet& reply, std::span<std::byte> out) noexcept;
 
   Controller& controller_;
@@ -281,6 +290,7 @@ class Server : private CycleHandler {
   protocol::Packet reply_{};
   protocol::Packet safe_{};
   std::uint64_t cyclic_count_ = 0;
+  std::uint64_t init_requested_at_ = 0;  // cyclic_count_ when 506 was last sent (0: not yet)
   int late_in_row_ = 0;
   SwitchTracker switch_;
   std::array<float, protocol::kMaxAxes> last_target_{};
