@@ -1,6 +1,6 @@
 # axon: the two set-up commands are `make run` and `make test` (see README.md).
 # Each installs missing Debian packages, configures with CMake presets and builds with Ninja.
-.PHONY: all deps release debug run test bench soak asan test-asan tsan test-tsan fuzz fuzz-smoke clean
+.PHONY: all deps release debug run test test-soak bench soak asan test-asan tsan test-tsan fuzz fuzz-smoke clean
 
 JOBS ?= $(shell nproc)
 # ccache (when installed) shares compiled objects between clones of the project on one machine.
@@ -25,7 +25,11 @@ run: release
 	./build/release/axon demo
 
 test: release
-	ctest --preset release -j $(JOBS)
+	ctest --preset release -j $(JOBS) -LE soak
+
+# The one-minute soaks (ctest label soak), one at a time: what CI runs after `make test`.
+test-soak: release
+	ctest --preset release -L soak
 
 bench: release
 	@bash bench/run-all.sh build/release
