@@ -19,11 +19,11 @@
 #include "axon/c4g/protocol/init_packet.hpp"
 #include "axon/c4g/protocol/packet.hpp"
 #include "axon/c4g/sim/simulated_controller.hpp"
+#include "axon/net/udp_relay.hpp"
 #include "soak.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
-#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -51,15 +51,6 @@ constexpr std::int32_t kDriveOff = 505;
 enum class Kind : std::uint8_t { late_app, wrong_app, controller_restart, server_restart };
 constexpr std::array kKinds{Kind::late_app, Kind::wrong_app, Kind::controller_restart, Kind::server_restart};
 
-int bind_loopback() {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (fd < 0 || ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) throw std::runtime_error("relay: cannot bind");
-  return fd;
-}
-
 // Between the controller and the server: tampers with datagrams at random and watches every cyclic
 // request the server gets and every reply it sends.
 class Relay {
@@ -74,26 +65,12 @@ class Relay {
   std::atomic<bool> server_down{false};  // a server restart is under way
   Counts counts;
 
-  Relay(std::uint16_t server_port, std::uint64_t seed) : rng_(seed) {
-    to_sim_ = bind_loopback();
-    to_server_ = bind_loopback();
-    server_.sin_family = AF_INET;
-    server_.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    server_.sin_port = htons(server_port);
-    thread_ = std::thread([this] { loop(); });
-  }
-  ~Relay() {
-    stop_ = true;
-    thread_.join();
-    ::close(to_sim_);
-    ::close(to_server_);
-  }
-  [[nodiscard]] std::uint16_t port() const {
-    sockaddr_in a{};
-    socklen_t len = sizeof a;
-    ::getsockname(to_sim_, reinterpret_cast<sockaddr*>(&a), &len);
-    return ntohs(a.sin_port);
-  }
+  Relay(std::uint16_t server_port, std::uint64_t seed)
+      : rng_(seed),
+        relay_(server_port, {[this](axon::net::UdpRelay&, std::span<const std::byte> d) { on_request(d); },
+                             [this](axon::net::UdpRelay&, std::span<const std::byte> d) { on_reply(d); },
+                             [this] { sweep(Clock::now(), server_down.load()); }}) {}
+  [[nodiscard]] std::uint16_t port() const { return relay_.port(); }
 
  private:
   struct Pending {
@@ -120,44 +97,17 @@ class Relay {
     return std::all_of(axes.begin(), axes.end(), [](const c4g::protocol::Axis& a) { return a.mode == 0; });
   }
   bool chance() { return std::uniform_real_distribution<double>(0, 1)(rng_) < kTamper; }
-  void send(int fd, const sockaddr_in& to, std::span<const std::byte> d) {
-    ::sendto(fd, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
-  }
-  void loop();
   void on_request(std::span<const std::byte> d);
   void on_reply(std::span<const std::byte> d);
   void sweep(Clock::time_point now, bool down);
 
-  int to_sim_ = -1, to_server_ = -1;
-  sockaddr_in server_{}, sim_{};
   std::mt19937_64 rng_;
   std::array<Pending, kRing> ring_{};
   std::size_t head_ = 0, tail_ = 0;  // pending requests [tail, head)
   std::vector<std::byte> held_;      // a reply held back, delivered after the next one
   bool was_down_ = false;
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
+  axon::net::UdpRelay relay_;  // last: its thread starts once everything above exists
 };
-
-void Relay::loop() {
-  std::array<std::byte, 2048> buf{};
-  while (!stop_) {
-    pollfd p[2] = {{to_sim_, POLLIN, 0}, {to_server_, POLLIN, 0}};
-    const int n = ::poll(p, 2, 1);
-    const bool down = server_down.load();
-    sweep(Clock::now(), down);
-    if (n <= 0) continue;
-    if ((p[0].revents & POLLIN) != 0) {
-      socklen_t len = sizeof sim_;
-      const auto got = ::recvfrom(to_sim_, buf.data(), buf.size(), 0, reinterpret_cast<sockaddr*>(&sim_), &len);
-      if (got > 0) on_request({buf.data(), static_cast<std::size_t>(got)});
-    }
-    if ((p[1].revents & POLLIN) != 0) {
-      const auto got = ::recvfrom(to_server_, buf.data(), buf.size(), 0, nullptr, nullptr);
-      if (got > 0) on_reply({buf.data(), static_cast<std::size_t>(got)});  // errors: a refused send while restarting
-    }
-  }
-}
 
 void Relay::on_request(std::span<const std::byte> d) {
   ++counts.requests;
@@ -171,10 +121,10 @@ void Relay::on_request(std::span<const std::byte> d) {
     ++head_;
     if (head_ - tail_ > kRing) ++tail_;  // cannot happen at 1 kHz with the 300 ms sweep
   }
-  send(to_server_, server_, d);
+  relay_.to_server(d);
   if (chance()) {
     ++counts.duplicated;
-    send(to_server_, server_, d);
+    relay_.to_server(d);
   }
 }
 
@@ -204,13 +154,13 @@ void Relay::on_reply(std::span<const std::byte> d) {
     held_.assign(d.begin(), d.end());
     return;
   }
-  send(to_sim_, sim_, d);
+  relay_.to_client(d);
   if (chance()) {
     ++counts.duplicated;
-    send(to_sim_, sim_, d);
+    relay_.to_client(d);
   }
   if (!held_.empty()) {
-    send(to_sim_, sim_, held_);
+    relay_.to_client(held_);
     held_.clear();
   }
 }
@@ -421,10 +371,16 @@ int main(int argc, char** argv) {
   const auto args = axon::soak::parse_args(argc, argv, "c4g");
   std::uint16_t port = 0;
   {  // a free port the restarted server binds again
-    const int fd = bind_loopback();
+    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
     sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
     socklen_t len = sizeof a;
-    ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+    if (fd < 0 || ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
+        ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
+      std::fprintf(stderr, "axon_soak_c4g: no free UDP port on loopback\n");
+      return 2;
+    }
     port = ntohs(a.sin_port);
     ::close(fd);
   }

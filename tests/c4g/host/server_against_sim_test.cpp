@@ -3,6 +3,7 @@
 // controllers for what the built-in applications do not cover (modes 8 and 9, the special modes
 // requested by the PC, refused mode changes, malformed and reordered datagrams through a proxy).
 // The command-line pairs (separate processes) are in tests/integration/cli_c4g_sim_*.sh.
+#include "axon/net/udp_relay.hpp"
 #include "axon/c4g/host/server.hpp"
 #include "axon/c4g/protocol/mode.hpp"
 #include "axon/c4g/sim/client_runner.hpp"
@@ -12,12 +13,6 @@
 #include "axon/c4g/sim/udp_client.hpp"
 
 #include <gtest/gtest.h>
-
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -600,90 +595,44 @@ TEST(ServerAgainstSim, ARestartedServerAsksForTheInitializationPacketWith506AndT
 // A UDP relay between the simulator and the server that tampers with chosen datagrams.
 class TamperingProxy {
  public:
-  explicit TamperingProxy(std::uint16_t server_port) {
-    to_sim_ = bind_loopback();
-    to_server_ = bind_loopback();
-    server_.sin_family = AF_INET;
-    server_.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    server_.sin_port = htons(server_port);
-    thread_ = std::thread([this] { loop(); });
-  }
-  ~TamperingProxy() {
-    stop_ = true;
-    thread_.join();
-    ::close(to_sim_);
-    ::close(to_server_);
-  }
-  [[nodiscard]] std::uint16_t port() const {
-    sockaddr_in a{};
-    socklen_t len = sizeof a;
-    ::getsockname(to_sim_, reinterpret_cast<sockaddr*>(&a), &len);
-    return ntohs(a.sin_port);
-  }
+  explicit TamperingProxy(std::uint16_t server_port)
+      : relay_(server_port, {[this](net::UdpRelay& r, std::span<const std::byte> d) { request(r, d); },
+                             [this](net::UdpRelay& r, std::span<const std::byte> d) { reply(r, d); },
+                             {}}) {}
+  [[nodiscard]] std::uint16_t port() const { return relay_.port(); }
 
  private:
-  static int bind_loopback() {
-    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    EXPECT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
-    return fd;
+  using Bytes = std::vector<std::byte>;
+  void request(net::UdpRelay& r, std::span<const std::byte> d) {
+    ++requests_;
+    r.to_server(d);
+    if (requests_ == 120) r.to_server(Bytes(50, std::byte{0x55}));  // no known size
+    if (requests_ == 170 && !previous_request_.empty()) r.to_server(previous_request_);  // an old number again
+    previous_request_.assign(d.begin(), d.end());
   }
-  void to_sim(const std::vector<char>& d) {
-    ::sendto(to_sim_, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&sim_), sizeof sim_);
-  }
-  void to_server(const std::vector<char>& d) {
-    ::sendto(to_server_, d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&server_), sizeof server_);
-  }
-  void loop() {
-    std::vector<char> buf(2048);
-    std::vector<char> held, previous_request;
-    int requests = 0, replies = 0;
-    while (!stop_) {
-      pollfd p[2] = {{to_sim_, POLLIN, 0}, {to_server_, POLLIN, 0}};
-      if (::poll(p, 2, 20) <= 0) continue;
-      if (p[0].revents & POLLIN) {
-        socklen_t len = sizeof sim_;
-        const auto n = ::recvfrom(to_sim_, buf.data(), buf.size(), 0, reinterpret_cast<sockaddr*>(&sim_), &len);
-        if (n > 0) {
-          std::vector<char> d(buf.begin(), buf.begin() + n);
-          ++requests;
-          to_server(d);
-          if (requests == 120) to_server(std::vector<char>(50, '\x55'));  // no known size
-          if (requests == 170 && !previous_request.empty()) to_server(previous_request);  // an old number again
-          previous_request = d;
-        }
-      }
-      if (p[1].revents & POLLIN) {
-        const auto n = ::recvfrom(to_server_, buf.data(), buf.size(), 0, nullptr, nullptr);
-        if (n > 0) {
-          std::vector<char> d(buf.begin(), buf.begin() + n);
-          ++replies;
-          if (replies == 100) {
-            held = d;  // delivered after the next reply: reordered
-            continue;
-          }
-          if (replies == 150) {
-            const std::uint32_t nan_bits = 0x7fc00000u;
-            std::memcpy(d.data() + 16, &nan_bits, 4);  // axis 1 D1
-          }
-          if (replies == 250) to_sim(std::vector<char>(7, '\x01'));
-          to_sim(d);
-          if (replies == 200) to_sim(d);  // duplicated
-          if (!held.empty()) {
-            to_sim(held);
-            held.clear();
-          }
-        }
-      }
+  void reply(net::UdpRelay& r, std::span<const std::byte> in) {
+    Bytes d(in.begin(), in.end());
+    ++replies_;
+    if (replies_ == 100) {
+      held_ = d;  // delivered after the next reply: reordered
+      return;
+    }
+    if (replies_ == 150) {
+      const std::uint32_t nan_bits = 0x7fc00000u;
+      std::memcpy(d.data() + 16, &nan_bits, 4);  // axis 1 D1
+    }
+    if (replies_ == 250) r.to_client(Bytes(7, std::byte{0x01}));
+    r.to_client(d);
+    if (replies_ == 200) r.to_client(d);  // duplicated
+    if (!held_.empty()) {
+      r.to_client(held_);
+      held_.clear();
     }
   }
 
-  int to_sim_ = -1, to_server_ = -1;
-  sockaddr_in server_{}, sim_{};
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
+  Bytes held_, previous_request_;
+  int requests_ = 0, replies_ = 0;
+  net::UdpRelay relay_;  // last: its thread starts once the state above exists
 };
 
 TEST(ServerAgainstSim, MalformedReorderedAndDuplicatedDatagramsAreCountedNotFatal) {
