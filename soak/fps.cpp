@@ -319,8 +319,12 @@ asio::awaitable<void> FpsSoak::run(asio::any_io_executor ex) {
     }
   }
   // The last word: the plane in service once more, and one clean cycle.
+  // The plane back in service: without the lost replies (their cost is the runs they refused, counted
+  // above), one clean cycle must complete; a second try is allowed.
+  on_sim([&] { sim_->simulator().set_reply_faults({}); });
   last_clean_ok_ = false;
-  if (co_await back_in_service()) co_await cycle(ex, 1'000'000, Fault::none);
+  for (int attempt = 0; attempt < 2 && !last_clean_ok_; ++attempt)
+    if (co_await back_in_service()) co_await cycle(ex, 1'000'000 + attempt, Fault::none);
   if (!last_clean_ok_) fail("the plane is not back in service: the last cycle, without a fault, did not complete");
   std::uint64_t lost = 0;
   std::string per;
