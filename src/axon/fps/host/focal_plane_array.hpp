@@ -116,7 +116,8 @@ class FocalPlaneArray {
   // layout), the connection's (CanErrc: connect_failed, timeout, device_error ...).
   asio::awaitable<Result<void>> restore_link(std::uint16_t gateway);
 
-  // Channels restarted after a bus-off (each stops every robot first, like a lost link).
+  // Bus-offs handled: each stopped every robot and made one restart attempt of its channel
+  // (link_stops() says whether the restart worked).
   [[nodiscard]] std::uint64_t bus_off_restarts() const noexcept { return bus_off_count_; }
 
   // Gateways whose connection dropped (by id), in the order noticed (again for each loss).
