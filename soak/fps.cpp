@@ -81,6 +81,19 @@ class FpsSoak {
   asio::awaitable<void> judge(Fault f, const Result<host::PlanAndMoveReport>& r, std::uint64_t collisions_before);
   asio::awaitable<bool> all_still(core::Duration within);
   std::uint16_t pick_robot(bool moving);
+  // Contacts between arms (and with obstacles) the simulator has seen so far.
+  std::uint64_t arm_collisions() {
+    return on_sim([&] {
+      const auto& st = sim_->simulator().stats();
+      return st.neighbour_collisions + st.obstacle_collisions;
+    });
+  }
+  // Gateway connections the host has lost so far, all gateways.
+  std::uint64_t link_losses() const {
+    std::uint64_t n = 0;
+    for (const auto& g : fpa_->gateways()) n += g.losses;
+    return n;
+  }
   void fail(std::string what) {
     spdlog::error("soak fps: {}", what);
     sum_.failures.push_back(std::move(what));
@@ -215,8 +228,7 @@ asio::awaitable<bool> FpsSoak::all_still(core::Duration within) {
 // inside each other's collision buffers, and the planner refuses to start from there.)
 asio::awaitable<void> FpsSoak::power_cycle() {
   const int sextant = std::uniform_int_distribution<int>(1, 6)(rng_);
-  std::uint32_t losses = 0;
-  for (const auto& g : fpa_->gateways()) losses += g.losses;
+  const auto losses = link_losses();
   off_ = on_sim([&] { return sim_->sextants().at(sextant); });
   on_sim([&] {
     (void)sim_->set_gateway_power(sextant, false);
@@ -226,9 +238,7 @@ asio::awaitable<void> FpsSoak::power_cycle() {
   ++sum_.faults;
   co_await core::sleep_for(1500ms);
   on_sim([&] { (void)sim_->set_gateway_power(sextant, true); });  // the robots come back in back_in_service()
-  std::uint32_t now = 0;
-  for (const auto& g : fpa_->gateways()) now += g.losses;
-  if (now > losses && fpa_->array().locked()) ++reported_[Fault::power_cycle];
+  if (link_losses() > losses && fpa_->array().locked()) ++reported_[Fault::power_cycle];
 }
 
 // One plan-and-move to random targets with fault `f` injected at its phase, then judged.
@@ -244,10 +254,7 @@ asio::awaitable<void> FpsSoak::cycle(asio::any_io_executor ex, std::uint64_t n, 
   o.run = [this](host::Trajectories t, host::TrajectoryOptions to) { return fpa_->run_trajectories(std::move(t), std::move(to), true); };
   phase_.clear();
   o.trajectory.on_phase = [this](std::string_view p) { phase_ = std::string(p); };
-  const auto collisions = on_sim([&] {
-    const auto& st = sim_->simulator().stats();
-    return st.neighbour_collisions + st.obstacle_collisions;
-  });
+  const auto collisions = arm_collisions();
   auto done = std::make_shared<bool>(false);
   collision_locks_ = fpa_->array().counters().collision_locks;
   if (f != Fault::none && f != Fault::power_cycle) asio::co_spawn(ex, inject(f, done), asio::detached);
@@ -290,10 +297,7 @@ asio::awaitable<void> FpsSoak::judge(Fault f, const Result<host::PlanAndMoveRepo
     ++sum_.unsafe;
     fail(fmt::format("{}: robots still moving 3 s after the run returned", name(f)));
   }
-  const auto collisions = on_sim([&] {
-    const auto& st = sim_->simulator().stats();
-    return st.neighbour_collisions + st.obstacle_collisions;
-  });
+  const auto collisions = arm_collisions();
   if (collisions != collisions_before) {
     ++sum_.unsafe;
     fail(fmt::format("{}: the simulator saw {} collision(s) between arms", name(f), collisions - collisions_before));
@@ -334,13 +338,10 @@ asio::awaitable<void> FpsSoak::run(asio::any_io_executor ex) {
   }
   sum_.lost = lost;
   const auto st = on_sim([&] { return sim_->simulator().stats(); });
-  std::uint64_t losses = 0, restorations = 0;
-  for (const auto& g : fpa_->gateways()) {
-    losses += g.losses;
-    restorations += g.restorations;
-  }
+  std::uint64_t restorations = 0;
+  for (const auto& g : fpa_->gateways()) restorations += g.restorations;
   sum_.more = {{"reported", per},
-               {"link_losses", std::to_string(losses)},
+               {"link_losses", std::to_string(link_losses())},
                {"reconnections", std::to_string(restorations)},
                {"bus_off_restarts", std::to_string(fpa_->bus_off_restarts())},
                {"runs_refused_without_fault", std::to_string(clean_failures_)},
