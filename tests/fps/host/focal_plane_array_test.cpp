@@ -193,9 +193,11 @@ TEST(FocalPlaneArray, GatewayTakenOverMidMoveIsStoppedThroughOneReconnectionBefo
         [&]() -> asio::awaitable<void> {
           co_await eventually([&] { return rig.sim->simulator().find(7)->moving(); }, 20000);
           const std::vector<int> channels{1};
+          // The gateway hands itself to the newcomer when it accepts the connection. The host takes
+          // it back at once, which may be before this client has set its channels up: its connect()
+          // then fails, and either outcome is a takeover (CI under ASan saw the second).
           auto g = co_await can::CanNetGateway::connect(rig.runner.io.get_executor(), rig.sim->gateways().at(1).endpoint,
                                                         channels);
-          EXPECT_TRUE(g.has_value());
           if (g) other = g.value();
         },
         asio::detached);
