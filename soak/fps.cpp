@@ -113,6 +113,7 @@ class FpsSoak {
   std::map<Fault, std::uint64_t> injected_, reported_;
   bool last_clean_ok_ = false;
   std::uint64_t clean_failures_ = 0;   // cycles without an injected fault that did not complete
+  std::uint64_t reuploads_ = 0;        // robots uploaded again after a lost reply
   unsigned failed_clean_ = 0;           // cycles in a row without an injected fault that failed
   std::uint64_t collision_locks_ = 0;   // the array's count when the cycle began
 };
@@ -122,7 +123,9 @@ void FpsSoak::start_sim() {
   so.simulator.time_scale = kTimeScale;
   so.seed = args_.seed;
   can::FaultRule drop{can::FaultRule::Action::drop};
-  drop.probability = 0.000005;  // about one lost reply in 5 cycles: that run must not start
+  // About two lost replies a cycle: a lost read is read again, a robot whose upload lost one is
+  // uploaded again (TrajectoryOptions::upload_retries); a run refused all the same is counted.
+  drop.probability = 0.00005;
   can::FaultRule delay{can::FaultRule::Action::delay};
   delay.probability = 0.0005;
   delay.delay = 3ms;
@@ -277,6 +280,8 @@ asio::awaitable<void> FpsSoak::judge(Fault f, const Result<host::PlanAndMoveRepo
       }
     }
   }
+  if (run != nullptr)
+    for (const auto& rr : run->robots) reuploads_ += rr.upload_attempts > 1 ? 1 : 0;
   const bool stopped = fpa_->array().locked() || (run != nullptr && !run->completed) || !r;
   if (f == Fault::none || f == Fault::power_cycle) {
     last_clean_ok_ = r && (run == nullptr || run->completed);
@@ -345,6 +350,7 @@ asio::awaitable<void> FpsSoak::run(asio::any_io_executor ex) {
                {"reconnections", std::to_string(restorations)},
                {"bus_off_restarts", std::to_string(fpa_->bus_off_restarts())},
                {"runs_refused_without_fault", std::to_string(clean_failures_)},
+               {"reuploads", std::to_string(reuploads_)},
                {"reply_faults", fmt::format("{}/{}/{}", st.faults_dropped, st.faults_delayed, st.faults_duplicated)}};
   sum_.finish(baseline_, Clock::now() - t0);  // before anything closes
   co_await fpa_->close();

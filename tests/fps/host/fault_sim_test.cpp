@@ -173,3 +173,65 @@ TEST(FaultSim, ALostCollisionReportIsCaughtByTheStatusPollAndStillStopsEveryone)
   EXPECT_FALSE(rig.model(5).moving());
   EXPECT_EQ(rig.simulator.stats().faults_dropped, 1u);
 }
+
+// One lost reply in a trajectory upload (here the second point's acknowledgement) must not call
+// the run off: the robot is uploaded again from SEND_NEW_TRAJECTORY, and the run starts and ends
+// at the targets. Before the re-upload, this run was refused ("not started").
+TEST(FaultSim, ALostReplyDuringAnUploadIsUploadedAgainAndTheRunCompletes) {
+  auto so = fast_sim();
+  so.reply_faults.rules.push_back(rule(can::FaultRule::Action::drop, from(3, CommandId::send_trajectory_data), 1, 1));
+  SimRig rig(1, so);
+  rig.add(3, 0);
+  rig.add(4, 0);
+  rig.start();
+  rig.run([&]() -> asio::awaitable<void> {
+    co_await rig.discover();
+    std::map<std::uint16_t, protocol::Trajectory> t;
+    t.emplace(3, trajectory({{5, 0.5}, {10, 1.0}, {15, 1.5}}, {{175, 1.0}}));
+    t.emplace(4, trajectory({{10, 1.0}}, {}));
+    auto rep = co_await rig.array->run_trajectories(std::move(t));
+    EXPECT_TRUE(rep.has_value());
+    if (!rep) co_return;
+    EXPECT_TRUE(rep.value().completed) << rep.value().summary();
+    const RobotRun* r3 = rep.value().find(3);
+    EXPECT_EQ(r3->upload_attempts, 2u);
+    EXPECT_NE(r3->detail.find("loaded on attempt 2"), std::string::npos) << r3->detail;
+    EXPECT_EQ(rep.value().find(4)->upload_attempts, 1u);
+  });
+  EXPECT_EQ(rig.simulator.stats().faults_dropped, 1u);
+  EXPECT_NEAR(rig.model(3).physical_deg(sim::Arm::alpha), 15.0, 0.1);
+  EXPECT_FALSE(rig.array->locked());
+}
+
+// A robot that stops answering mid-upload gets its retries, then the run is called off as before:
+// nothing starts, the other robot's trajectory is withdrawn, and the report says how often it
+// tried. With upload_retries 0 a single lost reply is enough.
+TEST(FaultSim, ARobotThatStopsAnsweringMidUploadFailsAfterItsRetriesAndNothingStarts) {
+  for (unsigned retries : {0u, 1u}) {
+    auto so = fast_sim();
+    so.reply_faults.rules.push_back(rule(can::FaultRule::Action::drop, from(3, CommandId::send_trajectory_data), 1));
+    SimRig rig(1, so);
+    rig.add(3, 0);
+    rig.add(4, 0);
+    rig.start();
+    rig.run([&]() -> asio::awaitable<void> {
+      co_await rig.discover();
+      std::map<std::uint16_t, protocol::Trajectory> t;
+      t.emplace(3, trajectory({{5, 0.5}, {10, 1.0}}, {}));
+      t.emplace(4, trajectory({{10, 1.0}}, {}));
+      TrajectoryOptions o;
+      o.upload_retries = retries;
+      auto rep = co_await rig.array->run_trajectories(std::move(t), o);
+      EXPECT_TRUE(rep.has_value());
+      if (!rep) co_return;
+      EXPECT_FALSE(rep.value().started);
+      const RobotRun* r3 = rep.value().find(3);
+      EXPECT_EQ(r3->state, RobotState::upload_failed);
+      EXPECT_EQ(r3->upload_attempts, retries + 1);
+      if (retries > 0) { EXPECT_NE(r3->detail.find("after 2 attempts"), std::string::npos) << r3->detail; }
+      EXPECT_EQ(rep.value().find(4)->state, RobotState::withdrawn);
+    });
+    EXPECT_FALSE(rig.model(3).moving());
+    EXPECT_FALSE(rig.model(4).moving());
+  }
+}

@@ -65,6 +65,11 @@ std::vector<std::string> unconfirmed_outside(const std::vector<std::pair<std::si
   return out;
 }
 
+// An upload that ended because a reply did not come (not a refusal, not the lock): worth another go.
+bool lost_reply(const UploadResult& u) {
+  return u.error && *u.error == HostErrc::timeout && u.stage != UploadResult::Stage::not_sent;
+}
+
 }  // namespace
 
 asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::uint16_t, protocol::Trajectory> trajectories,
@@ -170,11 +175,20 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
   co_await for_each_concurrently(n, [&](std::size_t i) -> asio::awaitable<void> {
     auto& r = rep.robots[i];
     if (r.state != RobotState::pending) co_return;
-    r.upload = co_await find(r.id)->upload_trajectory(*traj[i]);
+    std::string lost;  // the attempts that ended without a reply, for the report
+    for (;;) {
+      ++r.upload_attempts;
+      r.upload = co_await find(r.id)->upload_trajectory(*traj[i]);
+      if (r.upload.ok() || !lost_reply(r.upload) || r.upload_attempts > o.upload_retries || lock_->locked()) break;
+      lost += fmt::format("{}attempt {}: {}", lost.empty() ? "" : "; ", r.upload_attempts, r.upload.describe());
+      spdlog::warn("fps array: positioner {}: upload attempt {} lost a reply; uploading again", r.id, r.upload_attempts);
+    }
     if (r.upload.ok()) {
       r.state = RobotState::loaded;
+      if (!lost.empty()) r.detail = fmt::format("loaded on attempt {} ({})", r.upload_attempts, lost);
     } else {
-      fail(r, RobotState::upload_failed, r.upload.describe());
+      fail(r, RobotState::upload_failed,
+           lost.empty() ? r.upload.describe() : fmt::format("{} (after {} attempts; {})", r.upload.describe(), r.upload_attempts, lost));
     }
   });
 

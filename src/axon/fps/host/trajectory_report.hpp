@@ -38,7 +38,8 @@ struct RobotRun {
   std::uint16_t id = 0;
   std::size_t bus = 0;
   RobotState state = RobotState::pending;
-  UploadResult upload;
+  UploadResult upload;               // the last attempt
+  unsigned upload_attempts = 0;      // uploads started (more than one: a reply was lost, see upload_retries)
   std::optional<ArmAngles> start;    // position before the upload
   std::optional<ArmAngles> target;   // the last point of each arm (the start for an arm without points)
   std::optional<ArmAngles> reached;  // position after the move
@@ -53,6 +54,10 @@ struct TrajectoryOptions {
   // clear_collision_flags STOP_TRAJECTORY follows on the robots' buses, as the host in service does.
   bool clear_collision_flags = false;
   core::Duration settle = 100ms;        // after the abort/stop, before the next command
+  // A robot whose upload ended without a reply (a lost frame: HostErrc::timeout) is uploaded again
+  // from the start this many times (SEND_NEW_TRAJECTORY restarts the robot's point counters), so
+  // that one lost reply does not call off a whole-plane run. A refusal is never retried.
+  unsigned upload_retries = 1;
   // Collecting start acknowledgements. The robots that did start keep moving while the host waits
   // for one that does not answer, so keep this short (acknowledgements take milliseconds).
   core::Duration start_window = 250ms;
