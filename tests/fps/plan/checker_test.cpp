@@ -52,6 +52,33 @@ TEST(PlanChecker, CatchesCollisionThatOnlyHappensMidMove) {
   EXPECT_GE(static_clearance(s.model, {pose_at(p.first_collision_s - r.step_s), {90, 0}}), 0);
 }
 
+// Two robots standing in contact the whole move (held by the planner where a power loss left
+// them) keep the clearance they started with: a standing contact, not a collision of the move;
+// with allow_standing_contacts off it counts. A third robot moving into one of them always counts.
+TEST(PlanChecker, AContactBetweenRobotsThatNeverMoveIsTheStartsNotTheMoves) {
+  const auto m = build({{1, {0, 0}, {}, {}, 2.0}, {2, {22.4, 0}, {}, {}, 2.0}});
+  ASSERT_LT(static_clearance(m, {{0, 0}, {180, 0}}), 0.0);
+  const std::vector<RobotTrajectory> still{RobotTrajectory::hold({0, 0}), RobotTrajectory::hold({180, 0})};
+  TrajectoryChecker checker(m);
+  CheckReport r;
+  CheckOptions allow;
+  allow.allow_standing_contacts = true;
+  ASSERT_TRUE(checker.check(still, allow, r));
+  EXPECT_TRUE(r.ok());
+  EXPECT_EQ(r.standing_contacts, 1u);
+  EXPECT_TRUE(r.robot_pairs[0].standing);
+  ASSERT_TRUE(checker.check(still, {}, r));  // by default every contact counts
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.collided_pairs, 1u);
+  EXPECT_LT(r.min_clearance_mm, 0.0);
+
+  // Robot 2 turns further into robot 1: the move's collision.
+  const std::vector<RobotTrajectory> moving{RobotTrajectory::hold({0, 0}), RobotTrajectory::linear({170, 0}, {180, 0}, 0, 1)};
+  ASSERT_TRUE(checker.check(moving, allow, r));
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.standing_contacts, 0u);
+}
+
 TEST(PlanChecker, StepKeepsEveryArmPointWithinTheLimit) {
   Sweep s;
   TrajectoryChecker checker(s.model);

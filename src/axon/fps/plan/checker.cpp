@@ -95,15 +95,24 @@ Result<void> TrajectoryChecker::check(std::span<const RobotTrajectory> trajector
     for (auto& t : pool) t.join();
   }
   out.collided_pairs = 0;
+  out.standing_contacts = 0;
   out.min_clearance_mm = std::numeric_limits<double>::infinity();
   for (unsigned k = 0; k < threads; ++k) {
     for (std::size_t p = 0; p < out.robot_pairs.size(); ++p) merge(out.robot_pairs[p], workers_[k].robot_pairs[p]);
     for (std::size_t p = 0; p < out.obstacle_pairs.size(); ++p)
       merge(out.obstacle_pairs[p], workers_[k].obstacle_pairs[p]);
   }
+  auto standing = [&](std::size_t i) { return max_speed(trajectories[i].alpha) == 0 && max_speed(trajectories[i].beta) == 0; };
+  for (std::size_t p = 0; p < out.robot_pairs.size(); ++p)
+    out.robot_pairs[p].standing = standing(m.robot_pairs()[p].a) && standing(m.robot_pairs()[p].b);
+  for (std::size_t p = 0; p < out.obstacle_pairs.size(); ++p) out.obstacle_pairs[p].standing = standing(m.obstacle_pairs()[p].robot);
   for (const auto* v : {&out.robot_pairs, &out.obstacle_pairs})
     for (const auto& o : *v) {
-      out.collided_pairs += o.collided ? 1 : 0;
+      if (o.standing && options.allow_standing_contacts) {
+        out.standing_contacts += o.collided ? 1 : 0;
+        continue;
+      }
+      out.collided_pairs += o.move_collided(options) ? 1 : 0;
       out.min_clearance_mm = std::min(out.min_clearance_mm, o.min_clearance_mm);
     }
   return ok();

@@ -29,6 +29,12 @@ struct CheckOptions {
   double max_step_mm = 0.05;  // largest travel of any arm point between samples
   unsigned threads = 0;       // 0: std::thread::hardware_concurrency()
   bool obstacles = true;      // also check robot-obstacle pairs
+  // A pair whose bodies never move (two robots standing still throughout, or a standing robot and
+  // an obstacle) keeps the clearance it started with: a contact there is the start's, not the
+  // move's (the planner holds robots that start in contact). true: such contacts are counted in
+  // standing_contacts, not in collided_pairs, and left out of min_clearance_mm; false (a check of
+  // poses: every contact counts): collisions. The planner's verification sets it.
+  bool allow_standing_contacts = false;
 };
 
 struct PairOutcome {
@@ -36,6 +42,12 @@ struct PairOutcome {
   double first_collision_s = std::numeric_limits<double>::quiet_NaN();
   double min_clearance_mm = std::numeric_limits<double>::infinity();
   double min_clearance_s = std::numeric_limits<double>::quiet_NaN();
+  bool standing = false;  // neither body moves during the whole move
+
+  // A contact the move made: not a standing one that `o` allows.
+  [[nodiscard]] bool move_collided(const CheckOptions& o) const noexcept {
+    return collided && !(standing && o.allow_standing_contacts);
+  }
 };
 
 struct CheckReport {
@@ -47,7 +59,8 @@ struct CheckReport {
   double step_s = 0;
   std::size_t samples = 0;
   std::size_t collided_pairs = 0;  // robot and obstacle pairs that collided at least once
-  double min_clearance_mm = std::numeric_limits<double>::infinity();
+  std::size_t standing_contacts = 0;  // pairs in contact that never move (allow_standing_contacts)
+  double min_clearance_mm = std::numeric_limits<double>::infinity();  // over the pairs that count
 
   [[nodiscard]] bool ok() const noexcept { return collided_pairs == 0; }
   // Pair evaluations done (samples x pairs checked).

@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <span>
 #include <random>
 #include <set>
 #include <thread>
@@ -104,10 +106,10 @@ Result<std::size_t> verify_with_fallbacks(const CollisionModel& model, std::span
     std::fill(flagged.begin(), flagged.end(), false);
     const auto rp = model.robot_pairs();
     for (std::size_t k = 0; k < rp.size(); ++k)
-      if (report.robot_pairs[k].collided) flagged[rp[k].a] = flagged[rp[k].b] = true;
+      if (report.robot_pairs[k].move_collided(options)) flagged[rp[k].a] = flagged[rp[k].b] = true;
     const auto op = model.obstacle_pairs();
     for (std::size_t k = 0; k < op.size(); ++k)
-      if (report.obstacle_pairs[k].collided) flagged[op[k].robot] = true;
+      if (report.obstacle_pairs[k].move_collided(options)) flagged[op[k].robot] = true;
     bool reverted = false;
     for (std::size_t i = 0; i < n; ++i) {
       if (!flagged[i]) continue;
@@ -282,6 +284,69 @@ constexpr const char* kReverseStuck = "its target cannot be reached from the fol
 
 std::size_t firmware_points(const std::vector<TimedAngle>& pts) { return pts.empty() ? 0 : pts.size() - 1; }
 
+// Where every robot stands still (frozen or held) and aims, while the problem is set up.
+struct Setup {
+  Plan& plan;
+  std::vector<Pose>& target;
+  std::vector<bool>& still;
+  std::span<const Pose> current;
+
+  void hold(std::size_t i, const std::string& why, std::vector<std::int32_t> blockers = {}) {
+    RobotPlan& r = plan.robots[i];
+    if (r.status == RobotPlan::Status::held) {
+      r.reason += "; " + why;
+      r.blockers.insert(r.blockers.end(), blockers.begin(), blockers.end());
+    } else if (r.status != RobotPlan::Status::frozen) {
+      r = {RobotPlan::Status::held, {}, why, std::move(blockers)};
+    }
+    still[i] = true;
+    target[i] = current[i];
+  }
+};
+
+// Robots that start in contact (with each other or with a fixed obstacle) are held where they
+// are: no move out of a contact can be certified, and standing still keeps it from getting worse.
+// Both robots of a pair are held; everyone else is planned around them.
+void hold_start_contacts(const CollisionModel& model, Setup& s) {
+  std::vector<Segment> segs(model.size());
+  std::vector<Contact> contacts;
+  model.segments(s.current, segs);
+  model.find_contacts(segs, contacts);
+  for (const auto& c : contacts) {
+    if (c.kind == Contact::Kind::robot) {
+      const auto ia = model.robot(c.a).id(), ib = model.robot(c.b).id();
+      s.hold(c.a, fmt::format("starts in contact with robot {} (clearance {:.3f} mm at the full buffer)", ib, c.clearance_mm), {ib});
+      s.hold(c.b, fmt::format("starts in contact with robot {} (clearance {:.3f} mm at the full buffer)", ia, c.clearance_mm), {ia});
+    } else {
+      s.hold(c.a, fmt::format("starts in contact with {} (clearance {:.3f} mm at the full buffer)", model.obstacles()[c.b].name,
+                              c.clearance_mm));
+    }
+  }
+}
+
+// Robots boxed in by fixed obstacles (a flood fill of their own angle space finds no fold with only
+// the obstacles present): boxed in at the start, held; at the target, parked at the fold.
+void set_aside_boxed_in(const CollisionModel& model, Setup& s, const StepperOptions& so, const std::function<Pose(std::size_t)>& park_pose) {
+  for (std::size_t i = 0; i < model.size(); ++i) {
+    if (s.still[i]) continue;
+    const double fold = park_pose(i).beta_deg;
+    if (auto around = fold_blocked_by_obstacles(model, i, s.current[i], fold, so); !around.empty()) {
+      s.hold(i, fmt::format("no fold is reachable from its start: boxed in by {} and its angle limits (flood fill of its "
+                            "angle space with only the fixed obstacles)",
+                            fmt::join(around, ", ")));
+    } else if (s.plan.robots[i].status == RobotPlan::Status::reached) {
+      if (auto around_t = fold_blocked_by_obstacles(model, i, s.target[i], fold, so); !around_t.empty()) {
+        s.plan.robots[i] = {RobotPlan::Status::parked, {},
+                            fmt::format("its target cannot be reached from any fold: boxed in by {} and its angle "
+                                        "limits (flood fill of its angle space with only the fixed obstacles)",
+                                        fmt::join(around_t, ", ")),
+                            {}};
+        s.target[i] = park_pose(i);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request, const PlannerOptions& o) {
@@ -297,28 +362,6 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   if (!(o.speed.alpha_deg_s > 0) || !(o.speed.beta_deg_s > 0) || !(o.step_deg > 0))
     return make_error(PlanErrc::bad_trajectory, "plan request: speeds and step must be positive");
 
-  // The current configuration must be clear: no move out of a contact can be certified.
-  std::vector<Segment> segs(n);
-  std::vector<Contact> contacts;
-  model.segments(request.current, segs);
-  model.find_contacts(segs, contacts);
-  if (!contacts.empty()) {
-    std::string what;
-    for (const auto& c : contacts) {
-      if (what.size() > 300) {
-        what += ", ...";
-        break;
-      }
-      if (!what.empty()) what += ", ";
-      what += c.kind == Contact::Kind::robot
-                  ? fmt::format("robots {} and {} ({:.3f} mm)", model.robot(c.a).id(), model.robot(c.b).id(), c.clearance_mm)
-                  : fmt::format("robot {} and {} ({:.3f} mm)", model.robot(c.a).id(), model.obstacles()[c.b].name,
-                                c.clearance_mm);
-    }
-    return make_error(contacts.front().kind == Contact::Kind::robot ? PlanErrc::robot_collision : PlanErrc::obstacle_collision,
-                      fmt::format("current poses already in contact: {}", what));
-  }
-
   Plan plan;
   plan.robots.resize(n);
   std::vector<Pose> target = request.target;
@@ -331,6 +374,10 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
       target[i] = request.current[i];
     }
   }
+  Setup setup{plan, target, still, request.current};
+  hold_start_contacts(model, setup);
+  std::vector<Segment> segs(n);
+  std::vector<Contact> contacts;
 
   const double dt = o.step_deg / std::max(o.speed.alpha_deg_s, o.speed.beta_deg_s);
   auto fold_beta = [&](std::size_t i) {
@@ -354,10 +401,22 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
       target[i] = park_pose(i);
     }
   }
+  StepperOptions so;
+  so.dt_s = dt;
+  so.alpha_step_deg = o.speed.alpha_deg_s * dt;
+  so.beta_step_deg = o.speed.beta_deg_s * dt;
+  so.margin_mm = o.margin_mm;
+  so.max_duration_s = o.max_half_s;
+  so.stop_avoid_deg = o.stop_avoid_deg;
+  so.give_up_after = o.give_up_after;
+  so.stall_s = o.stall_s;
+  set_aside_boxed_in(model, setup, so, park_pose);
   auto settle_targets = [&]() {
     for (std::size_t guard = 0; guard < 4 * n + 4; ++guard) {
       model.segments(target, segs);
       model.find_contacts(segs, contacts);
+      // Bodies that all stay: a contact they started in (held), nothing to settle.
+      std::erase_if(contacts, [&](const Contact& c) { return still[c.a] && (c.kind != Contact::Kind::robot || still[c.b]); });
       if (contacts.empty()) return;
       for (const auto& c : contacts) {
         std::size_t victim = c.a;
@@ -371,7 +430,7 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
         } else {
           why = fmt::format("target collides with {} ({:.3f} mm)", model.obstacles()[c.b].name, c.clearance_mm);
         }
-        if (still[victim]) continue;  // two robots that stay cannot touch: the current poses are clear
+        if (still[victim]) continue;  // two robots that stay: a contact they started in (held)
         if (target[victim] == park_pose(victim)) {
           // Already folded: the other one gives way if it can.
           const std::size_t other = victim == c.a ? c.b : c.a;
@@ -394,16 +453,8 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
     }
   };
   settle_targets();
+  plan.stats.setup_s = seconds_since(t_start);
 
-  StepperOptions so;
-  so.dt_s = dt;
-  so.alpha_step_deg = o.speed.alpha_deg_s * dt;
-  so.beta_step_deg = o.speed.beta_deg_s * dt;
-  so.margin_mm = o.margin_mm;
-  so.max_duration_s = o.max_half_s;
-  so.stop_avoid_deg = o.stop_avoid_deg;
-  so.give_up_after = o.give_up_after;
-  so.stall_s = o.stall_s;
 
   StepperResult ra, rb, rm;
   std::vector<StepperRobot> fa(n), fb(n);
@@ -525,6 +576,7 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
       return make_error(PlanErrc::robot_collision,
                         fmt::format("planner did not settle after {} rounds: robots keep blocking each other", max_rounds));
     settle_targets();
+  plan.stats.setup_s = seconds_since(t_start);
   }
 
   // Third phase for robots parked because the reverse half got stuck: with everyone else at rest
@@ -635,7 +687,9 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   const auto t_check = Clock::now();
   std::vector<std::size_t> level(n, 0);
   if (o.verify) {
-    AXON_TRY(checks, verify_with_fallbacks(model, layers, o.check, plan.trajectories, level, plan.check));
+    CheckOptions check = o.check;
+    check.allow_standing_contacts = true;  // robots held where they started in contact
+    AXON_TRY(checks, verify_with_fallbacks(model, layers, check, plan.trajectories, level, plan.check));
     plan.stats.checks = checks;
     plan.verified = plan.check.ok();
   } else {

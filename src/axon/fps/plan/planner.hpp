@@ -87,6 +87,7 @@ std::string_view to_string(RobotPlan::Status s) noexcept;
 
 struct PlanStats {
   double plan_s = 0;             // wall time of plan_moves
+  double setup_s = 0;            // of which the checks before the engine (contacts, boxed-in robots, targets)
   double search_s = 0;           // of which the engine
   double check_s = 0;            // of which the checker
   double smooth_s = 0;           // of which the shortcuts (smooth.hpp)

@@ -6,6 +6,7 @@
 #include <deque>
 #include <limits>
 #include <numbers>
+#include <string>
 #include <unordered_map>
 
 namespace axon::fps::plan {
@@ -48,6 +49,7 @@ class RobotGrid {
       return c;
     };
     clr_[key(0, 0)] = c_start;
+    exhausted_ = false;
     while (!q.empty() && parent.size() < max_cells) {
       const auto [a, b] = q.front();
       q.pop_front();
@@ -81,19 +83,27 @@ class RobotGrid {
           q.push_back({a2, b2});
         }
     }
+    exhausted_ = q.empty();
     return {};
   }
 
 
-  // Turns alpha alone from the start towards `alpha`, step by certified step, as far as it is
-  // clear; the poses passed (just the start when it cannot move).
-  std::vector<Pose> walk_alpha(double alpha) const {
+  // Whether the last search() ran out of cells to visit (a closed region at this resolution), as
+  // opposed to reaching its cell limit or a fold.
+  [[nodiscard]] bool exhausted() const noexcept { return exhausted_; }
+
+  // Moves from the start straight towards `goal` (each angle at most one step per step), step by
+  // certified step, as far as it is clear; the poses passed (just the start when it cannot move).
+  std::vector<Pose> walk_to(Pose goal) const {
     std::vector<Pose> path{start_};
     double c = clearance(start_);
-    while (path.back().alpha_deg != alpha) {
+    auto toward = [](double from, double to, double step) {
+      const double next = from + std::clamp(to - from, -step, step);
+      return std::abs(to - next) < 1e-9 ? to : next;
+    };
+    while (!(path.back() == goal)) {
       const Pose p = path.back();
-      const double d = std::clamp(alpha - p.alpha_deg, -sa_, sa_);
-      const Pose q{std::abs(alpha - (p.alpha_deg + d)) < 1e-9 ? alpha : p.alpha_deg + d, p.beta_deg};
+      const Pose q{toward(p.alpha_deg, goal.alpha_deg, sa_), toward(p.beta_deg, goal.beta_deg, sb_)};
       const double cq = clearance(q);
       if (cq < std::min(margin_, c) || !edge_ok(p, q, c, cq)) break;
       path.push_back(q);
@@ -131,6 +141,7 @@ class RobotGrid {
   Pose start_;
   double sa_, sb_, margin_;
   std::unordered_map<std::int64_t, double> clr_;
+  bool exhausted_ = false;
 };
 
 // A way to a fold and the time of each of its steps.
@@ -138,6 +149,12 @@ struct GridPath {
   std::vector<Pose> poses;  // empty: none found
   double dt = 0;
 };
+
+// The grids searched, coarse to fine: (fraction of the engine's step, margin kept).
+std::array<std::pair<double, double>, 3> grid_levels(const StepperOptions& o) {
+  const double fine_margin = std::min(o.margin_mm, kFineMargin);
+  return {{{1.0, o.margin_mm}, {0.5, fine_margin}, {0.25, fine_margin}}};
+}
 
 // The search on the engine's grid first; where that finds no way out, on grids of half and a
 // quarter of the step (each step then takes as much less time, the speed stays the same) that
@@ -147,9 +164,7 @@ struct GridPath {
 // bench problems reaches a fold on a 0.25 deg grid).
 GridPath find_fold(const Positioner& r, const std::vector<Fixed>& fixed, Pose start, double fold, const StepperOptions& o,
                    std::size_t max_cells) {
-  const double fine_margin = std::min(o.margin_mm, kFineMargin);
-  const std::array<std::pair<double, double>, 3> levels{{{1.0, o.margin_mm}, {0.5, fine_margin}, {0.25, fine_margin}}};
-  for (const auto& [f, margin] : levels) {
+  for (const auto& [f, margin] : grid_levels(o)) {
     RobotGrid g(r, fixed, start, o.alpha_step_deg * f, o.beta_step_deg * f, margin);
     std::vector<Pose> p = g.search(fold, max_cells);
     if (!p.empty()) return {std::move(p), o.dt_s * f};
@@ -252,8 +267,8 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
           RobotGrid gj(rj, std::move(fj), poses[j], o.alpha_step_deg, o.beta_step_deg, o.margin_mm);
           // How far it can turn either way (the unfolded robots, often this one, may stop it);
           // the best alpha within that range.
-          const double lo = gj.walk_alpha(lj.alpha_min_deg).back().alpha_deg;
-          const double hi = gj.walk_alpha(lj.alpha_max_deg).back().alpha_deg;
+          const double lo = gj.walk_to({lj.alpha_min_deg, poses[j].beta_deg}).back().alpha_deg;
+          const double hi = gj.walk_to({lj.alpha_max_deg, poses[j].beta_deg}).back().alpha_deg;
           double best_a = poses[j].alpha_deg, best_d = sweep_clearance(segs[j]);
           auto consider = [&](double a) {
             const double d = sweep_clearance(rj.collision_segment({a, poses[j].beta_deg}));
@@ -266,7 +281,7 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
           consider(lo);
           consider(hi);
           if (best_a == poses[j].alpha_deg) continue;
-          std::vector<Pose> w = gj.walk_alpha(best_a);
+          std::vector<Pose> w = gj.walk_to({best_a, poses[j].beta_deg});
           if (w.size() < 2) continue;
           slot = std::max(slot, static_cast<double>(w.size() - 1) * o.dt_s);
           turns.emplace_back(j, std::move(w));
@@ -311,6 +326,33 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
   }
   result.duration_s = std::max(result.duration_s, t);
   return done;
+}
+
+}  // namespace axon::fps::plan
+
+namespace axon::fps::plan {
+
+std::vector<std::string> fold_blocked_by_obstacles(const CollisionModel& model, std::size_t i, Pose from, double fold_beta,
+                                                   const StepperOptions& o, std::size_t max_cells) {
+  const auto obstacles = model.obstacles();
+  const auto opairs = model.obstacle_pairs();
+  std::vector<Fixed> fixed;
+  std::vector<std::string> around;
+  for (const std::uint32_t k : model.obstacle_pairs_of(i)) {
+    fixed.push_back({obstacles[opairs[k].obstacle].shape, opairs[k].limit_mm});
+    around.push_back(obstacles[opairs[k].obstacle].name);
+  }
+  if (fixed.empty()) return {};
+  const Positioner& r = model.robot(i);
+  // Most robots fold straight (beta alone): no search needed.
+  if (RobotGrid(r, fixed, from, o.alpha_step_deg, o.beta_step_deg, o.margin_mm).walk_to({from.alpha_deg, fold_beta}).back() ==
+      Pose{from.alpha_deg, fold_beta})
+    return {};
+  for (const auto& [f, margin] : grid_levels(o)) {
+    RobotGrid g(r, fixed, from, o.alpha_step_deg * f, o.beta_step_deg * f, margin);
+    if (!g.search(fold_beta, max_cells).empty() || !g.exhausted()) return {};  // a way out, or undecided
+  }
+  return around;
 }
 
 }  // namespace axon::fps::plan

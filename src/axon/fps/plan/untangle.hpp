@@ -18,6 +18,8 @@
 #include "axon/fps/plan/stepper.hpp"
 
 #include <span>
+#include <string>
+#include <vector>
 
 namespace axon::fps::plan {
 
@@ -26,5 +28,14 @@ namespace axon::fps::plan {
 // `reached` and the result's duration are updated. Returns how many were untangled.
 std::size_t untangle_to_fold(const CollisionModel& model, std::span<const StepperRobot> robots, StepperResult& result,
                              const StepperOptions& options, std::size_t max_cells_per_robot = 200'000);
+
+// Whether robot i is boxed in by fixed obstacles: with only the fiducials and other obstacles
+// present (every other robot out of the way), a flood fill of its own angle space from `from`
+// (the untangle's grids, coarse to fine) finds no fold (beta at `fold_beta`, any alpha). Returns
+// the names of the obstacles around it when every grid ran out of cells to visit (a closed pocket
+// between obstacles and its angle stops, at the finest resolution); empty when a fold is
+// reachable, or when the search hit `max_cells` before deciding (then the engine gets to try).
+std::vector<std::string> fold_blocked_by_obstacles(const CollisionModel& model, std::size_t i, Pose from, double fold_beta,
+                                                   const StepperOptions& options, std::size_t max_cells = 200'000);
 
 }  // namespace axon::fps::plan
