@@ -5,7 +5,10 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <functional>
 #include <numbers>
+#include <queue>
+#include <tuple>
 #include <string>
 #include <unordered_map>
 
@@ -26,7 +29,9 @@ class RobotGrid {
       : r_(r), fixed_(std::move(fixed)), start_(start), sa_(sa), sb_(sb), margin_(margin) {}
 
   // Path of poses from the start to a fold at beta `fold`, empty when none within `max_cells`.
-  std::vector<Pose> search(double fold, std::size_t max_cells) {
+  // Breadth-first (the quickest way out at this resolution); `greedy`: the cells nearest the fold
+  // first, which finds *a* way out visiting far fewer cells (reachability only).
+  std::vector<Pose> search(double fold, std::size_t max_cells, bool greedy = false) {
     const AngleLimits& l = r_.limits();
     // The outermost cell on each side may be a partial step that lands exactly on the limit
     // (pose() clamps): robots caught against a stop often get out only along it.
@@ -37,9 +42,26 @@ class RobotGrid {
     auto key = [](int a, int b) { return (static_cast<std::int64_t>(a) << 32) ^ static_cast<std::uint32_t>(b); };
     std::unordered_map<std::int64_t, std::int64_t> parent;  // cell -> previous cell
     std::deque<std::pair<int, int>> q;
+    std::priority_queue<std::tuple<double, int, int>, std::vector<std::tuple<double, int, int>>, std::greater<>> near;
+    auto push = [&](int a, int b) {
+      if (greedy) near.push({std::abs(pose(a, b).beta_deg - fold), a, b});
+      else q.push_back({a, b});
+    };
+    auto pop = [&] {
+      std::pair<int, int> c;
+      if (greedy) {
+        c = {std::get<1>(near.top()), std::get<2>(near.top())};
+        near.pop();
+      } else {
+        c = q.front();
+        q.pop_front();
+      }
+      return c;
+    };
+    auto empty = [&] { return greedy ? near.empty() : q.empty(); };
     parent.reserve(4096);
     parent[key(0, 0)] = key(0, 0);
-    q.push_back({0, 0});
+    push(0, 0);
     const double c_start = clearance(start_);
     auto cell_clear = [&](int a, int b) {
       auto it = clr_.find(key(a, b));
@@ -50,9 +72,8 @@ class RobotGrid {
     };
     clr_[key(0, 0)] = c_start;
     exhausted_ = false;
-    while (!q.empty() && parent.size() < max_cells) {
-      const auto [a, b] = q.front();
-      q.pop_front();
+    while (!empty() && parent.size() < max_cells) {
+      const auto [a, b] = pop();
       const Pose p = pose(a, b);
       const double cp = cell_clear(a, b);
       // Within one step of the fold: finish there if that last step is clear.
@@ -80,10 +101,10 @@ class RobotGrid {
           const double c2 = cell_clear(a2, b2);
           if (c2 < std::min(margin_, cp) || !edge_ok(p, pose(a2, b2), cp, c2)) continue;
           parent[key(a2, b2)] = key(a, b);
-          q.push_back({a2, b2});
+          push(a2, b2);
         }
     }
-    exhausted_ = q.empty();
+    exhausted_ = empty();
     return {};
   }
 
@@ -350,7 +371,7 @@ std::vector<std::string> fold_blocked_by_obstacles(const CollisionModel& model, 
     return {};
   for (const auto& [f, margin] : grid_levels(o)) {
     RobotGrid g(r, fixed, from, o.alpha_step_deg * f, o.beta_step_deg * f, margin);
-    if (!g.search(fold_beta, max_cells).empty() || !g.exhausted()) return {};  // a way out, or undecided
+    if (!g.search(fold_beta, max_cells, true).empty() || !g.exhausted()) return {};  // a way out, or undecided
   }
   return around;
 }
