@@ -79,8 +79,8 @@ int main(int argc, char** argv) {
   fmt::print("fps_plan: {} robots, {} fiducials, {} neighbour pairs; speed {} / {} deg/s, step {} deg, buffer 2.0 mm\n",
              model.size(), plane.fiducials().size(), model.robot_pairs().size(), options.speed.alpha_deg_s,
              options.speed.beta_deg_s, options.step_deg);
-  fmt::print("{:>3} {:>7} {:>8} {:>8} {:>8} {:>8} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7} {:>8} {:>7} {:>5} {:>8} {:>6}\n", "#", "from", "plan_s",
-             "setup_s", "search_s", "check_s", "success", "dead", "escape", "p_med", "p_max", "move_s", "min_clr", "rounds", "mid_s", "smooth_s", "checks");
+  fmt::print("{:>3} {:>7} {:>8} {:>8} {:>8} {:>8} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7} {:>8} {:>7} {:>5} {:>8} {:>6} {:>6}\n", "#", "from", "plan_s",
+             "setup_s", "search_s", "check_s", "success", "dead", "escape", "p_med", "p_max", "move_s", "min_clr", "rounds", "mid_s", "smooth_s", "checks", "halv");
 
   std::vector<double> times, moves, med_points;
   std::size_t solved = 0, max_points = 0;
@@ -103,10 +103,10 @@ int main(int argc, char** argv) {
     moves.push_back(p.stats.duration_s);
     med_points.push_back(static_cast<double>(p.stats.median_points));
     max_points = std::max(max_points, p.stats.max_points);
-    fmt::print("{:>3} {:>7} {:>8.3f} {:>8.3f} {:>8.3f} {:>8.3f} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7.1f} {:>8.3f} {:>7} {:>5.1f} {:>8.3f} {:>6}\n", k,
+    fmt::print("{:>3} {:>7} {:>8.3f} {:>8.3f} {:>8.3f} {:>8.3f} {:>7} {:>4} {:>6} {:>5} {:>5} {:>7.1f} {:>8.3f} {:>7} {:>5.1f} {:>8.3f} {:>6} {:>6}\n", k,
                from_folded ? "folded" : "random", p.stats.plan_s, p.stats.setup_s, p.stats.search_s, p.stats.check_s, ok ? "yes" : "no",
                p.not_reached, p.stats.escapes, p.stats.median_points, p.stats.max_points, p.stats.duration_s,
-               p.check.min_clearance_mm, p.stats.rounds, p.stats.middle_s, p.stats.smooth_s, p.stats.checks);
+               p.check.min_clearance_mm, p.stats.rounds, p.stats.middle_s, p.stats.smooth_s, p.stats.checks, p.check.halvings);
     if (!p.ok()) std::fputs(p.summary(model).c_str(), stdout);
     std::fflush(stdout);
   }

@@ -33,6 +33,30 @@ void note(PairOutcome& o, double clearance, double t) {
   }
 }
 
+// Halvings of one sample interval before the checker gives up proving it clear.
+constexpr int kMaxHalvings = 12;
+
+// Proves the interval [t0, t1] between two samples clear for one pair, or finds the contact. The
+// clearance cannot change faster than `rate` (the sum of both bodies' fastest point speeds), so it
+// stays >= (c0 + c1 - rate * (t1 - t0)) / 2 in between; where that is negative the interval is
+// halved (exact clearance at the midpoint) until it is proven, a contact shows, or the halvings
+// run out: then the bound itself is noted (a contact the checker cannot rule out).
+template <class Clearance>
+void certify(PairOutcome& o, const Clearance& at, double rate, double t0, double c0, double t1, double c1, int depth,
+             std::size_t& halvings) {
+  if (c0 < 0 || c1 < 0 || c0 + c1 >= rate * (t1 - t0)) return;  // a contact is noted where sampled
+  const double tm = 0.5 * (t0 + t1);
+  if (depth >= kMaxHalvings) {
+    note(o, 0.5 * (c0 + c1 - rate * (t1 - t0)), tm);
+    return;
+  }
+  ++halvings;
+  const double cm = at(tm);
+  note(o, cm, tm);
+  certify(o, at, rate, t0, c0, tm, cm, depth + 1, halvings);
+  certify(o, at, rate, tm, cm, t1, c1, depth + 1, halvings);
+}
+
 }  // namespace
 
 Result<void> TrajectoryChecker::check(std::span<const RobotTrajectory> trajectories, const CheckOptions& options,
@@ -106,6 +130,8 @@ Result<void> TrajectoryChecker::check(std::span<const RobotTrajectory> trajector
   for (std::size_t p = 0; p < out.robot_pairs.size(); ++p)
     out.robot_pairs[p].standing = standing(m.robot_pairs()[p].a) && standing(m.robot_pairs()[p].b);
   for (std::size_t p = 0; p < out.obstacle_pairs.size(); ++p) out.obstacle_pairs[p].standing = standing(m.obstacle_pairs()[p].robot);
+  out.halvings = 0;
+  for (unsigned k = 0; k < threads; ++k) out.halvings += workers_[k].halvings;
   for (const auto* v : {&out.robot_pairs, &out.obstacle_pairs})
     for (const auto& o : *v) {
       if (o.standing && options.allow_standing_contacts) {
@@ -126,7 +152,12 @@ void TrajectoryChecker::run(Worker& w, std::span<const RobotTrajectory> trajecto
   w.segs.resize(n);
   w.mid.resize(n);
   w.half.resize(n);
-  for (std::size_t i = 0; i < n; ++i) w.half[i] = 0.5 * m.robot(i).collision_length_mm();
+  w.speed.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Positioner& r = m.robot(i);
+    w.half[i] = 0.5 * r.collision_length_mm();
+    w.speed[i] = max_speed(trajectories[i].alpha) * kRad * r.reach_mm() + max_speed(trajectories[i].beta) * kRad * r.collision_length_mm();
+  }
   w.alpha.resize(n);
   w.beta.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -135,11 +166,23 @@ void TrajectoryChecker::run(Worker& w, std::span<const RobotTrajectory> trajecto
   }
   w.robot_pairs.assign(shape.robot_pairs.size(), PairOutcome{});
   w.obstacle_pairs.assign(shape.obstacle_pairs.size(), PairOutcome{});
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  w.prev_robot.assign(shape.robot_pairs.size(), nan);
+  w.prev_obstacle.assign(shape.obstacle_pairs.size(), nan);
+  w.halvings = 0;
   const auto rp = m.robot_pairs();
   const auto op = m.obstacle_pairs();
+  auto segment_at = [&](std::size_t i, double t) {
+    return m.robot(i).collision_segment({angle_at(trajectories[i].alpha, t), angle_at(trajectories[i].beta, t)});
+  };
 
-  for (std::size_t s = first; s < last; ++s) {
+  // Each block also proves the interval that ends at its first sample (from the sample before).
+  const std::size_t begin = first > 0 ? first - 1 : first;
+  double t_prev = nan;
+  for (std::size_t s = begin; s < last; ++s) {
     const double t = s + 1 == shape.samples ? shape.end_s : shape.start_s + static_cast<double>(s) * shape.step_s;
+    const bool record = s >= first;  // the sample before the block is the previous block's to note
+    const double dt = s > begin ? t - t_prev : 0;
     for (std::size_t i = 0; i < n; ++i) {
       const Pose p{w.alpha[i].at(t), w.beta[i].at(t)};
       if (p != w.poses[i]) {  // a robot standing still keeps its segment (NaN at start: always differs)
@@ -149,20 +192,45 @@ void TrajectoryChecker::run(Worker& w, std::span<const RobotTrajectory> trajecto
       }
     }
     for (std::size_t k = 0; k < rp.size(); ++k) {
-      // Each segment lies within half its length of its midpoint, so the midpoints' distance
-      // minus both half lengths and the limit is a lower bound of the clearance. When that bound
-      // cannot beat the pair's smallest clearance so far (which is >= 0 unless it collided
-      // already), the sample can change nothing for this pair: skip the exact distance.
+      // Each segment lies within half its length of its midpoint, so the midpoints' distance minus
+      // both half lengths and the limit is a lower bound of the clearance. When that bound beats
+      // both the pair's smallest clearance so far and what the interval needs (its clearance can
+      // shrink by at most the pair's travel), the exact distance can change nothing: skipped, and
+      // the bound kept for the next interval.
       const RobotPair& p = rp[k];
       PairOutcome& o = w.robot_pairs[k];
-      const double room = w.half[p.a] + w.half[p.b] + p.limit_mm + o.min_clearance_mm;
-      if (room >= 0 && room < std::numeric_limits<double>::infinity() &&
-          norm2(w.mid[p.a] - w.mid[p.b]) > room * room && (o.collided || o.min_clearance_mm >= 0))
+      const double rate = w.speed[p.a] + w.speed[p.b];
+      const double reach = w.half[p.a] + w.half[p.b] + p.limit_mm;
+      const double need = std::max(rate * dt, o.min_clearance_mm);
+      double& prev = w.prev_robot[k];
+      if (prev >= 0 && need < std::numeric_limits<double>::infinity() && norm2(w.mid[p.a] - w.mid[p.b]) > (reach + need) * (reach + need) &&
+          (o.collided || o.min_clearance_mm >= 0)) {
+        prev = need;
         continue;
-      note(o, m.clearance(p, w.segs), t);
+      }
+      const double c = m.clearance(p, w.segs);
+      if (record) note(o, c, t);
+      if (s > begin) {
+        const double c0 = prev >= 0 && prev + c < rate * dt ? segment_distance(segment_at(p.a, t_prev), segment_at(p.b, t_prev)) - p.limit_mm : prev;
+        certify(o, [&](double tm) { return segment_distance(segment_at(p.a, tm), segment_at(p.b, tm)) - p.limit_mm; }, rate,
+                t_prev, c0, t, c, 0, w.halvings);
+      }
+      prev = c;
     }
     if (obstacles)
-      for (std::size_t k = 0; k < op.size(); ++k) note(w.obstacle_pairs[k], m.clearance(op[k], w.segs), t);
+      for (std::size_t k = 0; k < op.size(); ++k) {
+        const ObstaclePair& p = op[k];
+        PairOutcome& o = w.obstacle_pairs[k];
+        const Segment& shape_k = m.obstacles()[p.obstacle].shape;
+        const double c = m.clearance(p, w.segs);
+        if (record) note(o, c, t);
+        double& prev = w.prev_obstacle[k];
+        if (s > begin)
+          certify(o, [&](double tm) { return segment_distance(segment_at(p.robot, tm), shape_k) - p.limit_mm; },
+                  w.speed[p.robot], t_prev, prev, t, c, 0, w.halvings);
+        prev = c;
+      }
+    t_prev = t;
   }
 }
 

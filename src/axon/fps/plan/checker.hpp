@@ -7,8 +7,12 @@
 // a step dt moves any point of the segment at most (wa * reach + wb * collision length) * dt.
 // At every sample it evaluates the exact segment distances of the neighbour pairs and the
 // robot-obstacle pairs, and keeps per pair the first sample in collision and the smallest
-// clearance. Between samples two bodies can come closer by at most 2 * max_step_mm than the
-// samples show (0.1 mm with the default); see docs/fps-plan.md.
+// clearance. Between samples nothing is left to chance: a pair's clearance changes no faster than
+// the sum of its two bodies' fastest point speeds (rate), so over an interval of dt it stays at or
+// above (c0 + c1 - rate * dt) / 2, c0 and c1 being the clearances at its ends. Where that bound is
+// negative while both ends are clear, the interval is halved (exact clearance at the midpoint)
+// until it is proven clear or a contact shows; after 12 halvings the negative bound itself counts
+// as a contact. A clean report is therefore a proof, not a sampling result (docs/fps-plan.md).
 //
 // The sample range is split over threads in contiguous blocks. A checker keeps its scratch
 // storage between calls and fills a caller-owned report, so repeated checks allocate nothing
@@ -60,6 +64,7 @@ struct CheckReport {
   std::size_t samples = 0;
   std::size_t collided_pairs = 0;  // robot and obstacle pairs that collided at least once
   std::size_t standing_contacts = 0;  // pairs in contact that never move (allow_standing_contacts)
+  std::size_t halvings = 0;           // sample intervals halved to prove a close pair clear
   double min_clearance_mm = std::numeric_limits<double>::infinity();  // over the pairs that count
 
   [[nodiscard]] bool ok() const noexcept { return collided_pairs == 0; }
@@ -83,6 +88,9 @@ class TrajectoryChecker {
     std::vector<Segment> segs;
     std::vector<Vec2> mid;      // segment midpoints
     std::vector<double> half;   // half the segment lengths
+    std::vector<double> speed;  // fastest point speed of each robot's segment, mm/s
+    std::vector<double> prev_robot, prev_obstacle;  // per pair: clearance (or a lower bound) at the last sample
+    std::size_t halvings = 0;
     std::vector<AngleCursor> alpha, beta;
     std::vector<PairOutcome> robot_pairs, obstacle_pairs;
   };
