@@ -1,4 +1,4 @@
-// Dense-sampling collision check of a whole move, independent of any planner.
+// Collision check of a whole move, independent of any planner: dense samples, and a proof between them.
 //
 // Every robot follows its alpha and beta trajectories (linear between points). The checker picks
 // one time step for the move such that no point of any collision segment travels more than
