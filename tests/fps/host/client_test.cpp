@@ -6,6 +6,9 @@
 #include "axon/fps/plan/error.hpp"
 #include "axon/fps/sim/simulated_plane.hpp"
 
+#include "axon/fps/plan/layout_model.hpp"
+#include "axon/fps/plan/stop_sweep.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -122,6 +125,41 @@ TEST_F(ClientOnPlane, GoToDatumsDrivesIntoTheHardStopsAndReportsWhereTheRobotSta
   const auto row = std::find_if(table.begin(), table.end(), [](const RobotStatus& r) { return r.id == 3; });
   ASSERT_NE(row, table.end());
   EXPECT_TRUE(row->ready) << row->state;
+}
+
+// With the layout known, a datum search whose way to the hard stops passes a neighbour is refused
+// before anything moves, naming the neighbour (protocol document 5.3.11: a collision on the way
+// would be taken for the stop).
+TEST_F(ClientOnPlane, ADatumSearchWhoseWayToTheStopsIsBlockedIsRefusedNamingTheNeighbour) {
+  const auto model = plan::model_from_layout(plane.plane()).value();
+  const auto idx = model.index_of(3).value();
+  std::vector<plan::Pose> poses(model.size());
+  for (const auto& r : fps.status())
+    if (r.position) poses[model.index_of(r.id).value()] = {r.position->alpha, r.position->beta};
+  auto clear = [&] {
+    std::vector<plan::Segment> segs(model.size());
+    std::vector<plan::Contact> contacts;
+    model.segments(poses, segs);
+    model.find_contacts(segs, contacts);
+    return contacts.empty();
+  };
+  std::optional<double> blocked;  // an alpha of robot 3 (beta 150) from which the way is blocked
+  for (double a = 0; a < 360 && !blocked; a += 10) {
+    poses[idx] = {a, 150};
+    if (clear() && !plan::check_sweep_to_stops(model, idx, poses).clear) blocked = a;
+  }
+  ASSERT_TRUE(blocked.has_value());
+  ASSERT_TRUE(fps.goto_absolute({{3, {*blocked, 150}}}).completed);
+  try {
+    fps.go_to_datums(3);
+    FAIL() << "a datum search went out through a neighbour";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), host::HostErrc::not_ready) << e.what();
+    EXPECT_NE(std::string(e.what()).find("may touch robot"), std::string::npos) << e.what();
+  }
+  const auto truth = plane.arms(3);
+  ASSERT_TRUE(truth.has_value());
+  EXPECT_LT(error_deg(*truth, {*blocked, 150}), 0.1) << "the robot moved";
 }
 
 TEST_F(ClientOnPlane, CalibrateRunsMotorsAndDatumsAndSaves) {

@@ -139,6 +139,9 @@ class Array final : public MotionGate {
   void collision_seen(std::uint16_t positioner, const protocol::PositionerStatus& status) override;
   [[nodiscard]] bool locked() const noexcept { return lock_->locked(); }
   [[nodiscard]] const LockState& lock_state() const noexcept { return lock_->state(); }
+  // The lock's rule asked up front for a whole sequence, so that a refused one does nothing at all
+  // (HostErrc::locked with the lock's reason when command `c` to any of `ids` would be refused).
+  [[nodiscard]] Result<void> admit_all(protocol::CommandId c, const std::vector<std::uint16_t>& ids) const;
   // The lock every client of this array obeys (for a client made by hand on one of its buses).
   [[nodiscard]] std::shared_ptr<const MotionLock> motion_lock() const noexcept { return lock_; }
   // Locks the array and stops every robot (TRAJECTORY_ABORT broadcast on every bus at once), as
@@ -208,8 +211,6 @@ class Array final : public MotionGate {
   };
 
   asio::awaitable<Result<MoveResults>> move_many(std::map<std::uint16_t, ArmAngles> values, bool relative);
-  // The lock's rule asked up front for a whole sequence, so that a refused one does nothing at all.
-  [[nodiscard]] Result<void> admit_all(protocol::CommandId c, const std::vector<std::uint16_t>& ids) const;
   void on_unsolicited(std::size_t bus, const Unsolicited& u);
   void lock_for(std::string reason);
   void stop_in_background();

@@ -5,6 +5,7 @@
 #include "axon/fps/host/array.hpp"
 #include "axon/fps/host/focal_plane_array.hpp"
 #include "axon/fps/host/plan_and_move.hpp"
+#include "axon/fps/host/datum_check.hpp"
 #include "axon/fps/plan/layout_model.hpp"
 #include "axon/fps/plan/targets.hpp"
 #include "axon/net/endpoint.hpp"
@@ -236,10 +237,22 @@ MoveOutcome Client::run_trajectories(const std::map<std::uint16_t, ArmPath>& pat
   });
 }
 
+namespace {
+
+// The geometry the sweep to the hard stops is checked on: the layout's, when there is one.
+std::shared_ptr<const plan::CollisionModel> datum_model(const Client::Impl& impl) {
+  if (!impl.layout) return nullptr;
+  return std::make_shared<const plan::CollisionModel>(need(plan::model_from_layout(*impl.layout)));
+}
+
+}  // namespace
+
 Angles Client::go_to_datums(std::uint16_t id) {
   auto& array = impl_->open_array();
-  return impl_->run([&array, id]() -> asio::awaitable<Angles> {
+  auto model = datum_model(*impl_);
+  return impl_->run([&array, id, model]() -> asio::awaitable<Angles> {
     auto* p = need(array.positioner(id));
+    if (model) need(co_await host::check_datum_sweep(array, *model, id, host::Arm::both));
     auto done = co_await p->go_to_datums(host::Arm::both);
     need(std::move(done));
     auto at = co_await p->read_position();
@@ -254,8 +267,10 @@ CalibrationOutcome Client::calibrate(std::uint16_t id, const CalibrationSteps& s
   plan.datums = steps.datums;
   plan.cogging = steps.cogging;
   plan.save = steps.save;
-  return impl_->run([&array, id, plan]() -> asio::awaitable<CalibrationOutcome> {
+  auto model = plan.datums ? datum_model(*impl_) : nullptr;
+  return impl_->run([&array, id, plan, model]() -> asio::awaitable<CalibrationOutcome> {
     auto* p = need(array.positioner(id));
+    if (model) need(co_await host::check_datum_sweep(array, *model, id, host::Arm::both));
     auto r = co_await p->calibrate(plan);
     const auto rep = need(std::move(r));
     const auto arms = [](const std::optional<protocol::ArmValues>& v) {

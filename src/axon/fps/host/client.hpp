@@ -174,14 +174,19 @@ class Client {
   // The same with a target file (YAML or CSV: robot, alpha/beta or x/y and fibre).
   PlanAndMoveOutcome plan_and_move(const std::string& target_file, const PlanSettings& settings = {});
 
-  // Datum search of one robot found by discover(): both arms drive into their hard stops (the arms
-  // move; nothing checks for neighbours on the way). Waits for the end and returns where the robot
-  // then stands. Refused while locked (HostErrc::locked); a robot that does not finish within the
-  // positioner's datum timeout is aborted and the call throws.
+  // Datum search of one robot found by discover(): both arms drive into their hard stops. With a
+  // layout (open(plane) or set_layout()), the positions of the robot and its neighbours are read
+  // first and the way to the stops (both arms at the same speed, the stops up to 10 deg below the
+  // limits) must be clear of the neighbours and the fixed obstacles: otherwise HostErrc::not_ready
+  // naming what is in the way, and nothing moves (host/datum_check.hpp). Without a layout nothing
+  // is checked. Waits for the end and returns where the robot then stands. Refused while locked
+  // (HostErrc::locked); a robot that does not finish within the positioner's datum timeout is
+  // aborted and the call throws.
   Angles go_to_datums(std::uint16_t id);
   // The calibration sequence of one robot found by discover() (motors, datums, cogging, save, as
-  // `steps` says; the arms move). Takes minutes, cogging up to 40: raise set_call_timeout() first
-  // when needed. Refused while locked (HostErrc::locked).
+  // `steps` says; the arms move; with datums, the same check as go_to_datums first). Takes minutes,
+  // cogging up to 40: raise set_call_timeout() first when needed. Refused while locked
+  // (HostErrc::locked).
   CalibrationOutcome calibrate(std::uint16_t id, const CalibrationSteps& steps = {});
 
   // Locks the array and aborts every robot on every bus; moves are refused until unlock().
