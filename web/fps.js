@@ -50,17 +50,7 @@ function buildLegend() {
 }
 
 function connect() {
-  const scheme = location.protocol === 'https:' ? 'wss' : 'ws';
-  const ws = new WebSocket(`${scheme}://${location.host}/ws?source=fps`);
-  ws.onopen = () => { $('conn').textContent = 'live'; $('conn').className = 'live'; };
-  ws.onclose = () => {
-    $('conn').textContent = 'disconnected, reconnecting';
-    $('conn').className = '';
-    setTimeout(connect, 1000);
-  };
-  ws.onmessage = (event) => {
-    const message = JSON.parse(event.data);
-    if (message.source !== 'fps') return;
+  axonConnect('fps', (message) => {
     fps.state = message.state;
     fps.seq = message.seq;
     fps.messages++;
@@ -68,7 +58,7 @@ function connect() {
     showLock();
     showDetails();
     scheduleDraw();
-  };
+  });
 }
 
 function showSummary() {

@@ -5,7 +5,8 @@
 // stop, a failed start, an exception, a closed stdout, Ctrl-C/SIGTERM/SIGHUP) the board gets zero
 // current and is disabled, and the disable's result decides the exit code. Tables and results go
 // to stdout (JSON Lines with --json), logs to stderr. The options live in one Blmc object per
-// invocation, shared by the subcommands' callbacks.
+// invocation, shared by the subcommands' callbacks. --http serves the board's live page and
+// /metrics (docs/dashboard.md): a web::BlmcView fed on the bus thread from the loop's records.
 #include "axon/blmc/host/board.hpp"
 #include "axon/blmc/host/control_run.hpp"
 #include "axon/blmc/host/error.hpp"
@@ -17,6 +18,9 @@
 #include "axon/can/bus_spec.hpp"
 #include "axon/can/candump_log.hpp"
 #include "axon/can/open.hpp"
+#include "axon/net/endpoint.hpp"
+#include "axon/web/blmc_view.hpp"
+#include "axon/web/server.hpp"
 #include "checks.hpp"
 #include "commands.hpp"
 #include "run.hpp"
@@ -68,6 +72,8 @@ struct BlmcOptions {
   std::vector<int> cpus;
   bool pace_measurements = false;
   bool json = false;
+  std::string http;          // HOST:PORT of the live page (empty: none)
+  double http_linger_s = 0;  // keep serving the final state this long after the command
   // The subcommands' own arguments.
   int current_motor = 1;
   double current_amps = 0;
@@ -185,7 +191,39 @@ struct Blmc {
   BlmcOptions o;
   Output out{o.json};
   bool motors_may_be_on = false;
+  const char* command = "";  // the subcommand running
+  bool motion = false;       // it runs the control loop
 };
+
+// ---- --http: the live page ----------------------------------------------------------------------
+
+// The board's page on a web server of its own thread; the view is fed and published on the bus
+// thread (the loop's records drained there, or the monitor's samples), never on the real-time one.
+struct WebPage {
+  std::unique_ptr<web::Server> server;
+  std::shared_ptr<web::Source> source;
+  std::unique_ptr<web::BlmcView> view;
+  void publish(bool with_metrics = false) { view->publish(*source, with_metrics ? 1 : 10); }
+};
+
+std::unique_ptr<WebPage> open_web_page(const Blmc& cli, const std::string& board) {
+  const auto ep = need(net::parse_endpoint(cli.o.http));
+  web::ServerOptions so;
+  so.address = ep.host;
+  so.port = ep.port;
+  auto page = std::make_unique<WebPage>();
+  web::BlmcViewOptions vo;
+  vo.boards = {{board, cli.motion ? std::optional(control_options(cli.o, 0).limits) : std::nullopt}};
+  vo.nominal_period = control_options(cli.o, 0).loop.period;
+  vo.command = cli.command;
+  page->view = std::make_unique<web::BlmcView>(std::move(vo));
+  page->server = std::make_unique<web::Server>(so);
+  page->source = std::make_shared<web::Source>("blmc", fmt::format("blmc: board on {} ({})", board, cli.command), "blmc");
+  page->source->set_info(page->view->info_json());
+  page->publish(true);
+  page->server->add(page->source);
+  return page;
+}
 
 // ---- session ------------------------------------------------------------------------------------
 
@@ -196,6 +234,7 @@ struct Session {
   std::unique_ptr<bh::Board> board;
   std::optional<can::CandumpWriter> log;
   std::string iface;
+  std::unique_ptr<WebPage> web;  // with --http
   bool stop = false;
   bool signal_ends_normally = false;  // monitor/record until Ctrl-C: a signal is their end
   [[nodiscard]] const BlmcOptions& o() const { return cli->o; }
@@ -232,6 +271,12 @@ asio::awaitable<std::unique_ptr<Session>> open_session(Blmc& cli, asio::io_conte
     raw->board->interrupt();
   });
   spdlog::info("blmc: board on {}", spec.to_string());
+  if (!o.http.empty()) {
+    s->web = open_web_page(cli, s->iface);
+    const auto where = fmt::format("{}:{}", s->web->server->address(), s->web->server->port());
+    if (s->out().is_json()) s->out().emit(json{{"type", "listening"}, {"http", where}});
+    else s->out().emit("listening http " + where);
+  }
   co_return s;
 }
 
@@ -253,6 +298,21 @@ bool disable_over_new_connection(const BlmcOptions& o) {
   return static_cast<bool>(result);
 }
 
+// --http-linger: the page goes on showing the board's status (disabled, its error) after the
+// command, until the time is up or a stop signal, which is then the normal end.
+asio::awaitable<void> linger(Session& s, const SignalHook& on_signal) {
+  Session* raw = &s;
+  on_signal([raw, on_signal] {
+    on_signal.signal_ends_normally();
+    raw->board->interrupt();
+  });
+  co_await bh::monitor(*s.board, 100ms, seconds(s.o().http_linger_s), [raw](double, const bh::Measurements& m) {
+    if (m.status_byte.received()) raw->web->view->set_status(0, m.status_byte.value);
+    raw->web->publish();
+    return true;
+  });
+}
+
 using Body = std::function<asio::awaitable<int>(Session&)>;
 
 int run_blmc(Blmc& cli, bool signal_ends_normally, const Body& body) {
@@ -264,6 +324,7 @@ int run_blmc(Blmc& cli, bool signal_ends_normally, const Body& body) {
       std::exception_ptr failure;
       try {
         code = co_await body(*s);
+        if (s->web && cli.o.http_linger_s > 0) co_await linger(*s, set_on_signal);
       } catch (...) {
         failure = std::current_exception();
       }
@@ -301,11 +362,16 @@ json stats_json(const bh::LoopStats& st) {
 bh::ControlHooks table_hooks(Session& s) {
   s.out().table_header();
   bh::ControlHooks h;
-  if (!s.o().csv.empty()) {
-    auto csv = std::make_shared<bh::CycleCsv>(need(bh::CycleCsv::create(s.o().csv)));
-    h.record = [csv](const bh::CycleRecord& r) { csv->write(r); };
+  std::shared_ptr<bh::CycleCsv> csv;
+  if (!s.o().csv.empty()) csv = std::make_shared<bh::CycleCsv>(need(bh::CycleCsv::create(s.o().csv)));
+  if (csv || s.web) {
+    h.record = [csv, view = s.web ? s.web->view.get() : nullptr](const bh::CycleRecord& r) {
+      if (csv) csv->write(r);
+      if (view) view->add_record(r);
+    };
   }
   h.refresh = [&s](double t, const bh::CycleRecord* last) {
+    if (s.web) s.web->publish();
     if (!s.out().ok()) return false;
     return last == nullptr || s.out().row(t, bh::measurements_of(*last));
   };
@@ -315,6 +381,10 @@ bh::ControlHooks table_hooks(Session& s) {
 // The loop's figures and how it ended, for the report and the exit code.
 Outcome outcome_of(const Session& s, const bh::ControlOutcome& c) {
   const auto& st = c.stats;
+  if (s.web) {
+    s.web->view->end_run(st, c.fault);
+    s.web->publish(true);
+  }
   spdlog::info("blmc: {} cycles, period {:.1f} us mean, jitter p99 {} us max {} us, {} overruns, {} missed",
                st.cycles, std::chrono::duration<double, std::micro>(st.period_mean).count(),
                std::chrono::duration_cast<std::chrono::microseconds>(st.jitter_p99).count(),
@@ -391,7 +461,13 @@ asio::awaitable<int> cmd_monitor(Session& s) {
   bool writing = s.out().table_header();
   if (writing)
     writing = co_await bh::monitor(*s.board, seconds(1.0 / o.refresh_hz), seconds(o.duration_s),
-                                   [&s](double t, const bh::Measurements& m) { return s.out().row(t, m); });
+                                   [&s](double t, const bh::Measurements& m) {
+                                     if (s.web) {
+                                       s.web->view->add_measurements(0, t, m);
+                                       s.web->publish();
+                                     }
+                                     return s.out().row(t, m);
+                                   });
   const auto& m = s.board->latest();
   spdlog::info("blmc: {} board frames, {} rejected, {} foreign", m.frames, m.rejected, m.foreign);
   co_return writing ? exit_code_value::ok : exit_code_value::failed;
@@ -571,7 +647,9 @@ void check_loop_options(const BlmcOptions& o) {
 
 CLI::App* add(CLI::App* parent, GlobalOptions& global, const std::shared_ptr<Blmc>& cli, const char* name, const char* help, Kind kind, Body body) {
   auto* c = parent->add_subcommand(name, help);
-  c->callback([cli, body = std::move(body), kind, &global] {
+  c->callback([cli, body = std::move(body), kind, name, &global] {
+    cli->command = name;
+    cli->motion = kind == Kind::motion;
     if (kind == Kind::motion) check_loop_options(cli->o);
     global.exit_code = run_blmc(*cli, kind == Kind::observe, body);
   });
@@ -618,6 +696,10 @@ void add_board_options(CLI::App* b, BlmcOptions& o) {
   b->add_option("--cpu", o.cpus, "pin the control thread to these CPUs")->delimiter(',');
   b->add_flag("--pace-measurements", o.pace_measurements, "start each cycle when the board's data burst arrived");
   b->add_flag("--json", o.json, "stdout: JSON Lines (one object per line: status, sample, report, sent)");
+  b->add_option("--http", o.http, "monitor, current, pd, home: serve the board's live page and /metrics on HOST:PORT "
+                                   "(docs/dashboard.md; 127.0.0.1 keeps it on this machine, port 0: any)");
+  b->add_option("--http-linger", o.http_linger_s, "with --http: keep serving the final state this many seconds after the "
+                                                  "command (Ctrl-C ends it; default 0)")->check(non_negative());
 }
 
 void add_motion_commands(CLI::App* b, GlobalOptions& global, const std::shared_ptr<Blmc>& cli) {

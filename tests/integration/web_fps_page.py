@@ -18,37 +18,16 @@ import tempfile
 import time
 import urllib.request
 
-from selenium import webdriver
-from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), 'helpers'))
+from browser import page, start_chromium, wait_until  # noqa: E402
 
 AXON = sys.argv[1]
 COLLIDER = 100          # robot that reports a collision the first time it moves
 TARGET = (20.0, 170.0)  # where the move takes every robot
 TOLERANCE_DEG = 0.5     # page angles (the simulator's physical ones) against the commanded target
-
-
-def start_chromium():
-    options = webdriver.ChromeOptions()
-    for arg in ('--headless=new', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage', '--window-size=1400,1000'):
-        options.add_argument(arg)
-    options.binary_location = shutil.which('chromium') or '/usr/bin/chromium'
-    try:
-        return webdriver.Chrome(service=Service(shutil.which('chromedriver') or '/usr/bin/chromedriver'), options=options)
-    except Exception as e:  # no browser at all: nothing this test can check
-        print('SKIP: chromium cannot start: %s' % str(e).splitlines()[0])
-        sys.exit(0)
-
-
-def wait_until(what, check, seconds=20.0, step=0.02):
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        value = check()
-        if value:
-            return value
-        time.sleep(step)
-    raise AssertionError('timed out waiting for ' + what)
 
 
 def start_sim(tmp):
@@ -79,10 +58,6 @@ def gateway_of(layout_file, robot):
 def api_state(url):
     with urllib.request.urlopen(url + '/api/fps/state', timeout=5) as r:
         return json.load(r)
-
-
-def page(driver, expression):
-    return driver.execute_script('return ' + expression)
 
 
 def check_draws_every_robot(driver):

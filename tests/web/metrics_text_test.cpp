@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -39,6 +40,21 @@ TEST(MetricsText, WritesNonFiniteValuesAsPrometheusSpellsThem) {
       .sample(std::numeric_limits<double>::infinity())
       .sample(-std::numeric_limits<double>::infinity());
   EXPECT_NE(m.text().find("x NaN\nx +Inf\nx -Inf\n"), std::string::npos) << m.text();
+}
+
+TEST(MetricsText, HistogramBucketsAreCumulativeAndEndAtInf) {
+  const std::array<double, 2> bounds{1e-05, 0.0001};
+  const std::array<std::uint64_t, 3> counts{4, 2, 1};
+  MetricsText m;
+  m.family("axon_test_jitter_seconds", MetricType::histogram, "Jitter").histogram(bounds, counts, 0.25, {{"board", "can0"}});
+  EXPECT_EQ(m.text(),
+            "# HELP axon_test_jitter_seconds Jitter\n"
+            "# TYPE axon_test_jitter_seconds histogram\n"
+            "axon_test_jitter_seconds_bucket{board=\"can0\",le=\"1e-05\"} 4\n"
+            "axon_test_jitter_seconds_bucket{board=\"can0\",le=\"0.0001\"} 6\n"
+            "axon_test_jitter_seconds_bucket{board=\"can0\",le=\"+Inf\"} 7\n"
+            "axon_test_jitter_seconds_sum{board=\"can0\"} 0.25\n"
+            "axon_test_jitter_seconds_count{board=\"can0\"} 7\n");
 }
 
 }  // namespace

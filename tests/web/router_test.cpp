@@ -22,7 +22,9 @@ class RouterTest : public ::testing::Test {
     std::ofstream(root_ / "assets" / "js" / "fps.js") << "let x = 1;";
     std::ofstream(root_ / "assets" / ".hidden") << "secret";
     std::ofstream(root_ / "outside.txt") << "outside";
-    router_ = std::make_unique<Router>((root_ / "assets").string());
+    fs::create_directories(root_ / "javascript" / "chart.js");
+    std::ofstream(root_ / "javascript" / "chart.js" / "chart.min.js") << "/* chart */";
+    router_ = std::make_unique<Router>((root_ / "assets").string(), (root_ / "javascript").string());
     source_ = std::make_shared<Source>("fps", "fps: a <test> plane", "fps");
     router_->add(source_);
   }
@@ -88,6 +90,16 @@ TEST_F(RouterTest, NeverReadsOutsideTheAssetsFolder) {
     EXPECT_EQ(r.body.find("outside"), std::string::npos) << target;
     EXPECT_EQ(r.body.find("secret"), std::string::npos) << target;
   }
+}
+
+TEST_F(RouterTest, ServesScriptLibrariesFromTheJavascriptFolderOnly) {
+  const auto r = get("/javascript/chart.js/chart.min.js");
+  EXPECT_EQ(r.status, 200);
+  EXPECT_EQ(r.body, "/* chart */");
+  EXPECT_EQ(r.content_type, "text/javascript; charset=utf-8");
+  EXPECT_EQ(get("/chart.js/chart.min.js").status, 404);  // not an asset
+  for (const char* target : {"/javascript/../outside.txt", "/javascript/../assets/fps.html", "/javascript/", "/javascript/x.js"})
+    EXPECT_EQ(get(target).status, 404) << target;
 }
 
 TEST_F(RouterTest, OnlyGetIsServedAndWsWantsAnUpgrade) {

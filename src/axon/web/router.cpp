@@ -126,7 +126,8 @@ std::string json_quote(std::string_view text) {
   return out + "\"";
 }
 
-Router::Router(std::string assets_dir) : assets_dir_(std::move(assets_dir)) {}
+Router::Router(std::string assets_dir, std::string javascript_dir)
+    : assets_dir_(std::move(assets_dir)), javascript_dir_(std::move(javascript_dir)) {}
 
 void Router::add(std::shared_ptr<Source> source) {
   std::lock_guard lock(mutex_);
@@ -160,7 +161,9 @@ HttpResponse Router::handle(const HttpRequest& request, const ServerStats& stats
   }
   if (path == "/ws") return text_response(426, "/ws is a WebSocket: connect with a WebSocket client\n");
   if (path == "/api" || path.starts_with("/api/")) return api(path);
-  return file(path);
+  constexpr std::string_view kJavascript = "/javascript";
+  if (path.starts_with("/javascript/")) return file(javascript_dir_, path.substr(kJavascript.size()));
+  return file(assets_dir_, path);
 }
 
 std::string Router::metrics(const ServerStats& stats) const {
@@ -226,10 +229,10 @@ HttpResponse Router::api(std::string_view path) const {
   return text_response(404, fmt::format("no such endpoint: {}\n", path));
 }
 
-HttpResponse Router::file(std::string_view path) const {
+HttpResponse Router::file(const std::string& dir, std::string_view path) {
   const std::string rel = safe_relative_path(path);
   if (rel.empty()) return text_response(404, "not found\n");
-  const fs::path full = fs::path(assets_dir_) / rel;
+  const fs::path full = fs::path(dir) / rel;
   std::error_code ec;
   if (!fs::is_regular_file(full, ec)) return text_response(404, fmt::format("not found: {}\n", rel));
   std::ifstream in(full, std::ios::binary);
@@ -266,6 +269,11 @@ std::string query_param(std::string_view target, std::string_view key) {
 std::string ws_message(const Source& source, const Snapshot& snapshot) {
   return fmt::format("{{\"source\":{},\"seq\":{},\"state\":{}}}", json_quote(source.name()), snapshot.sequence,
                      snapshot.state);
+}
+
+std::string default_javascript_dir() {
+  if (const char* env = std::getenv("AXON_JAVASCRIPT_DIR"); env != nullptr && *env != '\0') return env;
+  return "/usr/share/javascript";
 }
 
 std::string default_assets_dir() {

@@ -10,7 +10,10 @@
 //   /metrics                the server's own counters, then every source's metrics (Prometheus text)
 //   /ws                     the WebSocket of live state (the server upgrades; a plain GET gets 426)
 //   /<file>                 a page's file from the assets folder (html, js, css, svg, png, json)
-// A query string is ignored except by /ws. File paths are refused (404) unless every segment is
+//   /javascript/<file>      a script library from the system's javascript folder (Debian's
+//                           libjs-* packages, e.g. /javascript/chart.js/chart.min.js), as Debian's
+//                           web servers alias it; 404 when the package is not installed
+// A query string is ignored except by /ws. File paths (in both folders) are refused (404) unless every segment is
 // letters, digits, '.', '_' or '-' and none starts with a dot, so nothing outside the folder is read.
 #pragma once
 
@@ -50,9 +53,12 @@ struct HttpResponse {
   std::string body;
 };
 
+// Where /javascript/ is read from: $AXON_JAVASCRIPT_DIR, else /usr/share/javascript.
+[[nodiscard]] std::string default_javascript_dir();
+
 class Router {
  public:
-  explicit Router(std::string assets_dir);
+  explicit Router(std::string assets_dir, std::string javascript_dir = default_javascript_dir());
 
   // Thread-safe. A second source of the same name: CoreErrc::invalid_argument (axon::Exception).
   void add(std::shared_ptr<Source> source);
@@ -67,9 +73,10 @@ class Router {
  private:
   [[nodiscard]] HttpResponse index() const;
   [[nodiscard]] HttpResponse api(std::string_view path) const;
-  [[nodiscard]] HttpResponse file(std::string_view path) const;
+  [[nodiscard]] static HttpResponse file(const std::string& dir, std::string_view path);
 
   std::string assets_dir_;
+  std::string javascript_dir_;
   mutable std::mutex mutex_;
   std::vector<std::shared_ptr<Source>> sources_;
 };

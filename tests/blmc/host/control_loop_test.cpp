@@ -66,6 +66,24 @@ TEST(BlmcControlLoop, CycleSendsSafeCurrentsAndRecords) {
   EXPECT_FALSE(loop.faulted());
 }
 
+// The records carry the overruns so far, for a watcher that sees only them (web::BlmcView).
+TEST(BlmcControlLoop, RecordsCountTheOverrunsSoFar) {
+  core::ManualClock clock;
+  CyclicPort port(64);
+  Constant ctl;
+  ControlLoop loop({&port}, ctl, {SafetyLimits{}}, {}, clock);
+  const auto start = clock.now();
+  loop.step(start, clock.now());
+  clock.advance(3ms);  // the second cycle, due 1 ms after the first, ends after its successor's deadline
+  loop.step(start + 1ms, clock.now());
+  CycleRecord first, second;
+  ASSERT_TRUE(loop.pop_record(first));
+  ASSERT_TRUE(loop.pop_record(second));
+  EXPECT_EQ(first.overruns, 0u);
+  EXPECT_EQ(second.overruns, 1u);
+  EXPECT_EQ(loop.overruns(), 1u);
+}
+
 TEST(BlmcControlLoop, TimingBookkeepingWithAManualClock) {
   core::ManualClock clock;
   CyclicPort port(64);

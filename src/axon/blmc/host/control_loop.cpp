@@ -143,6 +143,7 @@ void ControlLoop::step(core::TimePoint deadline, core::TimePoint now) noexcept {
   const auto end = clock_->now();
   rec.compute = end - now;
   timing_.cycle_finished(end, deadline + options_.period);
+  rec.overruns = timing_.overruns();
   if (!records_.push(rec)) dropped_.fetch_add(1, std::memory_order_relaxed);
   cycles_.store(timing_.cycles(), std::memory_order_relaxed);
   overruns_.store(timing_.overruns(), std::memory_order_relaxed);

@@ -107,6 +107,7 @@ struct CycleRecord {
   core::TimePoint start{};
   core::Duration period{0};
   core::Duration compute{0};  // previous cycle's start to end
+  std::uint64_t overruns = 0;  // overruns so far, this cycle's included (LoopStats::overruns)
   std::uint8_t boards = 0;
   std::array<PerBoard, kMaxBoards> board{};
 };
