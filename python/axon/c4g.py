@@ -36,8 +36,9 @@ from ._axon.c4g import (
 def open_program(mode, *, arm=1, wait_s=10.0, delay_s=0.2, type="A"):
     """A robot program for SimulatedController (YAML text): drive on, open mode `mode` on `arm`,
     wait for the PC to end it (at most wait_s), pause delay_s, end the exchange (504)."""
+    delay = f"  - delay: {delay_s}\n" if delay_s > 0 else ""
     return (f"steps:\n  - drive_on\n  - go_open: {{type: {type}, mode: {mode}, arms: [{arm}]}}\n"
-            f"  - wait_for_pc: {{timeout: {wait_s}}}\n  - delay: {delay_s}\n  - exit_open\n")
+            f"  - wait_for_pc: {{timeout: {wait_s}}}\n{delay}  - exit_open\n")
 
 
 __all__ = [name for name in dir() if not name.startswith("_")]

@@ -187,9 +187,9 @@ TEST(StreamApp, LeavingTheModeDuringTheTrajectoryIsAnError) {
 }
 
 TEST(StreamApp, PerCycleTablePlaysOneRowEachCycleWhateverThePeriod) {
-  // 11 rows, axis 1 up 1 deg a row: with per_cycle, row k is the target of cycle k (2 ms here).
+  // 11 rows, axis 1 up 0.1 deg a row: with per_cycle, row k is the target of cycle k (2 ms here).
   std::vector<double> values(11 * 6, 0.0);
-  for (std::size_t k = 0; k < 11; ++k) values[k * 6] = static_cast<double>(k);
+  for (std::size_t k = 0; k < 11; ++k) values[k * 6] = 0.1 * static_cast<double>(k);
   auto o = options(4, std::make_shared<Trajectory>(Trajectory::from_table(values, 6, 1.0, AngleUnit::deg).value()));
   o.per_cycle = true;
   StreamApp app(o);
@@ -199,17 +199,17 @@ TEST(StreamApp, PerCycleTablePlaysOneRowEachCycleWhateverThePeriod) {
   h.place_at_link({0, 0, 0, 0, 0, 0});
   h.set_modes(code(Mode::mode4));
   h.run(app);  // row 1 goes out at the start (as in Mode4StreamsAbsoluteMotorTargetsThenExits)
-  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(1 * kDeg), 1e-4);
+  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(0.1 * kDeg), 1e-4);
   for (int k = 0; k < 4; ++k) h.run(app);
-  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(5 * kDeg), 1e-4);
+  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(0.5 * kDeg), 1e-4);
   run_until_exit(app, h);
-  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(10 * kDeg), 1e-4);
+  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(1.0 * kDeg), 1e-4);
   EXPECT_FALSE(app.has_error());
 }
 
 TEST(StreamApp, MadeByNameFromATrajectoryInMemory) {
   std::vector<double> values(11 * 6, 0.0);
-  for (std::size_t k = 0; k < 11; ++k) values[k * 6] = static_cast<double>(k);
+  for (std::size_t k = 0; k < 11; ++k) values[k * 6] = 0.1 * static_cast<double>(k);
   AppConfig c;
   c.app = "stream";
   c.trajectory = std::make_shared<Trajectory>(Trajectory::from_table(values, 6, 1.0, AngleUnit::deg).value());

@@ -81,7 +81,7 @@ TEST(Trajectory, FromATableOfRowsAStepApart) {
 
 TEST(Trajectory, FromATableRefusesPartialRowsBadStepsAndNonFiniteValues) {
   const std::array<double, 5> five{0, 1, 2, 3, 4};
-  auto detail = [](const Result<Trajectory>& r) { return r ? std::string("made") : r.error().detail; };
+  auto detail = [](const axon::Result<Trajectory>& r) { return r ? std::string("made") : r.error().detail; };
   EXPECT_EQ(detail(Trajectory::from_table(five, 2, 1.0)),
             "trajectory: 5 values do not make whole rows of 2 axes (at least one row and one axis)");
   EXPECT_EQ(detail(Trajectory::from_table({}, 2, 1.0)),
