@@ -1,5 +1,5 @@
-"""axon from Python: fiber positioner arrays (axon.fps), motor driver boards (axon.blmc) and CAN
-buses (axon.can).
+"""axon from Python: fiber positioner arrays (axon.fps), motor driver boards (axon.blmc), robot
+controllers' open interface (axon.c4g) and CAN buses (axon.can).
 
 The work is done by axon's C++ libraries (the extension axon._axon); this package re-exports it
 with Python names. Every blocking call releases the GIL and answers Ctrl-C (KeyboardInterrupt)
@@ -18,7 +18,7 @@ from ._axon import (
 
 __version__ = _axon.__version__
 
-from . import blmc, can, fps  # noqa: E402  (after the names they use)
+from . import blmc, c4g, can, fps  # noqa: E402  (after the names they use)
 
 __all__ = [
     "Cancelled",
@@ -29,6 +29,7 @@ __all__ = [
     "TimeoutError",
     "__version__",
     "blmc",
+    "c4g",
     "can",
     "fps",
 ]

@@ -14,11 +14,12 @@ namespace axon::python {
 
 namespace py = pybind11;
 
-void bind_errors(py::module_& m, py::module_& can, py::module_& fps, py::module_& blmc);
+void bind_errors(py::module_& m, py::module_& can, py::module_& fps, py::module_& blmc, py::module_& c4g);
 void bind_can(py::module_& m);
 void bind_fps_plan(py::module_& m);
 void bind_fps_client(py::module_& m);
 void bind_blmc(py::module_& m);
+void bind_c4g(py::module_& m);
 
 // How often a blocking call looks for Ctrl-C.
 inline constexpr auto kSignalPoll = std::chrono::milliseconds(50);

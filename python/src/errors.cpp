@@ -7,6 +7,7 @@
 
 #include "axon/blmc/host/error.hpp"
 #include "axon/blmc/protocol/error.hpp"
+#include "axon/c4g/protocol/error.hpp"
 #include "axon/can/error.hpp"
 #include "axon/core/error.hpp"
 #include "axon/fps/host/error.hpp"
@@ -186,13 +187,21 @@ void bind_blmc_errors(py::module_& blmc, const Common& k) {
   map_codes({HostErrc::homing_failed}, make_class(blmc, "HomingFailed", {error}, "No encoder index found."));
 }
 
+void bind_c4g_errors(py::module_& c4g) {
+  // Settings and trajectories the caller got wrong are axon.InvalidArgument (CoreErrc), a port in
+  // use axon.ConnectionError (NetErrc); what is c4g's own is the protocol's.
+  map_category(c4g::protocol::ProtocolErrc::wrong_size,
+               make_class(c4g, "Error", {classes().base}, "A C4G open-interface error: a datagram or initialization packet that does not decode."));
+}
+
 }  // namespace
 
-void bind_errors(py::module_& m, py::module_& can, py::module_& fps, py::module_& blmc) {
+void bind_errors(py::module_& m, py::module_& can, py::module_& fps, py::module_& blmc, py::module_& c4g) {
   const Common k = bind_common(m);
   bind_can_errors(can, k);
   bind_fps_errors(fps, k);
   bind_blmc_errors(blmc, k);
+  bind_c4g_errors(c4g);
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

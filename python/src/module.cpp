@@ -8,9 +8,11 @@ PYBIND11_MODULE(_axon, m) {
   auto can = m.def_submodule("can", "CAN buses, frames and candump logs");
   auto fps = m.def_submodule("fps", "fiber positioner arrays: layouts, planner, client, simulated plane");
   auto blmc = m.def_submodule("blmc", "motor driver boards: enable, measurements, a Python front end to the 1 kHz loop, simulated board");
-  axon::python::bind_errors(m, can, fps, blmc);
+  auto c4g = m.def_submodule("c4g", "robot controllers' open interface: the server with its applications, cycle statistics, simulated controller");
+  axon::python::bind_errors(m, can, fps, blmc, c4g);
   axon::python::bind_can(can);
   axon::python::bind_fps_plan(fps);
   axon::python::bind_fps_client(fps);
   axon::python::bind_blmc(blmc);
+  axon::python::bind_c4g(c4g);
 }

@@ -1,5 +1,7 @@
 #include "axon/c4g/apps/stream.hpp"
 
+#include "axon/c4g/apps/app_factory.hpp"
+
 #include "harness.hpp"
 
 #include <cmath>
@@ -182,4 +184,47 @@ TEST(StreamApp, LeavingTheModeDuringTheTrajectoryIsAnError) {
   h.run(app);
   EXPECT_EQ(app.phase(), Phase::refused);
   EXPECT_NE(app.error().find("left mode 4"), std::string::npos) << app.error();
+}
+
+TEST(StreamApp, PerCycleTablePlaysOneRowEachCycleWhateverThePeriod) {
+  // 11 rows, axis 1 up 0.1 deg a row: with per_cycle, row k is the target of cycle k (2 ms here).
+  std::vector<double> values(11 * 6, 0.0);
+  for (std::size_t k = 0; k < 11; ++k) values[k * 6] = 0.1 * static_cast<double>(k);
+  auto o = options(4, std::make_shared<Trajectory>(Trajectory::from_table(values, 6, 1.0, AngleUnit::deg).value()));
+  o.per_cycle = true;
+  StreamApp app(o);
+  Harness h;
+  h.start(app);
+  EXPECT_EQ(app.table_rows(), 11u);  // not 11 / 0.002 rows: the clock counts cycles
+  h.place_at_link({0, 0, 0, 0, 0, 0});
+  h.set_modes(code(Mode::mode4));
+  h.run(app);  // row 1 goes out at the start (as in Mode4StreamsAbsoluteMotorTargetsThenExits)
+  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(0.1 * kDeg), 1e-4);
+  for (int k = 0; k < 4; ++k) h.run(app);
+  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(0.5 * kDeg), 1e-4);
+  run_until_exit(app, h);
+  EXPECT_NEAR(h.rep.axes[0].d1, h.motor_axis1(1.0 * kDeg), 1e-4);
+  EXPECT_FALSE(app.has_error());
+}
+
+TEST(StreamApp, MadeByNameFromATrajectoryInMemory) {
+  std::vector<double> values(11 * 6, 0.0);
+  for (std::size_t k = 0; k < 11; ++k) values[k * 6] = 0.1 * static_cast<double>(k);
+  AppConfig c;
+  c.app = "stream";
+  c.trajectory = std::make_shared<Trajectory>(Trajectory::from_table(values, 6, 1.0, AngleUnit::deg).value());
+  c.per_cycle = true;
+  auto app = make_app(c);
+  ASSERT_EQ(app->name(), "stream");
+  Harness h;
+  h.start(*app);
+  EXPECT_EQ(static_cast<StreamApp&>(*app).table_rows(), 11u);  // per_cycle reached the app
+  c.file = "trajectory.csv";
+  try {
+    make_app(c);
+    ADD_FAILURE() << "a trajectory and a file were both taken";
+  } catch (const axon::Exception& e) {
+    EXPECT_EQ(e.error().code, axon::CoreErrc::invalid_argument);
+    EXPECT_EQ(e.error().detail, "give a trajectory or --file/--segment, not both");
+  }
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <limits>
 #include <numbers>
 
 using namespace axon::c4g::apps;
@@ -65,4 +66,30 @@ TEST(Trajectory, LoadReportsAMissingFile) {
   auto r = Trajectory::load("/nonexistent/traj.csv");
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().detail.find("/nonexistent/traj.csv"), std::string::npos);
+}
+
+TEST(Trajectory, FromATableOfRowsAStepApart) {
+  const std::array<double, 6> values{0, 90, 10, 90, 20, -90};  // 3 rows x 2 axes, degrees
+  const auto t = Trajectory::from_table(values, 2, 0.5, AngleUnit::deg).value();
+  EXPECT_EQ(t.axes(), 2u);
+  EXPECT_EQ(t.rows(), 3u);
+  EXPECT_DOUBLE_EQ(t.time(2), 1.0);
+  EXPECT_NEAR(t.value(1, 0), 10 * std::numbers::pi / 180, 1e-12);
+  EXPECT_NEAR(t.value(2, 1), -std::numbers::pi / 2, 1e-12);
+  EXPECT_DOUBLE_EQ(Trajectory::from_table(values, 3, 1.0).value().value(1, 2), -90);  // radians as given
+}
+
+TEST(Trajectory, FromATableRefusesPartialRowsBadStepsAndNonFiniteValues) {
+  const std::array<double, 5> five{0, 1, 2, 3, 4};
+  auto detail = [](const axon::Result<Trajectory>& r) { return r ? std::string("made") : r.error().detail; };
+  EXPECT_EQ(detail(Trajectory::from_table(five, 2, 1.0)),
+            "trajectory: 5 values do not make whole rows of 2 axes (at least one row and one axis)");
+  EXPECT_EQ(detail(Trajectory::from_table({}, 2, 1.0)),
+            "trajectory: 0 values do not make whole rows of 2 axes (at least one row and one axis)");
+  EXPECT_EQ(detail(Trajectory::from_table(five, 0, 1.0)),
+            "trajectory: 5 values do not make whole rows of 0 axes (at least one row and one axis)");
+  EXPECT_EQ(detail(Trajectory::from_table(five, 5, 0.0)), "trajectory: the step between rows must be > 0, got 0");
+  const std::array<double, 4> nan{0, 1, std::numeric_limits<double>::quiet_NaN(), 3};
+  EXPECT_EQ(detail(Trajectory::from_table(nan, 2, 1.0)), "trajectory: row 1 axis 1 is not a finite number");
+  EXPECT_EQ(Trajectory::from_table(nan, 2, 1.0).error().code, axon::CoreErrc::invalid_argument);
 }

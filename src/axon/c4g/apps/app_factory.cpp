@@ -53,7 +53,10 @@ StreamOptions stream_options(const AppConfig& c, const std::string& file) {
   const auto unit = unit_of(c);
   StreamOptions s;
   if (!file.empty() && !c.segments.empty()) throw bad("give --file or --segment, not both");
+  if (c.trajectory && (!file.empty() || !c.segments.empty())) throw bad("give a trajectory or --file/--segment, not both");
   if (!file.empty()) s.trajectory = std::make_shared<Trajectory>(Trajectory::load(file, unit).value());
+  if (c.trajectory) s.trajectory = c.trajectory;
+  s.per_cycle = c.per_cycle;
   for (const auto& spec : c.segments) s.segments.push_back(parse_segment(spec, unit));
   s.mode = c.mode;
   s.arm = c.arm;
@@ -115,7 +118,7 @@ std::unique_ptr<App> make_handover(const AppConfig& c, const std::function<void(
   HandoverOptions h;
   h.arm = c.arm;
   h.hold_s = c.open_time_s > 0 ? c.open_time_s : 0.5;
-  if (!c.file.empty() || !c.segments.empty()) h.stream = stream_options(c, c.file);
+  if (!c.file.empty() || !c.segments.empty() || c.trajectory) h.stream = stream_options(c, c.file);
   if (!c.correct_file.empty() || !c.feed.empty() || !c.amplitude.empty()) {
     h.correct = correct_options(c, c.correct_file, say);
     if (h.correct->open_time_s <= 0 && !h.correct->values) h.correct->open_time_s = h.hold_s;
@@ -130,7 +133,8 @@ std::unique_ptr<App> make_app(const AppConfig& c, const std::function<void(const
   if (c.app == "monitor") return std::make_unique<MonitorApp>();
   if (c.app == "echo") return std::make_unique<EchoApp>();
   if (c.app == "stream") {
-    if (c.file.empty() && c.segments.empty()) throw bad("--app stream needs --file TRAJECTORY.csv or --segment N=FILE.csv");
+    if (c.file.empty() && c.segments.empty() && !c.trajectory)
+      throw bad("--app stream needs --file TRAJECTORY.csv or --segment N=FILE.csv");
     if (c.mode != 4 && c.mode != 5) throw bad("--app stream: --mode must be 4 or 5");
     auto s = stream_options(c, c.file);
     s.rearm = c.rearm;

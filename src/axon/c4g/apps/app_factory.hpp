@@ -10,6 +10,7 @@
 
 #include "axon/c4g/apps/app.hpp"
 #include "axon/c4g/apps/correction_limits.hpp"
+#include "axon/c4g/apps/trajectory.hpp"
 
 #include <functional>
 #include <memory>
@@ -22,6 +23,10 @@ struct AppConfig {
   std::string app;  // monitor, echo, stream, correct, pid, handover, contribute
   // stream / correct / handover
   std::string file;                   // stream: trajectory CSV; correct: correction values CSV
+  // stream: a trajectory already in memory (a table from a binding) instead of `file`; per_cycle:
+  // its clock counts controller cycles (StreamOptions::per_cycle).
+  std::shared_ptr<const Trajectory> trajectory;
+  bool per_cycle = false;
   std::string correct_file;           // handover: correction values CSV for mode 7
   std::vector<std::string> segments;  // stream/handover: MOTION_TYPE=FILE.csv
   int mode = 4;                       // stream: 4 or 5; contribute: 8 or 9

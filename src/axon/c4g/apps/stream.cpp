@@ -64,13 +64,14 @@ bool StreamApp::build(const Trajectory& traj, std::vector<double>& table, std::s
     return false;
   }
   const double period = view_->period_s;
-  rows = static_cast<std::size_t>(std::floor(traj.duration() / period + 1e-9)) + 1;
-  if (traj.start_time() + static_cast<double>(rows - 1) * period < traj.end_time() - 1e-12) ++rows;  // end exactly
+  const double step = options_.per_cycle ? 1.0 : period;  // one cycle on the trajectory's clock
+  rows = static_cast<std::size_t>(std::floor(traj.duration() / step + 1e-9)) + 1;
+  if (traj.start_time() + static_cast<double>(rows - 1) * step < traj.end_time() - 1e-12) ++rows;  // end exactly
   table.assign(rows * n, 0.0);
   std::vector<double> pos(n), vel(n);
   protocol::ArmTransform::Vector link(static_cast<Eigen::Index>(n));
   for (std::size_t k = 0; k < rows; ++k) {
-    const double t = std::min(traj.start_time() + static_cast<double>(k) * period, traj.end_time());
+    const double t = std::min(traj.start_time() + static_cast<double>(k) * step, traj.end_time());
     traj.sample(t, pos, vel);
     for (std::size_t j = 0; j < n; ++j) link[static_cast<Eigen::Index>(j)] = pos[j];
     const auto motor = view_->transform.motor_velocity(link);  // the linear part K_r q / 2 pi
@@ -79,11 +80,11 @@ bool StreamApp::build(const Trajectory& traj, std::vector<double>& table, std::s
   const double max_step = options_.max_motor_speed * period;
   for (std::size_t k = 1; k < rows; ++k)
     for (std::size_t j = 0; j < n; ++j) {
-      const double step = std::fabs(table[k * n + j] - table[(k - 1) * n + j]);
-      if (step > max_step) {
+      const double jump = std::fabs(table[k * n + j] - table[(k - 1) * n + j]);
+      if (jump > max_step) {
         fail("stream: the trajectory is not continuous: axis %zu moves %.4f motor turns in one cycle at t=%.3f s "
              "(limit %.4f = %.1f turns/s x %.4f s)",
-             j + 1, step, traj.start_time() + static_cast<double>(k) * period, max_step, options_.max_motor_speed, period);
+             j + 1, jump, (traj.start_time() / step + static_cast<double>(k)) * period, max_step, options_.max_motor_speed, period);
         return false;
       }
     }

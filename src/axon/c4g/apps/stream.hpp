@@ -53,6 +53,9 @@ struct StreamOptions {
   int mode = 4;  // 4 or 5
   std::size_t arm = 1;
   bool relative = false;
+  // The trajectories' clock counts controller cycles, not seconds: row k of a table one step apart
+  // (Trajectory::from_table with row_step 1) is played at cycle k, whatever the controller's period.
+  bool per_cycle = false;
   double start_tolerance_rad = 0.5 * std::numbers::pi / 180.0;
   double max_motor_speed = 100.0;  // [motor turns/s] continuity limit
   double hold_s = 0.1;

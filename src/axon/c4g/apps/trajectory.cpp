@@ -113,6 +113,29 @@ Result<Trajectory> Trajectory::from_rows(std::vector<double> times, std::vector<
   return t;
 }
 
+Result<Trajectory> Trajectory::from_table(std::span<const double> values, std::size_t axes, double row_step, AngleUnit unit) {
+  if (axes == 0 || values.empty() || values.size() % axes != 0)
+    return Error(CoreErrc::invalid_argument,
+                 fmt::format("trajectory: {} values do not make whole rows of {} axes (at least one row and one axis)",
+                             values.size(), axes));
+  if (!std::isfinite(row_step) || row_step <= 0)
+    return Error(CoreErrc::invalid_argument, fmt::format("trajectory: the step between rows must be > 0, got {}", row_step));
+  Trajectory t;
+  t.axes_ = axes;
+  t.unit_ = unit;
+  const double scale = unit == AngleUnit::deg ? std::numbers::pi / 180.0 : 1.0;
+  const std::size_t rows = values.size() / axes;
+  t.values_.reserve(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i]))
+      return Error(CoreErrc::invalid_argument, fmt::format("trajectory: row {} axis {} is not a finite number", i / axes, i % axes + 1));
+    t.values_.push_back(values[i] * scale);
+  }
+  t.times_.reserve(rows);
+  for (std::size_t r = 0; r < rows; ++r) t.times_.push_back(static_cast<double>(r) * row_step);
+  return t;
+}
+
 void Trajectory::sample(double t, std::span<double> position, std::span<double> velocity) const noexcept {
   const std::size_t n = std::min({axes_, position.size(), velocity.size()});
   if (t <= times_.front() || times_.size() == 1) {

@@ -37,6 +37,12 @@ class Trajectory {
   static Result<Trajectory> load(const std::string& path, std::optional<AngleUnit> unit = std::nullopt);
   // From values already in radians (tests, generated corrections). times strictly increasing.
   static Result<Trajectory> from_rows(std::vector<double> times, std::vector<std::vector<double>> rows_rad);
+  // From a row-major table of rows x `axes` values (a numpy array's buffer, one row per sample),
+  // the rows `row_step` apart on the trajectory's clock from 0 (seconds, or cycles: see
+  // StreamOptions::per_cycle), angles in `unit`. At least one row and one axis, every value finite,
+  // row_step finite and > 0; CoreErrc::invalid_argument saying which otherwise.
+  static Result<Trajectory> from_table(std::span<const double> values, std::size_t axes, double row_step,
+                                       AngleUnit unit = AngleUnit::rad);
 
   [[nodiscard]] std::size_t axes() const noexcept { return axes_; }
   [[nodiscard]] std::size_t rows() const noexcept { return times_.size(); }
