@@ -73,6 +73,7 @@ Result<void> TrajectoryChecker::check(std::span<const RobotTrajectory> trajector
   double start = std::numeric_limits<double>::infinity();
   double end = -std::numeric_limits<double>::infinity();
   double point_speed = 0;  // mm/s
+  speed_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const RobotTrajectory& t = trajectories[i];
     if (auto v = validate(t); !v)
@@ -80,8 +81,8 @@ Result<void> TrajectoryChecker::check(std::span<const RobotTrajectory> trajector
     start = std::min({start, t.alpha.front().t_s, t.beta.front().t_s});
     end = std::max({end, t.alpha.back().t_s, t.beta.back().t_s});
     const Positioner& p = m.robot(i);
-    point_speed = std::max(point_speed, max_speed(t.alpha) * kRad * p.reach_mm() +
-                                            max_speed(t.beta) * kRad * p.collision_length_mm());
+    speed_[i] = max_speed(t.alpha) * kRad * p.reach_mm() + max_speed(t.beta) * kRad * p.collision_length_mm();
+    point_speed = std::max(point_speed, speed_[i]);
   }
   if (n == 0) start = end = 0;
 
@@ -126,7 +127,7 @@ Result<void> TrajectoryChecker::check(std::span<const RobotTrajectory> trajector
     for (std::size_t p = 0; p < out.obstacle_pairs.size(); ++p)
       merge(out.obstacle_pairs[p], workers_[k].obstacle_pairs[p]);
   }
-  auto standing = [&](std::size_t i) { return max_speed(trajectories[i].alpha) == 0 && max_speed(trajectories[i].beta) == 0; };
+  auto standing = [&](std::size_t i) { return speed_[i] == 0; };
   for (std::size_t p = 0; p < out.robot_pairs.size(); ++p)
     out.robot_pairs[p].standing = standing(m.robot_pairs()[p].a) && standing(m.robot_pairs()[p].b);
   for (std::size_t p = 0; p < out.obstacle_pairs.size(); ++p) out.obstacle_pairs[p].standing = standing(m.obstacle_pairs()[p].robot);
@@ -152,12 +153,7 @@ void TrajectoryChecker::run(Worker& w, std::span<const RobotTrajectory> trajecto
   w.segs.resize(n);
   w.mid.resize(n);
   w.half.resize(n);
-  w.speed.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Positioner& r = m.robot(i);
-    w.half[i] = 0.5 * r.collision_length_mm();
-    w.speed[i] = max_speed(trajectories[i].alpha) * kRad * r.reach_mm() + max_speed(trajectories[i].beta) * kRad * r.collision_length_mm();
-  }
+  for (std::size_t i = 0; i < n; ++i) w.half[i] = 0.5 * m.robot(i).collision_length_mm();
   w.alpha.resize(n);
   w.beta.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -199,7 +195,7 @@ void TrajectoryChecker::run(Worker& w, std::span<const RobotTrajectory> trajecto
       // the bound kept for the next interval.
       const RobotPair& p = rp[k];
       PairOutcome& o = w.robot_pairs[k];
-      const double rate = w.speed[p.a] + w.speed[p.b];
+      const double rate = speed_[p.a] + speed_[p.b];
       const double reach = w.half[p.a] + w.half[p.b] + p.limit_mm;
       const double need = std::max(rate * dt, o.min_clearance_mm);
       double& prev = w.prev_robot[k];
@@ -227,7 +223,7 @@ void TrajectoryChecker::run(Worker& w, std::span<const RobotTrajectory> trajecto
         double& prev = w.prev_obstacle[k];
         if (s > begin)
           certify(o, [&](double tm) { return segment_distance(segment_at(p.robot, tm), shape_k) - p.limit_mm; },
-                  w.speed[p.robot], t_prev, prev, t, c, 0, w.halvings);
+                  speed_[p.robot], t_prev, prev, t, c, 0, w.halvings);
         prev = c;
       }
     t_prev = t;

@@ -88,7 +88,6 @@ class TrajectoryChecker {
     std::vector<Segment> segs;
     std::vector<Vec2> mid;      // segment midpoints
     std::vector<double> half;   // half the segment lengths
-    std::vector<double> speed;  // fastest point speed of each robot's segment, mm/s
     std::vector<double> prev_robot, prev_obstacle;  // per pair: clearance (or a lower bound) at the last sample
     std::size_t halvings = 0;
     std::vector<AngleCursor> alpha, beta;
@@ -98,6 +97,7 @@ class TrajectoryChecker {
            const CheckReport& shape, bool obstacles) const;
 
   const CollisionModel* model_;
+  std::vector<double> speed_;  // per robot: fastest point speed of its segment in this move, mm/s
   std::vector<Worker> workers_;
 };
 

@@ -165,6 +165,14 @@ class RobotGrid {
   bool exhausted_ = false;
 };
 
+// Appends robot i's fixed obstacles, each with its pair's limit.
+void add_obstacles(const CollisionModel& model, std::size_t i, std::vector<Fixed>& fixed) {
+  for (const std::uint32_t k : model.obstacle_pairs_of(i)) {
+    const ObstaclePair& p = model.obstacle_pairs()[k];
+    fixed.push_back({model.obstacles()[p.obstacle].shape, p.limit_mm});
+  }
+}
+
 // A way to a fold and the time of each of its steps.
 struct GridPath {
   std::vector<Pose> poses;  // empty: none found
@@ -226,8 +234,6 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
   std::vector<Segment> segs(n);
   model.segments(poses, segs);
   const auto all_pairs = model.robot_pairs();
-  const auto obstacles = model.obstacles();
-  const auto opairs = model.obstacle_pairs();
   std::size_t done = 0;
   std::vector<bool> moving(n, false);
   for (bool progress = true; progress && !stuck.empty();) {
@@ -248,8 +254,7 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
         continue;
       }
       for (std::size_t k = 0; k < nb.size(); ++k) fixed.push_back({segs[nb[k]], all_pairs[pairs[k]].limit_mm});
-      for (const std::uint32_t k : model.obstacle_pairs_of(i))
-        fixed.push_back({obstacles[opairs[k].obstacle].shape, opairs[k].limit_mm});
+      add_obstacles(model, i, fixed);
       const double fold = robots[i].goal.beta_deg;
       GridPath path = find_fold(model.robot(i), fixed, poses[i], fold, o, max_cells);
       if (path.poses.empty() && !std::any_of(moving.begin(), moving.end(), [](bool b) { return b; })) {
@@ -283,8 +288,7 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
           const auto pj = model.pairs_of(j);
           for (std::size_t k = 0; k < nbj.size(); ++k)
             if (!folded(nbj[k])) fj.push_back({segs[nbj[k]], all_pairs[pj[k]].limit_mm});
-          for (const std::uint32_t k : model.obstacle_pairs_of(j))
-            fj.push_back({obstacles[opairs[k].obstacle].shape, opairs[k].limit_mm});
+          add_obstacles(model, j, fj);
           RobotGrid gj(rj, std::move(fj), poses[j], o.alpha_step_deg, o.beta_step_deg, o.margin_mm);
           // How far it can turn either way (the unfolded robots, often this one, may stop it);
           // the best alpha within that range.
@@ -312,8 +316,7 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
           std::vector<Segment> segs2 = segs;
           for (const auto& [j, w] : turns) segs2[j] = model.robot(j).collision_segment(w.back());
           for (std::size_t k = 0; k < nb.size(); ++k) fixed2.push_back({segs2[nb[k]], all_pairs[pairs[k]].limit_mm});
-          for (const std::uint32_t k : model.obstacle_pairs_of(i))
-            fixed2.push_back({obstacles[opairs[k].obstacle].shape, opairs[k].limit_mm});
+          add_obstacles(model, i, fixed2);
           path = find_fold(model.robot(i), fixed2, poses[i], fold, o, max_cells);
           if (!path.poses.empty()) {
             for (const auto& [j, w] : turns) {
@@ -349,20 +352,10 @@ std::size_t untangle_to_fold(const CollisionModel& model, std::span<const Steppe
   return done;
 }
 
-}  // namespace axon::fps::plan
-
-namespace axon::fps::plan {
-
 std::vector<std::string> fold_blocked_by_obstacles(const CollisionModel& model, std::size_t i, Pose from, double fold_beta,
                                                    const StepperOptions& o, std::size_t max_cells) {
-  const auto obstacles = model.obstacles();
-  const auto opairs = model.obstacle_pairs();
   std::vector<Fixed> fixed;
-  std::vector<std::string> around;
-  for (const std::uint32_t k : model.obstacle_pairs_of(i)) {
-    fixed.push_back({obstacles[opairs[k].obstacle].shape, opairs[k].limit_mm});
-    around.push_back(obstacles[opairs[k].obstacle].name);
-  }
+  add_obstacles(model, i, fixed);
   if (fixed.empty()) return {};
   const Positioner& r = model.robot(i);
   // Most robots fold straight (beta alone): no search needed.
@@ -373,6 +366,9 @@ std::vector<std::string> fold_blocked_by_obstacles(const CollisionModel& model, 
     RobotGrid g(r, fixed, from, o.alpha_step_deg * f, o.beta_step_deg * f, margin);
     if (!g.search(fold_beta, max_cells, true).empty() || !g.exhausted()) return {};  // a way out, or undecided
   }
+  std::vector<std::string> around;
+  for (const std::uint32_t k : model.obstacle_pairs_of(i))
+    around.push_back(model.obstacles()[model.obstacle_pairs()[k].obstacle].name);
   return around;
 }
 
