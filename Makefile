@@ -24,12 +24,13 @@ debug: deps
 run: release
 	./build/release/axon demo
 
+# On failure, scripts/test-failures.sh repeats what each failed test said as the last lines.
 test: release
-	ctest --preset release -j $(JOBS) -LE soak
+	ctest --preset release -j $(JOBS) -LE soak || { bash scripts/test-failures.sh build/release; exit 1; }
 
 # The one-minute soaks (ctest label soak), one at a time: what CI runs after `make test`.
 test-soak: release
-	ctest --preset release -L soak
+	ctest --preset release -L soak || { bash scripts/test-failures.sh build/release; exit 1; }
 
 bench: release
 	@bash bench/run-all.sh build/release
@@ -47,14 +48,14 @@ asan: deps
 	@cmake --build --preset asan -j $(JOBS) --target axon_unit_tests_all axon_fuzz_all
 
 test-asan: asan
-	ctest --preset asan -j $(JOBS) -L unit
+	ctest --preset asan -j $(JOBS) -L unit || { bash scripts/test-failures.sh build/asan; exit 1; }
 
 tsan: deps
 	@cmake --preset tsan $(CMAKE_EXTRA) >/dev/null
 	@cmake --build --preset tsan -j $(JOBS) --target axon_unit_tests_all
 
 test-tsan: tsan
-	ctest --preset tsan -j $(JOBS) -L unit
+	ctest --preset tsan -j $(JOBS) -L unit || { bash scripts/test-failures.sh build/tsan; exit 1; }
 
 fuzz: deps
 	@cmake --preset asan $(CMAKE_EXTRA) >/dev/null

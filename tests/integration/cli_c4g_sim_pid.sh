@@ -6,13 +6,8 @@
 # not wait T1 + T2 + T3 after the switch is caught by the simulator.
 source "$(dirname "$0")/lib.sh"
 skip_without_sim_c4g
-# This test is about soft switching and the loops, and runs beside the rest of the suite: on a
-# loaded machine (load 11 on 2 cores) the server's first cycles after the initialization packet
-# came later than the manual's 500 us ten times in a row (a communication error). The simulator
-# takes the lenient window of a period here; the default stays the manual's.
-run_sim_lenient() { run_sim_c4g "$@" --lenient-timing; }
 start_c4g_serve --app pid --open-time 0.6 --amplitude 0.5 --frequency 1
-run_sim_lenient "steps:
+run_sim_c4g "steps:
   - drive_on
   - go_open: {type: A, mode: 1, arms: [1]}
   - wait_for_pc: {timeout: 10}
@@ -25,7 +20,7 @@ grep -q "pid: done" "$TMP/serve.out" || fail "mode 1: not done"
 grep -q "Safety: none" "$TMP/serve.out" || fail "mode 1: a safety fault"
 
 start_c4g_serve --app pid
-run_sim_lenient "steps:
+run_sim_c4g "steps:
   - drive_on
   - go_open: {type: B, mode: 2, arms: [1]}
   - delay: 0.2
@@ -42,7 +37,7 @@ grep -q "SCS_ROBOT_MOVED" "$TMP/sim.err" && fail "mode 2: the robot moved while 
 
 # Longer intervals on both sides (T1 + T2 + T3 = 0.5 s) and the reducer in the PC.
 start_c4g_serve --app pid --open-time 0.3 --switch-t1-ms 100 --switch-t2-ms 300 --switch-t3-ms 100 --reduce-in-pc
-run_sim_lenient "steps:
+run_sim_c4g "steps:
   - drive_on
   - go_open: {type: A, mode: 1, arms: [1]}
   - wait_for_pc: {timeout: 10}
@@ -56,7 +51,7 @@ grep -q "pid: soft switching: max following error 0.000" "$TMP/serve.out" || fai
 
 # A move right after GO OPEN (no DELAY of T1 + T2 + T3): the simulator stops the robot.
 start_c4g_serve --app pid
-run_sim_lenient "steps:
+run_sim_c4g "steps:
   - drive_on
   - go_open: {type: B, mode: 2, arms: [1]}
   - move: {arm: 1, deg: [5, 0, 0, 0, 0, 0], duration: 0.3}

@@ -87,13 +87,20 @@ start_c4g_serve() {
   C4G_PORT=$(wait_for_line "$TMP/serve.out" '^listening c4g ' | sed 's/.*://')
 }
 # run_sim_c4g SCENARIO_YAML [ARGS...]: runs the six-axis simulator against the server until its
-# scenario ends; SIM_RC holds its exit code.
+# scenario ends; SIM_RC holds its exit code. These tests are about the protocol and the apps, and run
+# beside the rest of the suite (ctest -j): the simulator takes the lenient reply window of one period
+# (--lenient-timing). Under that load the server's replies came later than the manual's 500 us ten
+# times in a row (a communication error; seen in cli_c4g_sim_pid at load 11 on 2 cores and in
+# cli_c4g_sim_timing beside the full suite), which says nothing about the protocol. A missing reply
+# is still a miss, and ten in a row still a communication error. The manual's window itself is
+# tested in-process (tests/c4g/sim/udp_client_test.cpp); C4G_STRICT=1 keeps it here too.
 run_sim_c4g() {
-  local scenario=$1
+  local scenario=$1 window=--lenient-timing
   shift
+  [ "${C4G_STRICT:-0}" = 1 ] && window=
   printf '%s\n' "$scenario" >"$TMP/scenario.yaml"
   SIM_RC=0
-  timeout 60 "$AXON" sim c4g --robot six-axis --server "127.0.0.1:$C4G_PORT" --scenario "$TMP/scenario.yaml" "$@" \
+  timeout 60 "$AXON" sim c4g --robot six-axis --server "127.0.0.1:$C4G_PORT" --scenario "$TMP/scenario.yaml" $window "$@" \
     >"$TMP/sim.out" 2>"$TMP/sim.err" || SIM_RC=$?
 }
 # wait_serve [SECONDS]: waits for the server to exit by itself; SERVE_RC holds its exit code.
