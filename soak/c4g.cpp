@@ -248,12 +248,16 @@ struct Session {
     o.controller.period_ms = 1;
     controller.emplace(c4g::sim::SimulatedController::start(std::move(o)));
   }
-  void stop_controller(Outcome& out) {
-    if (!controller) return;
+  // Stops the controller's program; returns how its session ended ("completed", "communication
+  // error", ...; "" when none ran).
+  std::string stop_controller(Outcome& out) {
+    if (!controller) return {};
     const auto r = controller->stop();
     add(out.ctl, r.stats);
     if (r.outcome == c4g::sim::SimulatedControllerReport::Outcome::communication_error) ++out.comm_errors;
     controller.reset();
+    return r.outcome_text + " after " + std::to_string(r.stats.cyclic_sent) + " cycles, " +
+           std::to_string(r.stats.misses) + " misses";
   }
 };
 
@@ -268,7 +272,8 @@ bool wait_for(F done, Clock::duration limit) {
   return true;
 }
 
-bool restart_controller(Session& s, Outcome& out);
+std::string restart_controller(Session& s, Outcome& out);
+void resumed_or_failed(const std::string& seen, const char* after, Outcome& out);
 
 // A late or wrong application: the server must latch (drive off from then on) and, once reset,
 // call the application again.
@@ -293,26 +298,47 @@ void bad_app(Session& s, Kind kind, Outcome& out) {
     // 30-minute run met this 4 times in 599 faults): started again, as after any dropped session,
     // and that session must resume.
     ++out.dropped_sessions;
-    if (restart_controller(s, out)) ++out.resumed;
-    else out.failures.push_back("the session did not resume after a communication error");
+    resumed_or_failed(restart_controller(s, out), "a communication error", out);
   } else {
     out.failures.push_back("the session did not resume after a reset");
   }
 }
 
-// Starts the controller's program again and waits until the application is called again.
-bool restart_controller(Session& s, Outcome& out) {
-  s.stop_controller(out);
-  const auto inits = s.app.inits.load();
-  const auto calls = s.app.calls.load();
-  s.start_controller();
-  return wait_for([&] { return s.app.inits.load() > inits && s.app.calls.load() > calls + 100; }, 3s);
+// What a restarted session showed when the application was not called again in time.
+std::string not_resumed(const Session& s, std::uint64_t inits, std::uint64_t calls) {
+  const auto& c = s.server->counters();
+  return "initialization packets +" + std::to_string(s.app.inits.load() - inits) + ", application calls +" +
+         std::to_string(s.app.calls.load() - calls) + ", server sessions " + std::to_string(c.sessions.load()) +
+         ", server safety " + std::string(c4g::host::to_string(s.server->safety().reason()));
 }
 
-void controller_restart(Session& s, Outcome& out) {
-  if (restart_controller(s, out)) ++out.resumed;
-  else out.failures.push_back("the session did not resume after a controller restart");
+// Starts the controller's program again and waits until the application is called again; "" when
+// it was, else what was seen. A new session that ends by itself before that (ten misses in a row on
+// a loaded machine) is counted as dropped by load and started once more; one that runs on without
+// the application being called is a failure at once.
+std::string restart_controller(Session& s, Outcome& out) {
+  std::string seen;
+  for (int attempt = 1; attempt <= 2; ++attempt) {
+    s.stop_controller(out);
+    const auto inits = s.app.inits.load();
+    const auto calls = s.app.calls.load();
+    s.start_controller();
+    if (wait_for([&] { return s.app.inits.load() > inits && s.app.calls.load() > calls + 100; }, 3s)) return {};
+    seen += (seen.empty() ? "" : "; ") + std::string("attempt ") + std::to_string(attempt) + ": " + not_resumed(s, inits, calls);
+    if (s.controller->running()) return seen + ", the controller still running";
+    seen += ", the controller's session ended: " + s.stop_controller(out);
+    ++out.dropped_sessions;
+  }
+  return seen;
 }
+
+// Counts a resumed session, or a failure naming the fault and what was seen.
+void resumed_or_failed(const std::string& seen, const char* after, Outcome& out) {
+  if (seen.empty()) ++out.resumed;
+  else out.failures.push_back(std::string("the session did not resume after ") + after + " (" + seen + ")");
+}
+
+void controller_restart(Session& s, Outcome& out) { resumed_or_failed(restart_controller(s, out), "a controller restart", out); }
 
 // The controller ends its session after ten packets without an answer (ERR_C4GOPEN_UDP): a restart
 // of the server longer than that ends it, and its program must be started again.
@@ -336,8 +362,7 @@ void server_restart(Session& s, Outcome& out) {
     return;
   }
   ++out.server_restart_drops;
-  if (restart_controller(s, out)) ++out.resumed;
-  else out.failures.push_back("the session did not resume after a server restart");
+  resumed_or_failed(restart_controller(s, out), "a server restart", out);
 }
 
 // A controller that ended its session by itself (ten misses on a loaded machine) is started again,
@@ -345,7 +370,8 @@ void server_restart(Session& s, Outcome& out) {
 void keep_controller(Session& s, Outcome& out) {
   if (s.controller->running()) return;
   ++out.dropped_sessions;
-  if (!restart_controller(s, out)) out.failures.push_back("the session did not resume after a communication error");
+  const auto seen = restart_controller(s, out);
+  if (!seen.empty()) out.failures.push_back("the session did not resume after a communication error (" + seen + ")");
 }
 
 void summarize(axon::soak::Summary& sum, const Session& s, const Outcome& out) {

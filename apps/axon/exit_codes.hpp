@@ -30,6 +30,15 @@ inline void record_stop_signal(int signo) noexcept {
   received_stop_signal().compare_exchange_strong(none, signo);
 }
 
+// Once a command's work is over (its devices made safe, its report being printed, the process on its
+// way out), a stop signal has nothing left to stop: it is ignored from then on, so that the exit
+// code stays the run's. The default action would kill the process mid-exit (exit 143 for a server
+// whose run ended 0, as a service manager or a script's clean-up signals it). SIGKILL and SIGQUIT
+// still end a clean-up that hangs.
+inline void ignore_late_stop_signals() noexcept {
+  for (int s : kStopSignals) std::signal(s, SIG_IGN);
+}
+
 // "SIGINT (Ctrl-C)", "SIGTERM", "SIGHUP": for messages that say why devices were stopped.
 inline const char* signal_name(int signo) noexcept {
   switch (signo) {

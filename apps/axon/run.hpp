@@ -52,6 +52,11 @@ class SignalHook {
 // event loop. A second signal stops it within kSecondSignalGrace, a third at once. A command ended by a signal exits 128+N (see
 // exit_codes.hpp) unless its normal end is a signal (SignalHook::signal_ends_normally()).
 inline int run_command(const std::function<asio::awaitable<int>(asio::io_context&, SignalHook)>& body) {
+  // Destroyed after `signals` below (whose end restores the default actions): from then on the
+  // command is ending and a stop signal is ignored, on every way out of here.
+  struct LateSignalsIgnored {
+    ~LateSignalsIgnored() { ignore_late_stop_signals(); }
+  } late_signals_ignored;
   asio::io_context io;
   asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);
   std::function<void()> on_signal = [&io] { io.stop(); };

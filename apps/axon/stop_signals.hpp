@@ -2,7 +2,8 @@
 // SIGINT/SIGTERM/SIGHUP for commands whose main thread polls instead of running an io_context (the
 // c4g server and controller simulator: their loops run on plain threads). While a StopSignals object
 // lives, each signal bumps a counter, raises a flag and is recorded (received_stop_signal(), for the
-// exit code 128+N); the destructor restores the default action.
+// exit code 128+N); from the destructor on, stop signals are ignored (the command is ending:
+// ignore_late_stop_signals).
 #include "exit_codes.hpp"
 
 #include <atomic>
@@ -20,9 +21,7 @@ class StopSignals {
     sigemptyset(&sa.sa_mask);
     for (int s : kStopSignals) sigaction(s, &sa, nullptr);
   }
-  ~StopSignals() {
-    for (int s : kStopSignals) std::signal(s, SIG_DFL);
-  }
+  ~StopSignals() { ignore_late_stop_signals(); }
   StopSignals(const StopSignals&) = delete;
   StopSignals& operator=(const StopSignals&) = delete;
 
