@@ -96,6 +96,9 @@ void write_server_metrics(MetricsText& m, const ServerStats& s) {
   m.family("axon_web_http_not_found_total", MetricType::counter, "HTTP requests answered 404").sample(s.not_found);
   m.family("axon_web_connections_refused_total", MetricType::counter,
            "Connections refused because too many were open (answered 503)").sample(s.refused);
+  m.family("axon_web_connections", MetricType::gauge, "Connections open now (HTTP and WebSocket)").sample(s.connections);
+  m.family("axon_web_connections_idle_closed_total", MetricType::counter,
+           "HTTP connections closed because no complete request came within the idle timeout").sample(s.idle_closed);
   m.family("axon_web_websocket_clients", MetricType::gauge, "WebSocket clients connected now").sample(s.ws_open);
   m.family("axon_web_websocket_accepted_total", MetricType::counter, "WebSocket clients accepted").sample(s.ws_accepted);
   m.family("axon_web_websocket_dropped_total", MetricType::counter,

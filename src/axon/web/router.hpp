@@ -34,6 +34,8 @@ struct ServerStats {
   std::uint64_t bad_requests = 0;      // malformed or oversized requests (answered 400, connection closed)
   std::uint64_t not_found = 0;         // answered 404
   std::uint64_t refused = 0;           // connections refused: too many at once (answered 503)
+  std::uint64_t idle_closed = 0;       // HTTP connections closed for no complete request within idle_timeout
+  std::uint64_t connections = 0;       // connections open now (HTTP and WebSocket, the refused ones until closed)
   std::uint64_t ws_accepted = 0;       // WebSocket clients accepted
   std::uint64_t ws_open = 0;           // WebSocket clients connected now
   std::uint64_t ws_dropped_slow = 0;   // clients dropped because their send queue was full

@@ -207,7 +207,10 @@ asio::awaitable<void> Server::Impl::session(tcp::socket socket) {
   beast::flat_buffer buffer;
   error_code ec;
   if (connections > options.max_connections) {
-    ++stats.refused;
+    // Logged on the first refusal and every 100th after it: a flood stays one line in a hundred.
+    if (stats.refused++ % 100 == 0)
+      spdlog::warn("web: {} connections open, the limit is {}: a new one answered 503 ({} so far)", connections - 1,
+                   options.max_connections, stats.refused);
     Response res = to_beast({503, "text/plain; charset=utf-8", "too many connections\n"}, 11, false);
     stream.expires_after(std::chrono::seconds(5));
     co_await http::async_write(stream, res, asio::redirect_error(kAwait, ec));
@@ -224,6 +227,8 @@ asio::awaitable<void> Server::Impl::session(tcp::socket socket) {
       if (is_parse_error(ec)) {
         Response res = bad_request(ec, stats);
         co_await http::async_write(stream, res, asio::redirect_error(kAwait, ec));
+      } else if (ec == beast::error::timeout) {
+        ++stats.idle_closed;  // a browser's idle keep-alive connection as much as a slow or half-open peer: not logged
       }
       break;
     }
@@ -279,7 +284,12 @@ asio::awaitable<void> Server::Impl::read_until_closed(std::shared_ptr<WsClient> 
     error_code ec;
     co_await client->ws.async_read(buffer, asio::redirect_error(kAwait, ec));
     if (ec) {
-      if (!client->closed && ec.category() == ws_errors && ec != websocket::error::closed) ++stats.ws_bad_frames;
+      // A frame that breaks the protocol: Beast answers with a close frame (1002) and ends here once
+      // the peer closes too, or after the handshake timeout (10 s) for one that stays silent.
+      if (!client->closed && ec.category() == ws_errors && ec != websocket::error::closed) {
+        ++stats.ws_bad_frames;
+        spdlog::warn("web: a WebSocket client broke the protocol ({}): closed", ec.message());
+      }
       co_return;
     }
     buffer.consume(buffer.size());  // pages send nothing the server acts on
@@ -382,7 +392,11 @@ ServerStats Server::stats() const {
   if (impl_->joined) return impl_->stats;
   std::promise<ServerStats> copy;
   auto result = copy.get_future();
-  asio::post(impl_->io, [&copy, impl = impl_.get()] { copy.set_value(impl->stats); });
+  asio::post(impl_->io, [&copy, impl = impl_.get()] {
+    ServerStats s = impl->stats;
+    s.connections = impl->connections;
+    copy.set_value(s);
+  });
   return result.get();
 }
 
