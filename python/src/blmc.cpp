@@ -344,6 +344,58 @@ void bind_board_onboard(py::class_<Board>& c) {
        }, py::arg("on"));
 }
 
+// Homing on the encoder index (MotorBoard::home): the motors must be enabled.
+struct HomeArgs {
+  double speed_rev_s, kp, kd, max_current_a, max_travel_rev, timeout_s, max_velocity_krpm, stale_data_s;
+  std::array<bool, 2> motors;
+  bool realtime;
+};
+
+blmc::HomingReport home(Board& b, const HomeArgs& a) {
+  blmc::host::HomingOptions o;
+  o.motors = a.motors;
+  o.speed_rev_s = a.speed_rev_s;
+  o.kp = a.kp;
+  o.kd = a.kd;
+  o.max_current_a = a.max_current_a;
+  o.max_travel_rev = a.max_travel_rev;
+  blmc::ControlSettings s;
+  s.limits.max_velocity_krpm = a.max_velocity_krpm;
+  s.limits.stale_after = duration_of<core::Duration>(a.stale_data_s, "stale_data_s");
+  s.realtime = a.realtime;
+  const auto timeout = duration_of<std::chrono::milliseconds>(a.timeout_s, "timeout_s");
+  auto& m = b.get();
+  return guarded(b, [&m, &o, &s, timeout] { return m.home(o, s, timeout); });
+}
+
+void bind_homing(py::module_& m, py::class_<Board>& c) {
+  using blmc::host::MotorHoming;
+  py::class_<MotorHoming>(m, "MotorHoming", "What homing found for one motor.")
+      .def_property_readonly("state", [](const MotorHoming& h) { return std::string(blmc::host::to_string(h.state)); },
+                             "'found', 'failed' (no index within max_travel_rev), 'idle' (not asked or not used), 'searching'.")
+      .def_readonly("start_rev", &MotorHoming::start_rev, "Where the motor was when the search began (rev).")
+      .def_readonly("index_rev", &MotorHoming::index_rev, "The encoder index: the motor's offset (rev; valid when found).")
+      .def("__repr__", [](const MotorHoming& h) {
+        return fmt::format("MotorHoming(state='{}', start_rev={:.5f}, index_rev={:.5f})", blmc::host::to_string(h.state), h.start_rev, h.index_rev);
+      });
+  py::class_<blmc::HomingReport>(m, "HomingReport", "How homing went: the control run and each motor's result.")
+      .def_readonly("control", &blmc::HomingReport::control)
+      .def_readonly("motors", &blmc::HomingReport::motors)
+      .def_readonly("all_found", &blmc::HomingReport::all_found)
+      .def("__repr__", [](const blmc::HomingReport& r) {
+        return fmt::format("HomingReport(all_found={}, motors=[{}, {}], end='{}')", r.all_found ? "True" : "False",
+                           blmc::host::to_string(r.motors[0].state), blmc::host::to_string(r.motors[1].state), blmc::to_string(r.control.end));
+      });
+  c.def("home", [](Board& b, double speed_rev_s, std::array<bool, 2> motors, double kp, double kd, double max_current_a,
+                   double max_travel_rev, double timeout_s, double max_velocity_krpm, double stale_data_s, bool realtime) {
+         return home(b, {speed_rev_s, kp, kd, max_current_a, max_travel_rev, timeout_s, max_velocity_krpm, stale_data_s, motors, realtime});
+       }, py::kw_only(), py::arg("speed_rev_s") = 0.5, py::arg("motors") = std::array<bool, 2>{true, true}, py::arg("kp") = 2.0,
+       py::arg("kd") = 0.02, py::arg("max_current_a") = 0.5, py::arg("max_travel_rev") = 2.0, py::arg("timeout_s") = 20.0,
+       py::arg("max_velocity_krpm") = 2.0, py::arg("stale_data_s") = 0.01, py::arg("realtime") = true,
+       "Finds each motor's encoder index under the 1 kHz loop and its safety limits (the motors must be enabled): "
+       "HomingReport. Ctrl-C: the motors are disabled.");
+}
+
 void bind_board(py::module_& m) {
   py::class_<Board> c(m, "MotorBoard", "One motor driver board (two motors) from blocking calls.");
   c.def(py::init(&open_board), py::arg("bus_spec"), py::kw_only(), py::arg("name") = "blmc",
@@ -384,6 +436,7 @@ void bind_board(py::module_& m) {
       .def("__exit__", [](Board& b, py::args) { b.close(); });
   bind_board_control(c);
   bind_board_onboard(c);
+  bind_homing(m, c);
 }
 
 blmc::sim::FaultKind fault_kind(const std::string& name) {
@@ -409,15 +462,18 @@ void bind_sim(py::module_& m) {
   py::class_<SimulatedBoard>(m, "SimulatedBoard",
                              "Motor driver boards simulated in this process (1 kHz firmware model, motors), served over socketcand "
                              "on loopback: MotorBoard(sim.bus_spec) reaches board 0.")
-      .def(py::init([](unsigned boards, double alignment_time_s) {
+      .def(py::init([](unsigned boards, double alignment_time_s, std::array<double, 2> index_offset_rev) {
              blmc::sim::SimulatedBoardOptions o;
              o.boards = boards;
              o.config.alignment_time = duration_of<core::Duration>(alignment_time_s, "alignment_time_s", false);
+             for (std::size_t k = 0; k < 2; ++k) o.config.motors[k].index_offset_rev = index_offset_rev[k];
              py::gil_scoped_release release;
              return std::make_unique<SimulatedBoard>(o);
            }),
            py::kw_only(), py::arg("boards") = 1, py::arg("alignment_time_s") = 2.0,
-           "alignment_time_s: how long the first enable after power-up aligns the motors.")
+           py::arg("index_offset_rev") = std::array<double, 2>{blmc::sim::MotorConfig{}.index_offset_rev, blmc::sim::MotorConfig{}.index_offset_rev},
+           "alignment_time_s: how long the first enable after power-up aligns the motors; index_offset_rev: where "
+           "each motor's encoder index mark sits within its turn (rev).")
       .def_property_readonly("bus_spec", [](const SimulatedBoard& s) { return s.bus_spec(0); }, "Board 0's bus spec.")
       .def("bus_spec_of", [](const SimulatedBoard& s, unsigned board) { return s.bus_spec(board); }, py::arg("board"),
            py::call_guard<py::gil_scoped_release>())

@@ -162,6 +162,34 @@ def test_ctrl_c_during_run_control_leaves_the_motors_disabled(sim, board):
     assert wait_until(lambda: motors_off(sim))
 
 
+def test_home_finds_each_motors_index_mark_where_the_simulator_put_it():
+    marks = (0.3, 0.7)
+    with axon.blmc.SimulatedBoard(alignment_time_s=0.2, index_offset_rev=marks) as sim, \
+            axon.blmc.MotorBoard(sim.bus_spec, recv_timeout_ms=500) as board:
+        board.enable()
+        report = board.home(speed_rev_s=0.5, max_travel_rev=1.2, timeout_s=10, stale_data_s=0.5)
+        assert report.all_found, report
+        assert report.control.fault is None, report.control.fault_text
+        for motor, mark in zip(report.motors, marks):
+            assert motor.state == "found", motor
+            assert abs(motor.index_rev - mark) < 0.001, motor
+        assert board.enabled and not board.running  # homing ends its run; the motors stay enabled
+
+
+def test_home_that_finds_no_mark_within_its_travel_says_so_per_motor(sim, board):
+    report = board.home(speed_rev_s=0.5, max_travel_rev=0.05, timeout_s=10, stale_data_s=0.5)
+    assert not report.all_found
+    assert [m.state for m in report.motors] == ["failed", "failed"], report
+    with pytest.raises(axon.blmc.InvalidArgument):
+        board.home(timeout_s=-1)
+
+
+def test_home_before_enable_is_refused(sim):
+    with axon.blmc.MotorBoard(sim.bus_spec) as board:
+        with pytest.raises(axon.blmc.NotEnabled):
+            board.home()
+
+
 def test_the_docs_quick_start_runs(source_dir):
     text = open(os.path.join(source_dir, "docs", "python.md"), encoding="utf-8").read()
     section = text.split("## `axon.blmc`", 1)[1]
