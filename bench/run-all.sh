@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Runs every benchmark executable built from bench/*.cpp and collects their BENCH summary lines.
+# Runs every benchmark executable built from bench/*.cpp, then bench/python_front_end.py, and collects
+# their BENCH summary lines.
 set -euo pipefail
 build=${1:-build/release}
 here=$(cd "$(dirname "$0")" && pwd)
@@ -12,6 +13,12 @@ for src in "$here"/*.cpp; do
   out=$("$exe" 2>&1 | tee /dev/stderr)
   summary+=("$(grep '^BENCH ' <<<"$out" | tail -n 1)")
 done
+# The Python front end's cost (needs the Python module: AXON_PYTHON=ON, the default with pybind11).
+if [ -d "$build/python/axon" ]; then
+  echo "== python_front_end"
+  out=$(/usr/bin/python3 "$here/python_front_end.py" "$build" 2>&1 | tee /dev/stderr)
+  summary+=("$(grep '^BENCH ' <<<"$out" | tail -n 1)")
+fi
 echo
 echo "== summary"
 printf '%s\n' "${summary[@]}"

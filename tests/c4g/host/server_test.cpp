@@ -486,6 +486,50 @@ TEST(Server, ASilentSessionEndsAndTheNextControllerMayStartOne) {
   EXPECT_EQ(rig.server->counters().sessions.load(), 2u);
 }
 
+// A controller that restarts faster than the cycle timeout comes back from the same address with
+// its numbering started again. Its initialization packet lost on the way (the c4g soak met this),
+// the server must not go on with the old one: it starts the session over and asks for it (506).
+TEST(Server, AControllerRestartWhoseInitializationPacketIsLostIsAskedForIt) {
+  auto o = loopback_options();
+  o.request_init_after = 5;
+  Rig rig(o);
+  rig.init();
+  for (std::int32_t num = 11; num < 300; ++num) EXPECT_EQ(rig.peer.ask(cyclic(num, 0)).num, num);
+  EXPECT_EQ(rig.server->state(), ServerState::running);
+  // The restarted controller: sync packets from 1; its initialization packet never arrives.
+  for (std::int32_t num = 1; num <= 4; ++num) {
+    const auto a = rig.peer.ask(cyclic(num, 0));
+    EXPECT_EQ(a.num, num);
+    for (const auto& ax : a.open_axes()) EXPECT_EQ(ax.mode, 0) << "no 506 during the sync phase";
+  }
+  EXPECT_EQ(rig.server->counters().controller_restarts.load(), 1u);
+  EXPECT_EQ(rig.server->state(), ServerState::syncing);
+  bool asked = false;
+  for (std::int32_t num = 5; num < 12 && !asked; ++num) {
+    const auto a = rig.peer.ask(cyclic(num, 0));
+    asked = a.open_axes()[0].mode == code(Mode::server_restart);
+  }
+  EXPECT_TRUE(asked) << "RESTART (506) asked for the missing initialization packet";
+  rig.peer.send(make_init(12));
+  EXPECT_EQ(rig.peer.answer().num, 12);
+  EXPECT_EQ(rig.controller.inits.load(), 2);
+  EXPECT_EQ(rig.server->state(), ServerState::running);
+  EXPECT_EQ(rig.peer.ask(cyclic(13, 0)).num, 13);
+  EXPECT_EQ(rig.server->counters().controller_restarts.load(), 1u) << "the numbering after the init goes on";
+}
+
+// Reordered and duplicated packets, and the wrap from 32767 to 1, are no restart.
+TEST(Server, ReorderingAndTheNumbersWrapAreNoRestart) {
+  Rig rig;
+  rig.init();
+  for (std::int32_t num : {11, 13, 12, 12, 14, 15, 32700}) rig.peer.ask(cyclic(num, 0));
+  for (std::int32_t num = 32701; num <= protocol::kMaxProtocolNumber; ++num) rig.peer.ask(cyclic(num, 0));
+  for (std::int32_t num = 1; num <= 3; ++num) EXPECT_EQ(rig.peer.ask(cyclic(num, 0)).num, num);
+  EXPECT_EQ(rig.server->counters().controller_restarts.load(), 0u);
+  EXPECT_EQ(rig.server->state(), ServerState::running);
+  EXPECT_EQ(rig.controller.inits.load(), 1);
+}
+
 TEST(Server, ForeignFloodDoesNotHideTheControllersSilence) {
   auto o = loopback_options();
   o.cycle.cycle_timeout = 30ms;

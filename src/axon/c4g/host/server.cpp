@@ -190,6 +190,7 @@ std::size_t Server::on_packet(std::span<const std::byte> in, const net::Datagram
 
 std::size_t Server::answer_init(std::span<const std::byte> in, std::span<std::byte> out) noexcept {
   bump(counters_.init_packets);
+  last_num_ = read_i32(in, 0) & protocol::kMaxProtocolNumber;  // a restart's numbering may start here
   // Decoding the initialization packet may allocate (error texts); it happens once per start-up,
   // before the cyclic exchange, so the cycle's no-allocation rule is kept where it matters.
   try {
@@ -318,6 +319,25 @@ void Server::enforce_mode_rules(const protocol::Packet& req, protocol::Packet& r
   }
 }
 
+// Lost, duplicated and reordered packets move the number by a few; a restart takes it back to the
+// controller's first number, and the wrap goes from kMaxProtocolNumber to 1.
+bool Server::numbering_restarted(std::int32_t num) const noexcept {
+  constexpr std::int32_t kWindow = 64;
+  if (last_num_ < 0 || num >= last_num_ - kWindow) return false;
+  return !(last_num_ > protocol::kMaxProtocolNumber - kWindow && num <= kWindow);
+}
+
+// The old session is over as after a silence (the application hears on_silence) and the new one
+// must bring its own initialization packet: the old one is no longer used, and when the new one
+// was lost on the way, RESTART (506) asks for it after request_init_after packets (the sync phase).
+void Server::start_session_over() noexcept {
+  bump(counters_.controller_restarts);
+  have_init_ = false;
+  init_requested_at_ = cyclic_count_;
+  state_.store(ServerState::syncing, std::memory_order_release);
+  controller_.on_silence();
+}
+
 void Server::request_missing_init(const protocol::Packet& req, protocol::Packet& rep) noexcept {
   const auto every = static_cast<std::uint64_t>(std::max(options_.request_init_after, 0));
   if (have_init_ || every == 0 || cyclic_count_ < every) return;
@@ -420,6 +440,8 @@ std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Data
                          ? protocol::decode_packet(in, request_, static_cast<std::size_t>(init_.open_axes))
                          : protocol::decode_packet(in, request_);
   if (!fault.ok()) return answer_bad_cyclic(in, out);
+  if (numbering_restarted(request_.num)) start_session_over();
+  last_num_ = request_.num;
 
   const bool freezing = update_freeze(request_);
   build_safe_reply(request_, safe_);
@@ -479,12 +501,13 @@ std::string Server::summary() const {
   fmt::format_to(it,
                  "Packets {} (init {}, cyclic {}), protocol errors {}, unanswered {}, controller exceptions {}, "
                  "late {}, refused mode changes {}, safe replies {}, frozen cycles {} (freezes {}, now {}), "
-                 "replies with unused fields set {}, initialization packets asked for (506) {}\n",
+                 "replies with unused fields set {}, initialization packets asked for (506) {}, controller restarts "
+                 "seen in the numbering {}\n",
                  counters_.packets.load(), counters_.init_packets.load(), counters_.cyclic_packets.load(),
                  counters_.protocol_errors.load(), counters_.unanswered.load(), counters_.controller_exceptions.load(),
                  counters_.controller_late.load(), counters_.refused_mode_changes.load(), counters_.safe_replies.load(),
                  counters_.frozen_cycles.load(), counters_.freezes.load(), to_string(freeze_state()),
-                 counters_.unused_fields.load(), counters_.init_requests.load());
+                 counters_.unused_fields.load(), counters_.init_requests.load(), counters_.controller_restarts.load());
   fmt::format_to(it, "Safety: {} (axis {}), currents clamped {}, drive-off replies {}, following-error replies {}\n",
                  to_string(safety_.reason()), safety_.fault_axis(), safety_.counters().currents_clamped.load(),
                  safety_.counters().drive_off_replies.load(), safety_.counters().following_error_replies.load());

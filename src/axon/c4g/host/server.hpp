@@ -168,6 +168,7 @@ struct ServerCounters {
   std::atomic<std::uint64_t> freezes{0};           // active freezings the controller entered
   std::atomic<std::uint64_t> unused_fields{0};     // replies with data in a field their mode does not use
   std::atomic<std::uint64_t> init_requests{0};     // RESTART (506) sent to get a missing initialization packet
+  std::atomic<std::uint64_t> controller_restarts{0};  // the session's numbering started again (a restart within the cycle timeout)
 };
 
 // Active freezing (special mode 500), as the Server drives it.
@@ -265,6 +266,10 @@ class Server : private CycleHandler {
   void build_freeze_reply(const protocol::Packet& request, protocol::Packet& reply) noexcept;
   // ServerOptions::request_init_after: RESTART (506) on every axis when the packet is missing.
   void request_missing_init(const protocol::Packet& request, protocol::Packet& reply) noexcept;
+  // A controller that restarts faster than the cycle timeout comes back from the same address,
+  // numbering from the start again: detected here, its session is started over.
+  [[nodiscard]] bool numbering_restarted(std::int32_t num) const noexcept;
+  void start_session_over() noexcept;
   std::size_t encode(const protocol::Packet& request, protocol::Packet& reply, std::span<std::byte> out) noexcept;
 
   Controller& controller_;
@@ -291,6 +296,7 @@ class Server : private CycleHandler {
   protocol::Packet safe_{};
   std::uint64_t cyclic_count_ = 0;
   std::uint64_t init_requested_at_ = 0;  // cyclic_count_ when 506 was last sent (0: not yet)
+  std::int32_t last_num_ = -1;           // the session's latest protocol number (-1: none yet)
   int late_in_row_ = 0;
   SwitchTracker switch_;
   std::array<float, protocol::kMaxAxes> last_target_{};
