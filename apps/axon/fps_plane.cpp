@@ -54,6 +54,7 @@ struct PlaneArgs {
   double max_rpm = host::kMaxMotorRpm;  // move: motor speed limit
   double gear_ratio = host::kGearRatio;
   bool sync = false;
+  double sync_hold_s = 0.5;       // move --sync: how long the sync line stays high
   std::string image;              // upgrade
   std::string version;            // upgrade: expected version
   std::vector<int> sextants;      // upgrade
@@ -107,6 +108,7 @@ core::Duration to_duration(double s) { return std::chrono::duration_cast<core::D
 host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
   host::FocalPlaneArrayOptions o;
   o.check_window = to_duration(a.window_s);
+  o.sync_hold = to_duration(a.sync_hold_s);
   if (!a.plc.empty()) o.plc = need(net::parse_endpoint(a.plc, 502));
   return o;
 }
@@ -426,6 +428,9 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions& global) {
   mv->add_option("--gear-ratio", a.gear_ratio, "motor turns per arm turn (default 1000)")->check(positive());
   mv->add_option("--points", a.points, "points per arm (default 20)")->check(CLI::Range(1, 1000));
   mv->add_flag("--sync", a.sync, "start with the PLC's sync line instead of the START_TRAJECTORY broadcast");
+  mv->add_option("--sync-hold", a.sync_hold_s,
+                 "seconds the sync line stays high for the start (default 0.5, as in service; robots need a few ms)")
+      ->check(CLI::Range(0.001, 10.0));
   mv->callback([args, &global] { global.exit_code = run_plane(*args, "move"); });
   auto* up = p->add_subcommand("upgrade",
                                "firmware of every robot, sextant by sextant: power-cycled into the bootloader by the PLC, "
