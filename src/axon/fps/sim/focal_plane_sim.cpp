@@ -216,12 +216,15 @@ struct FocalPlaneSimulator::Impl {
     if (high) {
       ++counters.sync_edges;
       sync_rose_at = at;
+      std::size_t running = 0;
+      for (const auto* m : simulator->robots()) running += m->run_state() == RunState::application ? 1 : 0;
+      spdlog::info("sim: sync line rising edge: {} robots", running);
     } else {
       counters.sync_last_high = at - sync_rose_at;
+      spdlog::info("sim: sync line low after {:.3f} s high", std::chrono::duration<double>(counters.sync_last_high).count());
     }
     // Every robot sees the level at the same instant; those without power ignore it, and each
     // robot running its application starts only if the line is still high at its second look.
-    spdlog::info("sim: sync line {}", high ? "high" : "low");
     simulator->set_sync_line(high);
   }
 };
