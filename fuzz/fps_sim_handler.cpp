@@ -1,5 +1,5 @@
 // Fuzzes the simulated positioner's firmware model with arbitrary request sequences, time steps,
-// power cycles, sync pulses and forced collisions.
+// power cycles, sync line edges and forced collisions.
 //
 // Input: byte 0 picks the starting state (bit 0 motors uncalibrated, bit 1 datums uncalibrated,
 // bit 2 datum lost, bit 3 start in the bootloader, bit 4 read an empty 112 as a get, bit 5 cogging
@@ -8,7 +8,7 @@
 //         bits 2..7 uid), length (% 9), that many payload bytes
 //   4     time step: two bytes (little-endian) in milliseconds, or in seconds when op bit 3 is set
 //   5     power: one byte (bit 0 sync line low, bit 1 lose the position, bit 2 off only)
-//   6     sync pulse
+//   6     sync line: high when op bit 3 is set, else low
 //   7     forced collision: one byte (bit 0: beta)
 // Nothing may crash, and everything the robot sends must be a well-formed frame from its own id
 // whose accepted replies have the size the command table declares.
@@ -111,7 +111,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         check(m, {});
         break;
       }
-      case 6: check(m, m.sync_pulse(now)); break;
+      case 6: check(m, m.set_sync_line((op & 8) != 0, now)); break;
       case 7: {
         const auto b = take(1);
         if (b.empty()) return 0;

@@ -54,6 +54,8 @@ struct PlaneArgs {
   double max_rpm = host::kMaxMotorRpm;  // move: motor speed limit
   double gear_ratio = host::kGearRatio;
   bool sync = false;
+  double sync_hold_s = 0.5;       // move --sync: how long the sync line stays high
+  bool approach = false;          // move: GO_TO_RELATIVE (0, 0) afterwards (interface document 7.3)
   std::string image;              // upgrade
   std::string version;            // upgrade: expected version
   std::vector<int> sextants;      // upgrade
@@ -107,6 +109,7 @@ core::Duration to_duration(double s) { return std::chrono::duration_cast<core::D
 host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
   host::FocalPlaneArrayOptions o;
   o.check_window = to_duration(a.window_s);
+  o.sync_hold = to_duration(a.sync_hold_s);
   if (!a.plc.empty()) o.plc = need(net::parse_endpoint(a.plc, 502));
   return o;
 }
@@ -220,6 +223,10 @@ asio::awaitable<void> show_progress(MoveProgress& p) {
   p.done = true;
 }
 
+std::size_t approached(const host::TrajectoryReport& rep) {
+  return static_cast<std::size_t>(std::count_if(rep.robots.begin(), rep.robots.end(), [](const auto& r) { return r.approached; }));
+}
+
 asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) {
   const auto limits = fps::plan::SpeedLimits::from_motor(a.max_rpm, a.gear_ratio);
   const auto table = co_await fpa.array().status_table(true);
@@ -228,6 +235,7 @@ asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) 
   if (t.empty()) throw Exception(Error(host::HostErrc::not_ready, "no robot reported its position: nothing to move"));
   host::TrajectoryOptions to;
   to.speed_limits = limits;
+  to.final_approach = a.approach;
   MoveProgress progress{duration_s, t.size()};
   to.on_phase = [&progress](std::string_view phase) { progress.started = progress.started || phase == "started"; };
   asio::co_spawn(co_await asio::this_coro::executor, show_progress(progress), asio::detached);
@@ -237,13 +245,18 @@ asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) 
   const auto rep = need(std::move(r));
   const auto& lock = fpa.array().lock_state();
   if (a.json) {
-    print_plane_json(move_json(fpa, rep, duration_s, a.sync));
+    auto j = move_json(fpa, rep, duration_s, a.sync);
+    if (a.approach) j["approached"] = approached(rep);
+    print_plane_json(j);
     co_return motion_exit_code(rep.completed, fpa.array());
   }
   for (const auto& [b, c] : started_per_bus(rep))
     std::printf("bus %s: %d of %d robots started\n", fpa.bus_ref(b).to_string().c_str(), c.first, c.second);
   std::printf("start by %s; upload %.3f s, start %.3f s, move %.3f s\n", a.sync ? "the sync line" : "broadcast",
               phase_s(rep.timings.upload), phase_s(rep.timings.start), phase_s(rep.timings.move));
+  if (a.approach)
+    std::printf("final approach (0.9 deg back and forth): %zu of %zu robots at their targets, %.3f s\n", approached(rep),
+                rep.robots.size(), phase_s(rep.timings.approach));
   if (lock.locked) std::printf("locked: %s\n", lock.reason.c_str());
   for (const auto& l : fpa.link_stops()) std::printf("%s\n", l.c_str());
   std::fputs(rep.summary().c_str(), stdout);
@@ -426,6 +439,12 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions& global) {
   mv->add_option("--gear-ratio", a.gear_ratio, "motor turns per arm turn (default 1000)")->check(positive());
   mv->add_option("--points", a.points, "points per arm (default 20)")->check(CLI::Range(1, 1000));
   mv->add_flag("--sync", a.sync, "start with the PLC's sync line instead of the START_TRAJECTORY broadcast");
+  mv->add_option("--sync-hold", a.sync_hold_s,
+                 "seconds the sync line stays high for the start (default 0.5, as in service; robots need a few ms)")
+      ->check(CLI::Range(0.001, 10.0));
+  mv->add_flag("--approach", a.approach,
+               "afterwards GO_TO_RELATIVE (0, 0) on every robot that arrived: the 0.9 deg back-and-forth that leaves the "
+               "arms outside the backlash, where correction iterations start (interface document 7.3)");
   mv->callback([args, &global] { global.exit_code = run_plane(*args, "move"); });
   auto* up = p->add_subcommand("upgrade",
                                "firmware of every robot, sextant by sextant: power-cycled into the bootloader by the PLC, "

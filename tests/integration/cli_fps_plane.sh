@@ -60,10 +60,11 @@ set -e
 [ $rc != 0 ] || fail "a sync move with a silent robot must be refused"
 grep -q 'start by the sync line refused.*: 5 (no acknowledgement)' "$TMP/refused.err" || fail "refusal does not name robot 5"
 grep -q 'sync line rising edge: ' "$TMP/a.err" && fail "the sync line was pulsed despite the refusal"
-# With every robot answering, a move started by the sync line reaches every bus.
+# With every robot answering, a move started by the sync line (held 0.5 s by default) reaches
+# every bus; the final approach (interface document 7.3) then brings every robot back to its target.
 PLC_A=$PLC
 plane c
-"$AXON" fps plane --layout "$TMP/c.yaml" --plc "$PLC" move --alpha 20 --beta 170 --duration 4 --sync \
+"$AXON" fps plane --layout "$TMP/c.yaml" --plc "$PLC" move --alpha 20 --beta 170 --duration 4 --sync --approach \
   >"$TMP/move.out" 2>"$TMP/move.err" || fail "sync move failed"
 for bus in gw1/1 gw1/2 gw2/1 gw2/2; do
   grep -Eq "^bus $bus: ([0-9]+) of \1 robots started" "$TMP/move.out" || fail "not every robot on $bus started"
@@ -71,6 +72,8 @@ done
 grep -q 'start by the sync line' "$TMP/move.out" || fail "not started by the sync line"
 grep -q '^completed: 12 robots' "$TMP/move.out" || fail "move did not complete"
 grep -q 'sync line rising edge: ' "$TMP/c.err" || fail "the simulator saw no sync edge"
+grep -Eq 'sync line low after (0\.[5-9]|[1-9])[0-9.]* s high' "$TMP/c.err" || fail "the sync line was held less than 0.5 s"
+grep -q '^final approach .*: 12 of 12 robots at their targets' "$TMP/move.out" || fail "final approach did not bring every robot back"
 PLC=$PLC_A
 
 # 3. Sextant 2 powered off, then on through the PLC, while the host keeps working.

@@ -111,6 +111,34 @@ TEST(FocalPlaneArray, SyncLineStartReachesEveryBus) {
   });
 }
 
+// The host holds the sync line as long as hosts in service do (FIELD-NOTES: about 0.5 s), well
+// past the robots' second look (interface document 6). The hold is read from the PLC emulator's
+// times of the two writes: the low one comes after the host's wait, so the interval cannot be
+// shorter than the hold, however slow the machine.
+TEST(FocalPlaneArray, SyncLineStartHoldsTheLineHalfASecondByDefault) {
+  PlaneRig rig;
+  rig.runner.run([&]() -> asio::awaitable<void> {
+    co_await rig.connect(std::nullopt);  // the default hold
+    if (!rig.fpa) co_return;
+    EXPECT_EQ(rig.fpa->options().sync_hold, 500ms);
+    // A short move (0.4 s simulated, 20 ms here): the host waits its duration in real time when it
+    // never saw the robots moving, as here, where they finish during the hold.
+    auto r = co_await rig.fpa->run_trajectories(everyone_to(rig, {3, 179}, 2, 0.4), {}, true);
+    EXPECT_TRUE(r.has_value());
+    if (!r) co_return;
+    EXPECT_TRUE(r.value().completed) << r.value().summary();
+    for (const auto& rr : r.value().robots) EXPECT_EQ(rr.state, RobotState::completed) << rr.id << " " << rr.detail;
+    EXPECT_EQ(rig.sim->counters().sync_edges, 1u);
+    EXPECT_GE(rig.sim->counters().sync_last_high, 500ms);
+    EXPECT_FALSE(rig.sim->sync_line());
+    for (auto* m : rig.sim->simulator().robots()) {
+      EXPECT_EQ(m->counters().sync_starts, 1u) << m->id();
+      EXPECT_EQ(m->counters().sync_glitches, 0u) << m->id();
+      EXPECT_NEAR(m->physical_deg(sim::Arm::alpha), 3.0, 0.1) << m->id();
+    }
+  });
+}
+
 TEST(FocalPlaneArray, CollisionOnOneBusStopsEveryBus) {
   sim::Scenario sc;
   sc.collide_on_move = {8};  // gateway 2, bus 1

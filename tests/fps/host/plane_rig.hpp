@@ -70,14 +70,15 @@ struct PlaneRig {
     });
   }
 
-  // Connects the array (inside a test body).
-  asio::awaitable<void> connect() {
+  // Connects the array (inside a test body); starts by the sync line hold it `sync_hold` (nullopt:
+  // the library's default).
+  asio::awaitable<void> connect(std::optional<core::Duration> sync_hold = 20ms) {
     FocalPlaneArrayOptions o;
     o.array = fast_array();
     o.check_window = 300ms;
     for (const auto& g : sim->gateways()) o.addresses[g.id] = g.endpoint;
     o.plc = sim->plc()->endpoint();
-    o.sync_hold = 20ms;
+    if (sync_hold) o.sync_hold = *sync_hold;
     auto r = co_await FocalPlaneArray::connect(runner.io.get_executor(), plane, o);
     EXPECT_TRUE(r.has_value()) << r.error().message();
     if (r) fpa = std::move(r).value();

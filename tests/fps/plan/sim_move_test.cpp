@@ -139,7 +139,7 @@ TEST(PlannedMoveInSimulator, NoCollisionAndEveryRobotAtItsTarget) {
   }
   ASSERT_GT(moving, model.size() / 2);
 
-  simulator.sync_pulse();
+  simulator.set_sync_line(true);  // held: every robot starts at its second look
   const auto total = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(plan.stats.duration_s + 2.0));
   for (core::Duration t{}; t < total; t += 20ms) {
     clock.advance(20ms);

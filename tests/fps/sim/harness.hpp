@@ -87,6 +87,15 @@ struct Harness {
     now += d;
     for (auto& m : model.advance(now)) unsolicited.push_back(m);
   }
+  // The sync line high for `hold`, then low again; returns what the robot sent meanwhile (its
+  // start reply, when the line was still high at its second look).
+  std::vector<Message> sync_pulse(SimDuration hold) {
+    std::vector<Message> out;
+    for (auto& m : model.set_sync_line(true, now)) out.push_back(m);
+    now += hold;
+    for (auto& m : model.set_sync_line(false, now)) out.push_back(m);
+    return out;
+  }
   // Waits in steps until DISPLACEMENT_COMPLETED (or the limit); returns the time waited.
   SimDuration wait_idle(SimDuration limit = 2h, SimDuration step = 100ms) {
     SimDuration waited{};

@@ -119,7 +119,7 @@ TEST(FpsSimBootloader, SyncLineLowAtPowerOnEntersTheBootloader) {
   auto out = h.send(CommandId::start_firmware_upgrade, two_u32(8, 0), 0);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].id.response, ResponseCode::invalid_broadcast);
-  EXPECT_TRUE(h.model.sync_pulse(h.now).empty());
+  EXPECT_TRUE(h.sync_pulse(10ms).empty());
 }
 
 TEST(FpsSimBootloader, TimesOutIntoTheApplicationAndValidCommandsRestartTheWait) {

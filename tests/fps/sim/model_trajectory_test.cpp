@@ -155,7 +155,7 @@ TEST(FpsSimTrajectory, StartWithoutTrajectoryIsInvalidWhenConfiguredSo) {
   c.start_without_trajectory = EmptyStart::refuse;
   Harness h(c);
   EXPECT_EQ(h.code(CommandId::start_trajectory), ResponseCode::invalid_trajectory);
-  EXPECT_EQ(h.model.sync_pulse(h.now).at(0).id.response, ResponseCode::invalid_trajectory);
+  EXPECT_EQ(h.sync_pulse(10ms).at(0).id.response, ResponseCode::invalid_trajectory);
 }
 
 TEST(FpsSimTrajectory, FirstPointIsCheckedAgainAtTheStartFromWhereTheArmIsThen) {
@@ -189,18 +189,32 @@ TEST(FpsSimTrajectory, AbortDuringUploadDropsIt) {
   EXPECT_EQ(h.code(CommandId::send_trajectory_data, point(10, 2)), ResponseCode::invalid_trajectory);
 }
 
-TEST(FpsSimTrajectory, SyncPulseStartsWithUidZero) {
+// Interface document 6: a rising edge, a second look a few ms later, and a start only if the line
+// is still high then; the reply is START_TRAJECTORY's with uid 0.
+TEST(FpsSimTrajectory, SyncLineStartsAtTheSecondLookWithUidZero) {
   Harness h;
-  ASSERT_TRUE(all_accepted(upload(h, {{10, 1}}, {})));
+  ASSERT_TRUE(all_accepted(upload(h, {{90, 10}}, {})));
   ASSERT_EQ(h.code(CommandId::trajectory_data_end), ResponseCode::accepted);
-  auto out = h.model.sync_pulse(h.now);
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(out[0].id.command, 14);
-  EXPECT_EQ(out[0].id.uid, 0);
-  EXPECT_EQ(out[0].id.response, ResponseCode::accepted);
+  const SimDuration recheck = h.model.config().sync_recheck;
+  ASSERT_GT(recheck, 0ms);
+  EXPECT_TRUE(h.model.set_sync_line(true, h.now).empty());
+  EXPECT_EQ(h.model.sync_check_at(), h.now + recheck);
+  h.wait(recheck - 1ms);
+  EXPECT_FALSE(h.model.moving());
+  EXPECT_TRUE(h.unsolicited.empty());
+  h.wait(1ms);
+  ASSERT_EQ(h.unsolicited.size(), 1u);
+  EXPECT_EQ(h.unsolicited[0].id.command, 14);
+  EXPECT_EQ(h.unsolicited[0].id.uid, 0);
+  EXPECT_EQ(h.unsolicited[0].id.response, ResponseCode::accepted);
   EXPECT_TRUE(h.model.moving());
+  EXPECT_EQ(h.model.counters().sync_starts, 1u);
+  // Held high, the line starts nothing more.
+  h.wait(1s);
+  EXPECT_EQ(h.unsolicited.size(), 1u);
   // A second pulse finds nothing loaded: accepted, and the running trajectory goes on.
-  out = h.model.sync_pulse(h.now);
+  EXPECT_TRUE(h.model.set_sync_line(false, h.now).empty());
+  auto out = h.sync_pulse(500ms);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].id.response, ResponseCode::accepted);
   EXPECT_TRUE(h.model.moving());
@@ -210,8 +224,53 @@ TEST(FpsSimTrajectory, SyncPulseStartsWithUidZero) {
   Harness old(c);
   ASSERT_TRUE(all_accepted(upload(old, {{10, 1}}, {})));
   ASSERT_EQ(old.code(CommandId::trajectory_data_end), ResponseCode::accepted);
-  ASSERT_EQ(old.model.sync_pulse(old.now).at(0).id.response, ResponseCode::accepted);
-  EXPECT_EQ(old.model.sync_pulse(old.now).at(0).id.response, ResponseCode::already_in_motion);
+  ASSERT_EQ(old.sync_pulse(500ms).at(0).id.response, ResponseCode::accepted);
+  EXPECT_EQ(old.sync_pulse(500ms).at(0).id.response, ResponseCode::already_in_motion);
+}
+
+TEST(FpsSimTrajectory, SyncPulseShorterThanTheSecondLookStartsNothing) {
+  Harness h;
+  ASSERT_TRUE(all_accepted(upload(h, {{10, 1}}, {})));
+  ASSERT_EQ(h.code(CommandId::trajectory_data_end), ResponseCode::accepted);
+  const SimDuration recheck = h.model.config().sync_recheck;
+  // Jitter: up and down again before the second look; its look finds the line low.
+  EXPECT_TRUE(h.sync_pulse(recheck - 1ms).empty());
+  h.wait(1s);
+  // A bounce: the second rise arms no look of its own; the first one's finds the line low again.
+  EXPECT_TRUE(h.model.set_sync_line(true, h.now).empty());
+  h.wait(1ms);
+  EXPECT_TRUE(h.model.set_sync_line(false, h.now).empty());
+  h.wait(1ms);
+  EXPECT_TRUE(h.model.set_sync_line(true, h.now).empty());  // the first look is still pending
+  h.wait(recheck - 3ms);
+  EXPECT_TRUE(h.model.set_sync_line(false, h.now).empty());
+  h.wait(1s);
+  EXPECT_TRUE(h.unsolicited.empty());
+  EXPECT_FALSE(h.model.moving());
+  EXPECT_EQ(h.model.counters().sync_glitches, 2u);
+  EXPECT_EQ(h.model.counters().sync_starts, 0u);
+  // The trajectory is still loaded: a proper pulse starts it.
+  const auto out = h.sync_pulse(recheck);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].id.response, ResponseCode::accepted);
+  EXPECT_TRUE(h.model.moving());
+}
+
+TEST(FpsSimTrajectory, SyncRecheckIsConfigurable) {
+  auto c = test_config();
+  c.sync_recheck = 0ms;  // an edge is enough
+  Harness h(c);
+  ASSERT_TRUE(all_accepted(upload(h, {{10, 1}}, {})));
+  ASSERT_EQ(h.code(CommandId::trajectory_data_end), ResponseCode::accepted);
+  const auto out = h.model.set_sync_line(true, h.now);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].id.uid, 0);
+  EXPECT_TRUE(h.model.moving());
+  const auto yaml = core::ConfigNode::load_string("sync_recheck_s: 0.25\n");
+  ASSERT_TRUE(yaml.has_value());
+  const auto read = PositionerConfig::from_config(yaml.value());
+  ASSERT_TRUE(read.has_value()) << read.error().message();
+  EXPECT_EQ(read.value().sync_recheck, 250ms);
 }
 
 TEST(FpsSimTrajectory, UploadNeedsTheDatum) {

@@ -393,7 +393,7 @@ TEST(FpsSimulator, ScaledProtocolTimeoutsWhenAsked) {
   EXPECT_EQ(rig.add(3)->config().bootloader_timeout, 10s);
 }
 
-TEST(FpsSimulator, SyncPulseStartsLoadedTrajectoriesAndRepliesWithUidZero) {
+TEST(FpsSimulator, SyncLineStartsLoadedTrajectoriesAndRepliesWithUidZero) {
   Rig rig;
   auto* a = rig.add(1);
   rig.add(2);
@@ -408,7 +408,7 @@ TEST(FpsSimulator, SyncPulseStartsLoadedTrajectoriesAndRepliesWithUidZero) {
       auto r = co_await rig.host->receive(1s);
       EXPECT_TRUE(r.has_value() && protocol::from_frame(r.value()).value().id.response == ResponseCode::accepted);
     }
-    rig.sim.sync_pulse();
+    rig.sim.set_sync_line(true);  // held: the tick passes the robots' second look
     got = co_await collect(*rig.host, 2, 1s);
     rig.sim.stop();
   });
@@ -448,6 +448,16 @@ asio::awaitable<void> upload(Rig& rig, std::uint16_t id, protocol::Trajectory t)
       EXPECT_EQ(protocol::from_frame(r.value()).value().id.response, ResponseCode::accepted);
     }
   }
+}
+
+// The sync line up, the manual clock to the robots' second look and a step: every loaded robot
+// starts then. Returns their replies.
+asio::awaitable<std::vector<protocol::Message>> sync_start(Rig& rig, core::ManualClock& clock) {
+  rig.sim.set_sync_line(true);
+  clock.advance(std::chrono::duration_cast<core::Duration>(PositionerConfig{}.sync_recheck));
+  rig.sim.step();
+  rig.sim.set_sync_line(false);
+  co_return co_await collect(*rig.host, 2, 1s);
 }
 
 protocol::Trajectory alpha_to(double deg, double seconds) {
@@ -501,8 +511,7 @@ TEST(FpsSimulator, ALateTickComparesEveryRobotAtTheSameInstant) {
   run(rig.io, [&]() -> asio::awaitable<void> {
     co_await upload(rig, 1, alpha_to(Chase::a_to, Chase::seconds));
     co_await upload(rig, 2, alpha_to(Chase::b_to, Chase::seconds));
-    rig.sim.sync_pulse();
-    const auto acks = co_await collect(*rig.host, 2, 1s);
+    const auto acks = co_await sync_start(rig, clock);
     EXPECT_EQ(acks.size(), 2u);
     seen = co_await drive(rig, clock, 100ms, 40);  // 4 s, ticks on time
     clock.advance(2s);                             // then no tick for 2 s
@@ -538,12 +547,64 @@ TEST(FpsSimulator, SyncEdgeStartsEveryRobotAtTheSameInstant) {
     clock.advance(3s);  // B is answered 3 s later than A
     co_await upload(rig, 2, alpha_to(Chase::b_to, Chase::seconds));
     clock.advance(1s);
-    rig.sim.sync_pulse();
-    (void)co_await collect(*rig.host, 2, 1s);
+    EXPECT_EQ((co_await sync_start(rig, clock)).size(), 2u);
     (void)co_await drive(rig, clock, 100ms, 50);  // half of the move
     rig.sim.stop();
   });
   // Both half way: 60 deg from where each started.
   EXPECT_NEAR(a->physical_deg(Arm::alpha), Chase::a_from + 60, 1e-6);
   EXPECT_NEAR(b->physical_deg(Arm::alpha), Chase::b_from + 60, 1e-6);
+}
+
+// Interface document 6: a pulse shorter than the robots' second look after the rising edge is
+// jitter and starts nothing; a line held past it starts every loaded robot at that instant, each
+// replying as to START_TRAJECTORY with uid 0.
+TEST(FpsSimulator, SyncLineStartsOnlyWhenStillHighAtTheSecondLook) {
+  core::ManualClock clock;
+  SimulatorOptions o;
+  o.clock = &clock;
+  o.tick = 1h;
+  Rig rig(o);
+  auto* a = rig.add(1);
+  auto* b = rig.add(2, 30, 0);
+  const auto recheck = std::chrono::duration_cast<core::Duration>(a->config().sync_recheck);
+  rig.sim.start();
+  run(rig.io, [&]() -> asio::awaitable<void> {
+    co_await upload(rig, 1, alpha_to(20, 2));
+    co_await upload(rig, 2, alpha_to(40, 2));
+    // A glitch: up, and down again 1 ms before the second look.
+    rig.sim.set_sync_line(true);
+    clock.advance(recheck - 1ms);
+    rig.sim.set_sync_line(false);
+    (void)co_await drive(rig, clock, 100ms, 10);
+    EXPECT_EQ(rig.sim.stats().unsolicited, 0u);  // nothing sent
+    EXPECT_FALSE(a->moving());
+    EXPECT_FALSE(b->moving());
+    // Held: nothing until the second look, then both start.
+    rig.sim.set_sync_line(true);
+    (void)co_await drive(rig, clock, recheck - 1ms, 1);
+    EXPECT_EQ(rig.sim.stats().unsolicited, 0u);
+    EXPECT_FALSE(a->moving());
+    clock.advance(1ms);
+    rig.sim.step();
+    EXPECT_TRUE(a->moving());
+    EXPECT_TRUE(b->moving());
+    const auto seen = co_await collect(*rig.host, 2, 1s);
+    EXPECT_EQ(seen.size(), 2u);
+    for (const auto& m : seen) {
+      EXPECT_EQ(m.id.command, 14);
+      EXPECT_EQ(m.id.uid, 0);
+      EXPECT_EQ(m.id.response, ResponseCode::accepted);
+    }
+    rig.sim.set_sync_line(false);
+    (void)co_await drive(rig, clock, 100ms, 30);
+    rig.sim.stop();
+  });
+  for (auto* m : {a, b}) {
+    EXPECT_EQ(m->counters().sync_glitches, 1u) << "robot " << m->id();
+    EXPECT_EQ(m->counters().sync_starts, 1u) << "robot " << m->id();
+  }
+  EXPECT_NEAR(a->physical_deg(Arm::alpha), 20, 1e-6);
+  EXPECT_NEAR(b->physical_deg(Arm::alpha), 40, 1e-6);
+  EXPECT_EQ(rig.sim.stats().unsolicited, 2u);
 }

@@ -70,6 +70,36 @@ bool lost_reply(const UploadResult& u) {
   return u.error && *u.error == HostErrc::timeout && u.stage != UploadResult::Stage::not_sent;
 }
 
+// Interface document 7.3: GO_TO_RELATIVE_POSITION (0, 0) to every robot that completed, all at
+// once; each either ends at its target (approached) or leaves the run with the reason.
+asio::awaitable<void> final_approach(Array& array, TrajectoryReport& rep) {
+  std::map<std::uint16_t, ArmAngles> in_place;
+  for (const auto& r : rep.robots)
+    if (r.state == RobotState::completed) in_place.emplace(r.id, ArmAngles{0, 0});
+  if (in_place.empty()) co_return;
+  auto moved = co_await array.goto_relative(std::move(in_place));
+  for (auto& r : rep.robots) {
+    if (r.state != RobotState::completed) continue;
+    if (!moved) {  // locked meanwhile (the whole call is refused)
+      r.state = RobotState::stopped;
+      r.detail = fmt::format("final approach (7.3) not sent: {}", moved.error().message());
+      continue;
+    }
+    const auto& m = moved.value().at(r.id);
+    if (m) {
+      r.reached = m.value().reached;
+      r.approached = true;
+      continue;
+    }
+    const auto& e = m.error();
+    r.state = e == HostErrc::collision ? RobotState::collided
+              : e == HostErrc::locked  ? RobotState::stopped
+              : e == HostErrc::timeout ? RobotState::timeout
+                                       : RobotState::position_mismatch;  // or refused: the detail says
+    r.detail = fmt::format("final approach (7.3): {}", e.message());
+  }
+}
+
 }  // namespace
 
 asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::uint16_t, protocol::Trajectory> trajectories,
@@ -344,6 +374,10 @@ asio::awaitable<Result<TrajectoryReport>> Array::run_trajectories(std::map<std::
     r.detail += aborted ? "; TRAJECTORY_ABORT sent to it" : fmt::format("; TRAJECTORY_ABORT not sent: {}", aborted.error().message());
   });
   phase_end(rep.timings.move, "finished");
+  if (o.final_approach && !lock_->locked()) {
+    co_await final_approach(*this, rep);
+    phase_end(rep.timings.approach, "approached");
+  }
   rep.completed = rep.all(RobotState::completed);
   if (rep.completed) {
     rep.outcome = fmt::format("completed: {} robots at their targets", n);

@@ -56,7 +56,10 @@ struct FocalPlaneArrayOptions {
   std::optional<net::Endpoint> plc;         // the PLC, if any
   plc::RegisterMap plc_map;
   plc::PlcClientOptions plc_client;
-  core::Duration sync_hold = 100ms;         // sync line high this long for a start
+  // The sync line is held high this long for a start, then dropped. Robots start only on a level
+  // that is still high a few ms after the rising edge (interface document 6); hosts in service
+  // hold it about 0.5 s (FIELD-NOTES).
+  core::Duration sync_hold = 500ms;
   core::Duration connection_poll = 20ms;    // how often the gateway connections are checked
   // Replaces the layout's gateway addresses (e.g. emulators on other ports), by gateway id.
   std::map<std::uint16_t, net::Endpoint> addresses;

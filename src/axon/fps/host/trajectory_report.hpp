@@ -42,7 +42,8 @@ struct RobotRun {
   unsigned upload_attempts = 0;      // uploads started (more than one: a reply was lost, see upload_retries)
   std::optional<ArmAngles> start;    // position before the upload
   std::optional<ArmAngles> target;   // the last point of each arm (the start for an arm without points)
-  std::optional<ArmAngles> reached;  // position after the move
+  std::optional<ArmAngles> reached;  // position after the move (after the final approach, if any)
+  bool approached = false;           // the final approach (TrajectoryOptions::final_approach) ended at the target
   std::string detail;                // why, for every state but completed / loaded
 };
 
@@ -73,6 +74,12 @@ struct TrajectoryOptions {
   // Called as each phase ends ("checked": robots checked, "uploaded": every upload done,
   // "started": start acknowledged, "finished": every robot done), e.g. for timings and progress.
   std::function<void(std::string_view phase)> on_phase;
+  // Interface document 7.3: after the move, GO_TO_RELATIVE_POSITION (0, 0) to every robot that
+  // completed. The firmware's precise approach drives each arm 0.9 deg past where it stands and
+  // back in open loop, so the arms end outside the gears' backlash, within 10-30 um of the target:
+  // where correction iterations start from. A robot whose approach fails (no answer, collision,
+  // away from its target) leaves the run in that state, with the reason. Phase "approached".
+  bool final_approach = false;
 };
 
 // Wall time of each phase of a run (zero for phases not reached).
@@ -81,6 +88,7 @@ struct TrajectoryTimings {
   core::Duration upload{0};  // every trajectory uploaded, every reply checked
   core::Duration start{0};   // start broadcast or sync line, acknowledgements collected
   core::Duration move{0};    // from the start until every robot was seen done
+  core::Duration approach{0};  // the final approach (TrajectoryOptions::final_approach)
 };
 
 struct TrajectoryReport {

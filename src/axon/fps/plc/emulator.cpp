@@ -216,13 +216,14 @@ bool PlcEmulator::Impl::answer(Conn& c, std::span<const std::uint8_t> adu) {
     const auto span = options.map.coil_span();
     std::vector<std::uint8_t> before(mapping->tab_bits, mapping->tab_bits + span);
     modbus_set_socket(ctx, c.fd);
+    const auto at = core::steady_now();  // before the answer: a client that waits on it comes later
     rc = modbus_reply(ctx, query.data(), static_cast<int>(adu.size()), mapping);
     error = errno;
     ++counters.requests;
     for (std::uint16_t a = 0; a < span; ++a) {
       if ((before[a] != 0) == (mapping->tab_bits[a] != 0)) continue;
       if (auto r = options.map.relay_at(a)) {
-        events.push_back(RelayEvent{*r, mapping->tab_bits[a] != 0, a});
+        events.push_back(RelayEvent{*r, mapping->tab_bits[a] != 0, a, at});
         ++counters.relay_changes;
       }
     }
@@ -373,7 +374,7 @@ void PlcEmulator::set_relay(Relay r, bool on) {
     if ((impl_->mapping->tab_bits[a] != 0) == on) return;
     impl_->mapping->tab_bits[a] = on ? 1 : 0;
     ++impl_->counters.relay_changes;
-    events.push_back(RelayEvent{r, on, a});
+    events.push_back(RelayEvent{r, on, a, core::steady_now()});
   }
   impl_->dispatch(events);
 }

@@ -18,10 +18,11 @@
 // Per connection the emulator holds at most one partial request (kMaxRequestSize bytes).
 //
 //   - on_relay_change(handler): called once per coil that a client's write changed, with the
-//     relay and its new state (sync line: on = high; a rising edge is on == true). Handlers run on
+//     relay, its new state (sync line: on = high; a rising edge is on == true) and the time of the
+//     change (so a handler posted later still knows how long a relay was closed). Handlers run on
 //     the server thread, or, when EmulatorOptions::hook_executor is set, are posted to that
 //     executor (e.g. the simulator's io_context: then a handler may call Simulator::power_off(),
-//     power_on(), sync_pulse() directly). Writes that do not change a coil fire nothing.
+//     power_on(), set_sync_line() directly). Writes that do not change a coil fire nothing.
 //   - set_sensor(name, value) / set_sensor_fault(name): what the next read returns.
 //   - a SensorScript (sensor_script.hpp): scripted values over time, applied before every request
 //     and at least every 50 ms.
@@ -32,6 +33,7 @@
 // the destructor) ends the thread and closes every connection.
 #pragma once
 
+#include "axon/core/clock.hpp"
 #include "axon/core/error.hpp"
 #include "axon/fps/plc/register_map.hpp"
 #include "axon/fps/plc/sensor_script.hpp"
@@ -53,6 +55,7 @@ struct RelayEvent {
   Relay relay;
   bool on = false;
   std::uint16_t coil = 0;
+  core::TimePoint at{};  // when the emulator applied the write (steady clock), before answering it
 };
 
 struct EmulatorOptions {

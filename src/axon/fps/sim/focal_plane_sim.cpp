@@ -119,6 +119,7 @@ struct FocalPlaneSimulator::Impl {
   std::unique_ptr<plc::PlcEmulator> plc;
   std::array<bool, kSextants> positioner_power{true, true, true, true, true, true};
   bool sync_high = false;
+  core::TimePoint sync_rose_at{};
   bool stopped = false;
   std::shared_ptr<bool> alive = std::make_shared<bool>(true);  // for hooks posted before stop()
   Counters counters;
@@ -148,7 +149,7 @@ struct FocalPlaneSimulator::Impl {
     switch (e.relay.kind) {
       case plc::RelayKind::positioner_power: r = set_positioner_power(e.relay.sextant, e.on); break;
       case plc::RelayKind::gateway_power: r = set_gateway_power(e.relay.sextant, e.on); break;
-      case plc::RelayKind::sync_line: set_sync(e.on); break;
+      case plc::RelayKind::sync_line: set_sync(e.on, e.at); break;
     }
     if (!r) spdlog::warn("sim: {}: {}", e.relay.to_string(), r.error().message());
   }
@@ -208,19 +209,23 @@ struct FocalPlaneSimulator::Impl {
     }
   }
 
-  void set_sync(bool high) {
-    const bool rising = high && !sync_high;
+  // `at`: when the PLC switched the line (its hooks run here later).
+  void set_sync(bool high, core::TimePoint at) {
+    if (high == sync_high) return;
     sync_high = high;
-    if (!rising) return;
-    ++counters.sync_edges;
-    // Every powered robot sees the edge at the same instant.
-    std::vector<std::uint16_t> ids;
-    for (const auto& [s, list] : sextants) {
-      if (s >= 1 && s <= kSextants && !positioner_power[static_cast<std::size_t>(s - 1)]) continue;
-      ids.insert(ids.end(), list.begin(), list.end());
+    if (high) {
+      ++counters.sync_edges;
+      sync_rose_at = at;
+      std::size_t running = 0;
+      for (const auto* m : simulator->robots()) running += m->run_state() == RunState::application ? 1 : 0;
+      spdlog::info("sim: sync line rising edge: {} robots", running);
+    } else {
+      counters.sync_last_high = at - sync_rose_at;
+      spdlog::info("sim: sync line low after {:.3f} s high", std::chrono::duration<double>(counters.sync_last_high).count());
     }
-    spdlog::info("sim: sync line rising edge: {} robots", ids.size());
-    (void)simulator->sync_pulse(ids);
+    // Every robot sees the level at the same instant; those without power ignore it, and each
+    // robot running its application starts only if the line is still high at its second look.
+    simulator->set_sync_line(high);
   }
 };
 
@@ -386,7 +391,7 @@ std::shared_ptr<can::VirtualBus> FocalPlaneSimulator::medium(const BusRef& bus) 
 const std::map<int, std::vector<std::uint16_t>>& FocalPlaneSimulator::sextants() const noexcept { return impl_->sextants; }
 Result<void> FocalPlaneSimulator::set_positioner_power(int sextant, bool on) { return impl_->set_positioner_power(sextant, on); }
 Result<void> FocalPlaneSimulator::set_gateway_power(int sextant, bool on) { return impl_->set_gateway_power(sextant, on); }
-void FocalPlaneSimulator::set_sync_line(bool high) { impl_->set_sync(high); }
+void FocalPlaneSimulator::set_sync_line(bool high) { impl_->set_sync(high, core::steady_now()); }
 bool FocalPlaneSimulator::sync_line() const noexcept { return impl_->sync_high; }
 const FocalPlaneSimulator::Counters& FocalPlaneSimulator::counters() const noexcept { return impl_->counters; }
 

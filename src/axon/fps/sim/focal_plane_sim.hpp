@@ -10,8 +10,10 @@
 //     saved calibration and the position stored at power-down kept); when power comes back with the
 //     sync line low, as it normally is, they enter their bootloader (the spec's way to upgrade
 //     firmware); with the sync line held high, they boot the application.
-//   - sync line: a rising edge starts the loaded trajectory of every powered robot on every bus at
-//     the same instant; each answers START_TRAJECTORY with uid 0, as the spec describes.
+//   - sync line: every powered robot on every bus sees the line change at the same instant; a
+//     rising edge starts each one's loaded trajectory if the line is still high at the robot's
+//     second look (PositionerConfig::sync_recheck, interface document 6), and each answers
+//     START_TRAJECTORY with uid 0, as the spec describes. A shorter pulse starts nothing.
 //   - gateway power of sextant s: the gateways serving sextant s stop (the host's connection
 //     drops, nothing is forwarded); power back starts them again on the same port. A gateway of
 //     sextant 0 (a bench-top one) has no relay and stays on.
@@ -149,7 +151,8 @@ class FocalPlaneSimulator {
   [[nodiscard]] bool sync_line() const noexcept;
 
   struct Counters {
-    std::uint64_t sync_edges = 0;
+    std::uint64_t sync_edges = 0;            // rising edges
+    core::Duration sync_last_high{};         // how long the line was high the last time, by the PLC's clock
     std::uint64_t sextant_power_changes = 0;
     std::uint64_t gateway_power_changes = 0;
   };

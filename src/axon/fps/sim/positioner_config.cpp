@@ -128,7 +128,7 @@ constexpr std::string_view kKeys[] = {
     "datum_spread_motor_deg", "motors_calibrated", "datums_calibrated", "cogging_calibrated", "datums_initialized",
     "start_position_deg", "sync_line_low_at_power_on", "receive_buffer", "boot_time_s", "bootloader_timeout_s",
     "watchdog_timeout_s", "hall_wake_up_s", "led_blink_s", "motor_calibration_time_s", "cogging_calibration_time_s",
-    "max_firmware_size", "cogging_vector_length", "raw_temperature", "x_mm", "y_mm", "orientation_deg",
+    "sync_recheck_s", "max_firmware_size", "cogging_vector_length", "raw_temperature", "x_mm", "y_mm", "orientation_deg",
     "alpha_arm_mm", "beta_arm_mm", "collision_buffer_mm", "seed"};
 }  // namespace
 
@@ -212,6 +212,7 @@ Result<PositionerConfig> PositionerConfig::from_config(const core::ConfigNode& n
   AXON_TRY(dur("led_blink_s", c.led_blink));
   AXON_TRY(dur("motor_calibration_time_s", c.motor_calibration_time));
   AXON_TRY(dur("cogging_calibration_time_s", c.cogging_calibration_time));
+  AXON_TRY(dur("sync_recheck_s", c.sync_recheck));
   AXON_TRY(num("max_firmware_size", c.max_firmware_size));
   AXON_TRY(num("cogging_vector_length", c.cogging_vector_length));
   AXON_TRY(num("raw_temperature", c.raw_temperature));

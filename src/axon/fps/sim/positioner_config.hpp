@@ -92,6 +92,10 @@ struct PositionerConfig {
   SimDuration led_blink = 2s;                              // the LED blinks this long after power-up
   SimDuration motor_calibration_time = 20s;
   SimDuration cogging_calibration_time = 40min;            // after the drive to the hard stop
+  // The sync line (interface document 6): after a rising edge the firmware waits this long and
+  // looks at the line again; only a line still high starts the trajectory. The document says "a
+  // few milliseconds" without a figure; hosts in service hold the line about 0.5 s.
+  SimDuration sync_recheck = 5ms;
 
   // Storage and readings.
   std::uint32_t max_firmware_size = 256 * 1024;            // START_FIRMWARE_UPGRADE above: code 1
@@ -122,9 +126,9 @@ struct PositionerConfig {
   // datums_calibrated, cogging_calibrated, datums_initialized, start_position_deg ([alpha, beta]),
   // sync_line_low_at_power_on, receive_buffer, boot_time_s, bootloader_timeout_s,
   // watchdog_timeout_s, hall_wake_up_s, led_blink_s, motor_calibration_time_s,
-  // cogging_calibration_time_s, max_firmware_size, cogging_vector_length, raw_temperature, x_mm,
-  // y_mm, orientation_deg, alpha_arm_mm (arms.alpha_length_mm), beta_arm_mm (arms.beta_collision_mm),
-  // collision_buffer_mm, seed.
+  // cogging_calibration_time_s, sync_recheck_s, max_firmware_size, cogging_vector_length,
+  // raw_temperature, x_mm, y_mm, orientation_deg, alpha_arm_mm (arms.alpha_length_mm), beta_arm_mm
+  // (arms.beta_collision_mm), collision_buffer_mm, seed.
   // `also_allowed` names keys the caller reads itself (e.g. "bus" in a simulator's robot list).
   static Result<PositionerConfig> from_config(const core::ConfigNode& node, const PositionerConfig& base,
                                               std::span<const std::string_view> also_allowed = {});

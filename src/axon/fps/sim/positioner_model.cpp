@@ -70,6 +70,7 @@ std::optional<SimTime> PositionerModel::next_event() const noexcept {
   consider(watchdog_at_);
   consider(led_off_at_);
   consider(hall_ready_at_);
+  consider(sync_check_at_);
   for (Arm a : kArms) {
     const ArmState& s = arms_[a];
     if (!s.moving) continue;
@@ -130,6 +131,7 @@ void PositionerModel::fire(SimTime t, Outbox& out) {
   for (Arm a : kArms) {
     if (arms_[a].moving && arms_[a].phys.end() <= t) finish_arm(a, arms_[a].phys.end());
   }
+  if (due(sync_check_at_)) sync_recheck(out);
 }
 
 // ---- power ----------------------------------------------------------------------------------
@@ -157,6 +159,7 @@ void PositionerModel::power_off(SimTime now, bool save_position) {
   watchdog_at_.reset();
   led_off_at_.reset();
   hall_ready_at_.reset();
+  sync_check_at_.reset();
   led_ = false;
   upload_ = {};
   boot_ = {};
@@ -239,16 +242,30 @@ void PositionerModel::start_application(SimTime t) {
 
 // ---- sync line and faults ---------------------------------------------------------------------
 
-Outbox PositionerModel::sync_pulse(SimTime now) {
+Outbox PositionerModel::set_sync_line(bool high, SimTime now) {
   Outbox out;
-  run_until(now, out);
-  if (run_ != RunState::application) return out;
+  run_until(now, out);  // a look due before this change sees the level the line had
+  const bool rising = high && !sync_high_;
+  sync_high_ = high;
+  if (rising && run_ == RunState::application && !sync_check_at_) {
+    sync_check_at_ = now_ + config_.sync_recheck;
+    run_until(now_, out);  // a recheck of zero looks at once
+  }
+  return out;
+}
+
+void PositionerModel::sync_recheck(Outbox& out) {
+  if (run_ != RunState::application) return;
+  if (!sync_high_) {
+    ++counters_.sync_glitches;
+    return;
+  }
+  ++counters_.sync_starts;
   const auto code = start_trajectory(now_);
   ++counters_.requests;
   if (code != protocol::ResponseCode::accepted) ++counters_.rejected;
   out.push_back(protocol::Message{
       protocol::Identifier{config_.id, protocol::number(protocol::CommandId::start_trajectory), 0, code}, {}});
-  return out;
 }
 
 Outbox PositionerModel::inject_collision(Arm arm, SimTime now) {

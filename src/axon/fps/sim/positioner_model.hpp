@@ -97,6 +97,8 @@ struct ModelCounters {
   std::uint64_t firmware_received = 0;  // images that passed their CRC
   std::uint64_t firmware_rejected = 0;  // images that failed it
   std::uint64_t watchdog_resets = 0;
+  std::uint64_t sync_starts = 0;        // second looks at the sync line that found it high
+  std::uint64_t sync_glitches = 0;      // rising edges the second look found gone (nothing started)
 };
 
 class PositionerModel {
@@ -122,9 +124,16 @@ class PositionerModel {
   void power_on(SimTime now, bool sync_line_low = false);
   void power_cycle(SimTime now, bool sync_line_low = false);
 
-  // A rising edge on the sync line: starts the loaded trajectory like START_TRAJECTORY and answers
-  // with the same response code, uid 0. Nothing outside the application.
-  Outbox sync_pulse(SimTime now);
+  // The sync line's level (interface document 6). A rising edge seen by the application arms a
+  // second look config.sync_recheck later: if the line is still high then, the loaded trajectory
+  // starts as with START_TRAJECTORY and the robot answers with that command's response code, uid
+  // 0 (advance() returns the reply at that instant); a pulse shorter than the recheck (jitter)
+  // starts nothing. An edge while a look is pending does not arm another. Returns what advancing
+  // to `now` produced.
+  Outbox set_sync_line(bool high, SimTime now);
+  [[nodiscard]] bool sync_line() const noexcept { return sync_high_; }
+  // When the pending second look is due (nullopt: none).
+  [[nodiscard]] std::optional<SimTime> sync_check_at() const noexcept { return sync_check_at_; }
 
   // Fault injection: a collision of `arm` now, whatever the geometry and detection settings (the
   // robot stops, sets the flag and reports with command 18, uid 0). Nothing outside the application.
@@ -209,6 +218,7 @@ class PositionerModel {
   void enter_bootloader(SimTime t);
   void boot_application(SimTime t, SimDuration delay);
   void start_application(SimTime t);
+  void sync_recheck(Outbox& out);
 
   // Motion (positioner_model.cpp).
   [[nodiscard]] double lower_stop(Arm a) const noexcept { return -config_.hard_stop_lower_deg[a]; }
@@ -244,6 +254,8 @@ class PositionerModel {
   std::optional<SimTime> boot_done_at_;
   std::optional<SimTime> bootloader_deadline_;
   std::optional<SimTime> watchdog_at_;
+  bool sync_high_ = false;
+  std::optional<SimTime> sync_check_at_;
   Flash flash_;
   Calibration cal_;
   PerArm<ArmState> arms_;

@@ -143,6 +143,7 @@ Result<PositionerModel*> Simulator::State::add(
     config.boot_time = scaled(config.boot_time, options.time_scale);
     config.bootloader_timeout = scaled(config.bootloader_timeout, options.time_scale);
     config.watchdog_timeout = scaled(config.watchdog_timeout, options.time_scale);
+    config.sync_recheck = scaled(config.sync_recheck, options.time_scale);
   }
   can::BusOptions bo;
   bo.rx_capacity = config.receive_buffer;
@@ -364,9 +365,16 @@ void Simulator::State::step() {
   do {
     const bool any_moving =
         std::any_of(robots.begin(), robots.end(), [](const auto& r) { return r->model.moving(); });
-    // Fine steps only while something moves and collisions are checked.
-    const SimTime next = (check && any_moving) ? std::min(target, t + options.collision_step) : target;
-    for (auto& r : robots) emit(*r, r->model.advance(next));
+    // Fine steps only while something moves and collisions are checked; at rest, a step ends where
+    // the sync line starts trajectories, so that the check follows them from their first instant.
+    SimTime next = target;
+    if (check && any_moving) {
+      next = std::min(target, t + options.collision_step);
+    } else if (check) {
+      for (const auto& r : robots)
+        if (const auto at = r->model.sync_check_at(); at && *at > t && *at < next) next = *at;
+    }
+    for (auto& r : robots) emit(*r, r->model.advance(next), true);  // all unsolicited
     if (check) check_collisions(next);
     t = next;
   } while (t < target);
@@ -511,10 +519,13 @@ Result<void> Simulator::power_on(std::span<const std::uint16_t> ids, bool sync_l
   return ok();
 }
 
-Result<void> Simulator::sync_pulse(std::span<const std::uint16_t> ids) {
+Result<void> Simulator::set_sync_line(std::span<const std::uint16_t> ids, bool high) {
   AXON_TRY(robots, lookup(state_->by_id, ids));
-  const SimTime t = state_->event_time();  // one edge, one instant for every robot it reaches
-  for (auto* r : robots) state_->emit(*r, r->model.sync_pulse(t), true);
+  // Every robot (and the collision check) to the present first: a recheck due before this change
+  // saw the line as it was. Then one edge, one instant for every robot it reaches.
+  state_->step();
+  const SimTime t = state_->event_time();
+  for (auto* r : robots) state_->emit(*r, r->model.set_sync_line(high, t), true);
   return ok();
 }
 
@@ -528,9 +539,10 @@ void Simulator::power_cycle(bool sync_line_low) {
   power_on(sync_line_low);
 }
 
-void Simulator::sync_pulse() {
+void Simulator::set_sync_line(bool high) {
+  state_->step();
   const SimTime t = state_->event_time();
-  for (auto& r : state_->robots) state_->emit(*r, r->model.sync_pulse(t), true);
+  for (auto& r : state_->robots) state_->emit(*r, r->model.set_sync_line(high, t), true);
 }
 
 Result<void> Simulator::force_collision(std::uint16_t id, Arm arm) {

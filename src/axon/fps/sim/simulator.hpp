@@ -16,8 +16,8 @@
 // last step, so every robot is at the same instant when the check compares them (with nothing
 // moving, time jumps to the present first). The protocol is unchanged
 // by the scale; only durations of physical processes shrink. Unless scale_protocol_timeouts is
-// set, the robots' boot time, bootloader wait and watchdog are stretched by the scale so that
-// they keep their real-time length for the host.
+// set, the robots' boot time, bootloader wait, watchdog and sync line recheck are stretched by the
+// scale so that they keep their real-time length for the host.
 //
 // Everything runs on one executor (like every can::Bus). A test can inject a core::ManualClock
 // and call step() after moving it, for runs that do not depend on the machine's speed.
@@ -107,16 +107,19 @@ class Simulator {
   // Frames lost to full receive buffers, all robots.
   [[nodiscard]] std::uint64_t receive_overflows() const noexcept;
 
-  // Power and the sync line, for every robot (what the PLC switches).
+  // Power and the sync line, for every robot (what the PLC switches). The sync line's level
+  // reaches every robot at one instant, after a step() to the present; a robot starts its
+  // trajectory PositionerConfig::sync_recheck after a rising edge if the line is still high then
+  // (PositionerModel::set_sync_line), and its reply goes out with the step that passes that instant.
   void power_off(bool save_position = true);
   void power_on(bool sync_line_low = false);
   void power_cycle(bool sync_line_low = false);
-  void sync_pulse();
+  void set_sync_line(bool high);
   // The same for the listed robots only (a sextant's power relay, robots on one sync line).
   // CoreErrc::invalid_argument names an unknown id; nothing is switched then.
   Result<void> power_off(std::span<const std::uint16_t> ids, bool save_position = true);
   Result<void> power_on(std::span<const std::uint16_t> ids, bool sync_line_low = false);
-  Result<void> sync_pulse(std::span<const std::uint16_t> ids);
+  Result<void> set_sync_line(std::span<const std::uint16_t> ids, bool high);
 
   // Faults.
   Result<void> force_collision(std::uint16_t id, Arm arm);
