@@ -136,7 +136,10 @@ TEST(BlmcMotorBoard, AnUndocumentedErrorCodeIsASafetyStopNamingIt) {
   ASSERT_TRUE(report.fault);
   EXPECT_EQ(report.fault->kind, host::FaultKind::undocumented_error) << report.fault_text;
   EXPECT_EQ(report.fault_text, "board sent undocumented error code 6");
-  EXPECT_EQ(sim.report().motors[0].iq_ref_a, 0.0);  // the host's zero reached the board
+  // The host's zero reaches the board through the bus thread, after the loop has ended: waited for
+  // (bounded), not read at once (under ASan in CI it was still on its way once).
+  for (int i = 0; i < 200 && sim.report().motors[0].iq_ref_a != 0.0; ++i) std::this_thread::sleep_for(10ms);
+  EXPECT_EQ(sim.report().motors[0].iq_ref_a, 0.0);
   EXPECT_GE(board.measurements().undocumented_errors, 1u);
   try {
     board.recover();
