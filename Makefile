@@ -1,6 +1,6 @@
 # axon: the two set-up commands are `make run` and `make test` (see README.md).
 # Each installs missing Debian packages, configures with CMake presets and builds with Ninja.
-.PHONY: all deps release debug run test test-soak bench soak asan test-asan tsan test-tsan fuzz fuzz-smoke clean
+.PHONY: all deps release debug run test test-soak bench soak asan test-asan tsan test-tsan fuzz fuzz-smoke fuzz-long clean
 
 JOBS ?= $(shell nproc)
 # ccache (when installed) shares compiled objects between clones of the project on one machine.
@@ -65,6 +65,14 @@ fuzz: deps
 FUZZ_SECONDS ?= 10
 fuzz-smoke: fuzz
 	@bash fuzz/smoke.sh build/asan $(FUZZ_SECONDS)
+
+# The long campaign: 30 minutes per target, FUZZ_JOBS at a time, each target's corpus kept in
+# build/fuzz-work/ from run to run (FUZZ_TARGETS="a b" for some of them). docs/reliability.md.
+FUZZ_LONG_SECONDS ?= 1800
+FUZZ_JOBS ?= 1
+fuzz-long: fuzz
+	@mkdir -p build/fuzz-work
+	@JOBS=$(FUZZ_JOBS) FUZZ_WORK=$(CURDIR)/build/fuzz-work bash fuzz/smoke.sh build/asan $(FUZZ_LONG_SECONDS)
 
 clean:
 	rm -rf build
