@@ -79,7 +79,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   require(after.received == before.received + 1);
   const auto accepted = after.accepted - before.accepted;
   const auto refused = (after.not_json - before.not_json) + (after.malformed - before.malformed) +
-                       (after.unknown - before.unknown) + (after.refused - before.refused);
+                       (after.unknown - before.unknown) + (after.refused - before.refused) +
+                       (after.oversized - before.oversized) + (after.busy - before.busy);
   require(accepted + refused == 1);
 
   const std::string commander = actor::header_text(message.headers, "commander_id");

@@ -88,8 +88,8 @@ int run_actor_fps(const ActorFpsOptions& o) {
     }
     const auto c = bus.core().counters();
     std::fprintf(stderr, "actor %s: %llu commands, %llu refused, %llu not understood\n", o.name.c_str(),
-                 static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.refused),
-                 static_cast<unsigned long long>(c.not_json + c.malformed + c.unknown));
+                 static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.refused + c.busy),
+                 static_cast<unsigned long long>(c.not_json + c.malformed + c.unknown + c.oversized));
     co_return 0;
   });
 }

@@ -1,11 +1,13 @@
 #include "axon/actor/actor_core.hpp"
 
 #include "axon/actor/command_line.hpp"
+#include "axon/core/log.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <system_error>
 #include <optional>
 #include <thread>
 
@@ -52,8 +54,8 @@ struct ActorCore::Running {
   std::atomic<bool> finished{false};
 };
 
-ActorCore::ActorCore(std::string name, std::function<void(Message)> publish)
-    : name_(std::move(name)), publish_(std::move(publish)) {
+ActorCore::ActorCore(std::string name, std::function<void(Message)> publish, ActorLimits limits)
+    : name_(std::move(name)), publish_(std::move(publish)), limits_(limits) {
   add_builtins();
 }
 
@@ -81,12 +83,19 @@ void ActorCore::add_builtins() {
 
 void ActorCore::refuse(const std::string& commander, const std::string& id, const std::string& reason,
                        std::uint64_t CoreCounters::*counter) {
+  std::uint64_t refusals = 0;
   {
     std::lock_guard lock(mutex_);
     ++(counters_.*counter);
     ++counters_.failed;
+    refusals = counters_.not_json + counters_.malformed + counters_.unknown + counters_.refused + counters_.oversized +
+               counters_.busy;
   }
-  spdlog::warn("{}: command refused: {}", name_, reason);
+  if (core::first_or_every(refusals, 100))
+    spdlog::warn("{}: command refused: {} ({} refused so far; logged on the first and every 100th)", name_, reason,
+                 refusals);
+  else
+    spdlog::debug("{}: command refused: {}", name_, reason);
   publish_(reply_message(MessageCode::failed, Keywords{{"error", reason}}, commander, id, name_));
 }
 
@@ -100,6 +109,11 @@ void ActorCore::handle(const Message& message) {
     ++counters_.received;
     if (id.empty()) id = fmt::format("{}-{}", name_, next_id_++);
   }
+  if (message.body.size() > limits_.max_body_bytes)
+    return refuse(commander, id,
+                  fmt::format("the message body is {} bytes, more than the {} a command may have", message.body.size(),
+                              limits_.max_body_bytes),
+                  &CoreCounters::oversized);
   auto text = command_string_of(message.body);
   if (!text) return refuse(commander, id, text.error().detail, &CoreCounters::not_json);
   auto line = split_command(text.value());
@@ -121,12 +135,23 @@ void ActorCore::handle(const Message& message) {
 
 void ActorCore::start(const Command::Id& who, CommandLine line, const Verb& verb) {
   std::string conflict;
+  std::size_t in_flight = 0;
   {
     std::lock_guard lock(mutex_);
-    if (verb.exclusive && !exclusive_running_.empty()) conflict = exclusive_running_;
-    else if (verb.exclusive) exclusive_running_ = verb.name;
-    if (conflict.empty()) ++counters_.accepted;
+    in_flight = running_.size();
+    if (in_flight >= limits_.max_running) {
+    } else if (verb.exclusive && !exclusive_running_.empty()) {
+      conflict = exclusive_running_;
+    } else {
+      if (verb.exclusive) exclusive_running_ = verb.name;
+      ++counters_.accepted;
+    }
   }
+  if (in_flight >= limits_.max_running)
+    return refuse(who.commander_id, who.command_id,
+                  fmt::format("busy: {} commands are running, the most this actor runs at once (try again later)",
+                              in_flight),
+                  &CoreCounters::busy);
   if (!conflict.empty())
     return refuse(who.commander_id, who.command_id,
                   fmt::format("{:?} refused: {:?} is running (stop it or wait for its end)", verb.name, conflict),
@@ -144,17 +169,22 @@ void ActorCore::start(const Command::Id& who, CommandLine line, const Verb& verb
   };
   auto command = std::make_shared<Command>(std::move(line), who, std::move(publish), name_);
   auto running = std::make_unique<Running>();
-  running->thread = std::thread([command, run = verb.run, done = &running->finished] {
-    try {
-      run(*command);
-      if (!command->done()) command->finish();
-    } catch (const std::exception& e) {
-      command->fail(e.what());
-    } catch (...) {
-      command->fail("unknown failure");
-    }
-    *done = true;
-  });
+  try {
+    running->thread = std::thread([command, run = verb.run, done = &running->finished] {
+      try {
+        run(*command);
+        if (!command->done()) command->finish();
+      } catch (const std::exception& e) {
+        command->fail(e.what());
+      } catch (...) {
+        command->fail("unknown failure");
+      }
+      *done = true;
+    });
+  } catch (const std::system_error& e) {  // the process is out of threads: this command fails, the actor goes on
+    command->fail(fmt::format("busy: no thread to run it ({})", e.what()));
+    return;
+  }
   std::lock_guard lock(mutex_);
   running_.push_back(std::move(running));
 }

@@ -4,7 +4,9 @@
 // the verb's handler on a thread of its own and turns what the handler writes into replies with
 // the convention's headers (message.hpp). Nothing a commander sends can crash it: a body that is
 // not JSON, a malformed or unknown command and a handler that throws each end in a failure reply
-// ('f', keyword `error` with the reason) and are counted.
+// ('f', keyword `error` with the reason) and are counted. A flood cannot exhaust it either: a body
+// over `max_body_bytes` is refused unparsed, a command beyond `max_running` running at once is
+// refused as busy, and refusals are logged on the first and every 100th (all are counted).
 //
 // Replies leave through the `publish` function given to the constructor, from the thread that
 // writes them (the caller of handle() for refusals, a command's thread otherwise): it must be
@@ -18,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <list>
@@ -75,6 +78,15 @@ struct CoreCounters {
   std::uint64_t unknown = 0;     // verbs the actor does not have
   std::uint64_t refused = 0;     // conflicting commands (an exclusive verb while one runs)
   std::uint64_t failed = 0;      // commands that ended with 'f' (their handler failed or threw)
+  std::uint64_t oversized = 0;   // bodies over max_body_bytes, refused unparsed
+  std::uint64_t busy = 0;        // commands refused because max_running were running (or no thread)
+};
+
+// What one actor takes on at once. A command's thread lives until its handler returns, so without
+// a bound a commander flooding a slow verb would start threads until the process fails.
+struct ActorLimits {
+  std::size_t max_running = 32;            // commands running at once
+  std::size_t max_body_bytes = 64 * 1024;  // a command line is a few hundred bytes at most
 };
 
 // The message that carries a reply: routing key reply.<commander_id> (reply.broadcast without a
@@ -85,7 +97,7 @@ Message reply_message(MessageCode code, const Keywords& keywords, const std::str
 
 class ActorCore {
  public:
-  ActorCore(std::string name, std::function<void(Message)> publish);
+  ActorCore(std::string name, std::function<void(Message)> publish, ActorLimits limits = {});
   ~ActorCore();  // waits for the running commands
   ActorCore(const ActorCore&) = delete;
   ActorCore& operator=(const ActorCore&) = delete;
@@ -115,6 +127,7 @@ class ActorCore {
 
   std::string name_;
   std::function<void(Message)> publish_;
+  ActorLimits limits_;
   std::vector<Verb> verbs_;
   mutable std::mutex mutex_;
   CoreCounters counters_;

@@ -113,7 +113,8 @@ struct FpsActor::Impl {
   json counters_json() const {
     const auto c = core.counters();
     return json{{"received", c.received}, {"accepted", c.accepted}, {"not_json", c.not_json}, {"malformed", c.malformed},
-                {"unknown", c.unknown},   {"refused", c.refused},   {"failed", c.failed}};
+                {"unknown", c.unknown},   {"refused", c.refused},   {"failed", c.failed},
+                {"oversized", c.oversized}, {"busy", c.busy}};
   }
 
   // The status keywords; read from the robots when the client is free, else from the last read.

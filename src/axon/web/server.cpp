@@ -5,6 +5,7 @@
 #include "axon/web/server.hpp"
 
 #include "axon/core/error.hpp"
+#include "axon/core/log.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
@@ -208,7 +209,7 @@ asio::awaitable<void> Server::Impl::session(tcp::socket socket) {
   error_code ec;
   if (connections > options.max_connections) {
     // Logged on the first refusal and every 100th after it: a flood stays one line in a hundred.
-    if (stats.refused++ % 100 == 0)
+    if (core::first_or_every(++stats.refused, 100))
       spdlog::warn("web: {} connections open, the limit is {}: a new one answered 503 ({} so far)", connections - 1,
                    options.max_connections, stats.refused);
     Response res = to_beast({503, "text/plain; charset=utf-8", "too many connections\n"}, 11, false);
