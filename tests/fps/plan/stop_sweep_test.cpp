@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <string>
 #include <vector>
 
@@ -86,6 +88,73 @@ TEST(StopSweep, TheBoundHoldsOnAFinerGrid) {
   const auto c = check_sweep_to_stops(p.model, 0, p.poses, coarse);
   const auto f = check_sweep_to_stops(p.model, 0, p.poses, fine);
   EXPECT_LE(c.min_clearance_mm, f.min_clearance_mm + 1e-9);
+}
+
+// ---- backing off ----
+
+// Robot 1 stretched towards robot 2 until its arm is `inside` mm within their buffers: where two
+// robots stop when the power goes mid-move.
+std::vector<Pose> in_contact(const CollisionModel& m, double inside) {
+  std::vector<Pose> poses{{0, 180}, {180, 180}};
+  for (double b = 180; b > 0; b -= 0.001) {
+    poses[0].beta_deg = b;
+    if (test::static_clearance(m, poses) < -inside) return poses;
+  }
+  ADD_FAILURE() << "no contact found";
+  return poses;
+}
+
+// The clearance of robot 1 to robot 2 along its move, on a grid finer than the planner's.
+double worst_on_the_way(const CollisionModel& m, const std::vector<Pose>& poses, const BackOff& b) {
+  double worst = 1e9;
+  for (int k = 0; k <= 4000; ++k) {
+    auto p = poses;
+    const double t = k / 4000.0;
+    p[0] = {b.from.alpha_deg + t * (b.to.alpha_deg - b.from.alpha_deg), b.from.beta_deg + t * (b.to.beta_deg - b.from.beta_deg)};
+    worst = std::min(worst, test::static_clearance(m, p));
+  }
+  return worst;
+}
+
+TEST(BackOff, APairLeftInContactIsSeparatedByTwoDegreesThatNeverMakeItWorse) {
+  const auto m = test::two_robots();
+  const auto poses = in_contact(m, 0.083);
+  const auto b = plan_back_off(m, 0, poses);
+  ASSERT_TRUE(b.found);
+  EXPECT_TRUE(b.clear);
+  EXPECT_EQ(std::abs(b.step_deg), 2.0);  // the document's 2 degrees are enough here
+  EXPECT_LT(b.clearance_before_mm, -0.08);
+  EXPECT_GE(b.clearance_after_mm, 0.0);
+  ASSERT_EQ(b.in_contact.size(), 1u);
+  EXPECT_EQ(b.in_contact[0].rfind("robot 2 (-0.08", 0), 0u) << b.in_contact[0];
+  // Never closer than at the start by more than the slack of the 0.05 deg grid.
+  const double slack = 0.5 * 0.05 * kRad * (m.robot(0).reach_mm() + m.robot(0).collision_length_mm());
+  EXPECT_GE(worst_on_the_way(m, poses, b), b.clearance_before_mm - slack);
+  auto after = poses;
+  after[0] = b.to;
+  EXPECT_GE(test::static_clearance(m, after), 0.0);
+}
+
+TEST(BackOff, ARobotThatCollidedWithNothingNearStillMovesTheDocumentsTwoDegrees) {
+  const auto m = test::two_robots();
+  const std::vector<Pose> poses{{180, 180}, {180, 180}};
+  const auto b = plan_back_off(m, 0, poses);
+  ASSERT_TRUE(b.found);
+  EXPECT_TRUE(b.clear);
+  EXPECT_EQ(std::abs(b.step_deg), 2.0);
+  EXPECT_TRUE(b.in_contact.empty());
+}
+
+TEST(BackOff, NoMoveInsideTheAngleLimitsIsNotFoundAndTheContactIsNamed) {
+  auto specs = std::vector<RobotSpec>{RobotSpec{1, {0, 0}, {}, {}, 2.0}, RobotSpec{2, {22.4, 0}, {}, {}, 2.0}};
+  const auto free_model = test::build(specs);
+  const auto poses = in_contact(free_model, 0.083);
+  specs[0].limits = {poses[0].alpha_deg - 1, poses[0].alpha_deg + 1, poses[0].beta_deg - 1, poses[0].beta_deg + 1};
+  const auto boxed = test::build(specs);
+  const auto b = plan_back_off(boxed, 0, poses);
+  EXPECT_FALSE(b.found);
+  ASSERT_EQ(b.in_contact.size(), 1u);
+  EXPECT_EQ(b.in_contact[0].rfind("robot 2", 0), 0u);
 }
 
 }  // namespace

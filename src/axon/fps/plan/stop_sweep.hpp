@@ -44,4 +44,40 @@ struct StopSweep {
 StopSweep check_sweep_to_stops(const CollisionModel& model, std::size_t i, std::span<const Pose> poses,
                                const StopSweepOptions& options = {});
 
+// ---- Backing off ---------------------------------------------------------------------------------
+// After a collision the document (9.4.1) asks for the flags to be cleared and the robot moved away
+// by at least 2 degrees; after a power loss mid-move, robots that stopped dead may stand inside a
+// neighbour's collision buffer, and the planner holds such pairs (docs/fps-plan.md). A back-off is
+// one arm of one robot turned by a few degrees (one arm at a time: its path does not depend on the
+// speeds), chosen so that it is certified on a grid of `grid_deg`:
+// - a body the robot is in contact with, or nearly (closer than the grid's slack), never comes
+//   closer along the move than it is at the start, at any grid pose (between grid poses it may, by
+//   at most the slack: 0.5 * grid * (reach + collision length) in radians, about 0.01 mm at 0.05 deg);
+// - every other body stays clear by the slack (proven in between as for the stop sweep);
+// - the arm stays inside its angle limits.
+// Of the certified moves the smallest step that ends clear of everything wins, then the one that
+// ends farthest from the nearest body; when none ends clear, the one that gains the most.
+
+struct BackOffOptions {
+  std::vector<double> steps_deg{2, 3, 4, 6, 8};  // tried in this order (the document's 2 degrees first)
+  double grid_deg = 0.05;
+};
+
+struct BackOff {
+  bool found = false;  // a certified move exists (to, arm, step_deg say which)
+  bool clear = false;  // and it ends clear of every body at the full buffer
+  Pose from;
+  Pose to;
+  char arm = 0;        // 'a' or 'b'
+  double step_deg = 0; // signed
+  double clearance_before_mm = 0;  // the smallest over every body, at the full buffer
+  double clearance_after_mm = 0;
+  // The bodies within the slack at the start, nearest first: "robot 12 (-0.083 mm)".
+  std::vector<std::string> in_contact;
+};
+
+// Robot `i` of `model` backing off from poses[i]; the others stand at their poses.
+BackOff plan_back_off(const CollisionModel& model, std::size_t i, std::span<const Pose> poses,
+                      const BackOffOptions& options = {});
+
 }  // namespace axon::fps::plan
