@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <iostream>
 #include <thread>
 
 namespace axon::fps {
@@ -160,6 +161,94 @@ TEST_F(ClientOnPlane, ADatumSearchWhoseWayToTheStopsIsBlockedIsRefusedNamingTheN
   const auto truth = plane.arms(3);
   ASSERT_TRUE(truth.has_value());
   EXPECT_LT(error_deg(*truth, {*blocked, 150}), 0.1) << "the robot moved";
+}
+
+// The poses the simulator says the robots stand at, in model order.
+std::vector<plan::Pose> true_poses(const sim::SimulatedPlane& plane, const plan::CollisionModel& model) {
+  std::vector<plan::Pose> poses(model.size());
+  for (std::size_t i = 0; i < model.size(); ++i) {
+    const auto a = plane.arms(static_cast<std::uint16_t>(model.robot(i).id()));
+    if (a) poses[i] = {a->alpha, a->beta};
+  }
+  return poses;
+}
+
+std::vector<plan::Contact> contacts_at(const plan::CollisionModel& model, const std::vector<plan::Pose>& poses) {
+  std::vector<plan::Segment> segs(model.size());
+  std::vector<plan::Contact> out;
+  model.segments(poses, segs);
+  model.find_contacts(segs, out);
+  return out;
+}
+
+// A collision leaves the robot where the simulator's collision check stopped it, inside its
+// neighbour's collision buffer (so does a power loss mid-move, for the robots that stop dead).
+// After unlock() (which clears the flags), back_off() finds the pair and moves one robot out,
+// certified, by the document's 2 degrees or more (9.4.1); the simulator's truth has no contact left.
+TEST_F(ClientOnPlane, BackOffSeparatesARobotLeftInsideItsNeighboursBuffer) {
+  const auto model = plan::model_from_layout(plane.plane()).value();
+  const auto start = true_poses(plane, model);
+  // A robot stretched (beta down from folded) until it is 0.3 to 0.5 mm inside one neighbour's
+  // buffer and touches nothing else: where it is sent, and where the collision check stops it.
+  std::optional<plan::Pose> inside;
+  std::size_t moved = 0;
+  for (std::size_t r = 0; r < model.size() && !inside; ++r) {
+    for (double a = 0; a < 360 && !inside; a += 5) {
+      auto poses = start;
+      for (double b = 180; b > 0; b -= 0.02) {
+        poses[r] = {a, b};
+        const auto c = contacts_at(model, poses);
+        if (c.empty()) continue;
+        if (c.size() != 1 || c[0].kind != plan::Contact::Kind::robot || c[0].clearance_mm < -0.5) break;
+        if (c[0].clearance_mm < -0.3) {
+          inside = poses[r];
+          moved = r;
+          break;
+        }
+      }
+    }
+  }
+  ASSERT_TRUE(inside.has_value());
+  const auto id = static_cast<std::uint16_t>(model.robot(moved).id());
+  ASSERT_TRUE(fps.goto_absolute({{id, {inside->alpha_deg, 180}}}).completed);  // alpha first, folded
+  const auto crash = fps.goto_absolute({{id, {inside->alpha_deg, inside->beta_deg}}});
+  EXPECT_FALSE(crash.completed) << crash.summary;
+  EXPECT_GE(plane.collisions(), 1u);
+  const auto left = contacts_at(model, true_poses(plane, model));
+  ASSERT_EQ(left.size(), 1u) << "the simulator stopped the robot outside the buffer";
+  try {
+    fps.back_off();
+    FAIL() << "a back-off went out while the array was locked";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), host::HostErrc::locked) << e.what();
+  }
+  fps.unlock();
+
+  const auto out = fps.back_off();
+  EXPECT_TRUE(out.ok) << out.summary;
+  ASSERT_EQ(out.contacts_before.size(), 1u) << out.summary;
+  ASSERT_EQ(out.moves.size(), 1u) << out.summary;
+  EXPECT_TRUE(out.moves[0].moved) << out.moves[0].problem;
+  EXPECT_GE(std::abs(out.moves[0].step_deg), 2.0);
+  EXPECT_LT(out.moves[0].clearance_before_mm, 0.0);
+  EXPECT_TRUE(out.contacts_after.empty()) << out.summary;
+  EXPECT_TRUE(contacts_at(model, true_poses(plane, model)).empty()) << "the simulator's robots still touch";
+  std::cout << out.summary;
+}
+
+// After a collision (the array locks by itself) and unlock(), which clears the flags, the robot
+// that reported it moves the document's 2 degrees away.
+TEST_F(ClientOnPlane, AfterACollisionAndUnlockTheRobotBacksOffTwoDegrees) {
+  plane.inject_collision(3);
+  for (int i = 0; i < 500 && !fps.locked(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_TRUE(fps.locked()) << "the collision did not lock the array";
+  fps.unlock();
+  const auto before = *plane.arms(3);
+  const auto out = fps.back_off({3});
+  ASSERT_EQ(out.moves.size(), 1u);
+  EXPECT_TRUE(out.moves[0].moved) << out.summary;
+  EXPECT_TRUE(out.ok) << out.summary;
+  EXPECT_NEAR(error_deg(*plane.arms(3), before), 2.0, 0.1);
 }
 
 TEST_F(ClientOnPlane, CalibrateRunsMotorsAndDatumsAndSaves) {

@@ -3,6 +3,7 @@
 #include "axon/can/open.hpp"
 #include "axon/core/loop_thread.hpp"
 #include "axon/fps/host/array.hpp"
+#include "axon/fps/host/back_off.hpp"
 #include "axon/fps/host/datum_check.hpp"
 #include "axon/fps/host/focal_plane_array.hpp"
 #include "axon/fps/host/plan_and_move.hpp"
@@ -257,6 +258,31 @@ Angles Client::go_to_datums(std::uint16_t id) {
     need(std::move(done));
     auto at = co_await p->read_position();
     co_return angles(need(std::move(at)));
+  });
+}
+
+namespace {
+
+BackOffOutcome outcome_of(const host::BackOffReport& r) {
+  BackOffOutcome out{r.contacts_before, {}, r.contacts_after, r.ok(), r.summary()};
+  for (const auto& s : r.steps)
+    out.moves.push_back({s.id, s.moved, s.plan.arm, s.plan.step_deg, {s.plan.from.alpha_deg, s.plan.from.beta_deg},
+                         {s.plan.to.alpha_deg, s.plan.to.beta_deg}, s.plan.clearance_before_mm, s.plan.clearance_after_mm,
+                         s.problem});
+  return out;
+}
+
+}  // namespace
+
+BackOffOutcome Client::back_off(const std::vector<std::uint16_t>& ids) {
+  auto& array = impl_->open_array();
+  auto model = datum_model(*impl_);
+  if (!model) throw Exception(Error(host::HostErrc::invalid_argument, "back_off needs the layout: open(plane) or set_layout()"));
+  return impl_->run([&array, ids, model]() -> asio::awaitable<BackOffOutcome> {
+    host::BackOffRequest request;
+    request.ids = ids;
+    auto r = co_await host::back_off(array, *model, request);
+    co_return outcome_of(need(std::move(r)));
   });
 }
 

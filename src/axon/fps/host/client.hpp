@@ -139,6 +139,27 @@ struct UnlockOutcome {
   std::vector<std::uint16_t> silent;
 };
 
+// One robot moved away from what it touched (or why it was not).
+struct BackOffMove {
+  std::uint16_t id = 0;
+  bool moved = false;
+  char arm = 0;         // 'a' or 'b': the arm that turned
+  double step_deg = 0;  // signed
+  Angles from;
+  Angles to;
+  double clearance_before_mm = 0;  // to the nearest body, at the full collision buffer
+  double clearance_after_mm = 0;   // as planned
+  std::string problem;             // why it did not move ("" when it did)
+};
+
+struct BackOffOutcome {
+  std::vector<std::string> contacts_before;  // "robot 1 / robot 2 (-0.083 mm)"
+  std::vector<BackOffMove> moves;
+  std::vector<std::string> contacts_after;
+  bool ok = false;      // every robot moved and no contact is left
+  std::string summary;  // one line per move and contact
+};
+
 class Client {
  public:
   explicit Client(ClientConfig config = {});
@@ -188,6 +209,14 @@ class Client {
   // cogging up to 40: raise set_call_timeout() first when needed. Refused while locked
   // (HostErrc::locked).
   CalibrationOutcome calibrate(std::uint16_t id, const CalibrationSteps& steps = {});
+
+  // Moves robots out of a contact (host/back_off.hpp): after a collision and unlock(), the robot
+  // that reported it (the protocol document's 2 degrees away, 9.4.1); with no ids, every robot in
+  // contact at the full collision buffer, as a power loss mid-move can leave them. One arm of one
+  // robot at a time, each move certified against the neighbours' read positions; what could not be
+  // moved is in the outcome with the reason. Needs the layout (HostErrc::invalid_argument); refused
+  // while locked (HostErrc::locked).
+  BackOffOutcome back_off(const std::vector<std::uint16_t>& ids = {});
 
   // Locks the array and aborts every robot on every bus; moves are refused until unlock().
   StopOutcome emergency_stop(const std::string& reason = "emergency stop");
