@@ -3,6 +3,7 @@
 // broadcast or by the sync line, firmware upgrade, the cold policy and correction iterations after
 // a measurement of the fibres.
 #include "commands.hpp"
+#include "axon/fps/host/back_off.hpp"
 #include "axon/fps/host/focal_plane_array.hpp"
 #include "axon/fps/host/cold_control.hpp"
 #include "axon/fps/host/plane_correct.hpp"
@@ -10,6 +11,7 @@
 #include "axon/fps/host/trajectory_build.hpp"
 #include "axon/fps/host/trajectory_speed.hpp"
 #include "checks.hpp"
+#include "id_list.hpp"
 #include "fps_json.hpp"
 #include "fps_stop.hpp"
 #include "axon/fps/plan/layout_model.hpp"
@@ -68,6 +70,8 @@ struct PlaneArgs {
   double tolerance_um = 5;        // correct
   int iterations = 3;             // correct
   double wait_s = 600;            // correct: for each measurement file to appear
+  std::vector<std::string> backoff_ids;  // backoff: empty = every robot in contact
+  bool unlock = false;                   // backoff: STOP_TRAJECTORY on every bus first
 };
 
 
@@ -333,6 +337,32 @@ asio::awaitable<int> plane_cold(host::FocalPlaneArray& fpa, const PlaneArgs& a, 
   co_return rc;
 }
 
+// `fps plane backoff`: robots out of a contact (host/back_off.hpp); 0 when none is left.
+asio::awaitable<int> plane_back_off(host::FocalPlaneArray& fpa, const PlaneArgs& a, const fps::FocalPlane& plane) {
+  const auto model = need(fps::plan::model_from_layout(plane));
+  if (a.unlock) {
+    auto u = co_await fpa.array().unlock();
+    need(std::move(u));
+  }
+  host::BackOffRequest request;
+  if (!a.backoff_ids.empty()) request.ids = need(parse_id_lists(a.backoff_ids));
+  auto r = co_await host::back_off(fpa.array(), model, std::move(request));
+  const auto rep = need(std::move(r));
+  if (a.json) {
+    nlohmann::json moves = nlohmann::json::array();
+    for (const auto& s : rep.steps)
+      moves.push_back({{"id", s.id}, {"moved", s.moved}, {"arm", s.plan.arm == 'a' ? "alpha" : s.plan.arm == 'b' ? "beta" : ""},
+                       {"step_deg", s.plan.step_deg}, {"from", {s.plan.from.alpha_deg, s.plan.from.beta_deg}},
+                       {"to", {s.plan.to.alpha_deg, s.plan.to.beta_deg}}, {"clearance_before_mm", s.plan.clearance_before_mm},
+                       {"clearance_after_mm", s.plan.clearance_after_mm}, {"problem", s.problem}});
+    print_plane_json({{"ok", rep.ok()}, {"contacts_before", rep.contacts_before}, {"moves", moves},
+                      {"contacts_after", rep.contacts_after}});
+  } else {
+    std::fputs(rep.summary().c_str(), stdout);
+  }
+  co_return rep.ok() ? 0 : 1;
+}
+
 // One `fps plane` action on the connected plane; returns the exit code.
 asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a, const std::string& action,
                                   const fps::FocalPlane& plane, const SetOnSignal& set_on_signal,
@@ -352,6 +382,10 @@ asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a
     rc = co_await plane_move(fpa, a);
   }
   if (action == "cold") rc = co_await plane_cold(fpa, a, set_on_signal);
+  if (action == "backoff") {
+    stop_robots_on_signal(set_on_signal, fpa.array());
+    rc = co_await plane_back_off(fpa, a, plane);
+  }
   if (action == "correct") rc = co_await plane_correct(fpa, a, plane, set_on_signal);
   if (action == "upgrade") {
     if (!uo.expected_version) std::printf("no --version given: versions are reported, not checked\n");
@@ -479,6 +513,12 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions& global) {
   cr->add_option("--wait", a.wait_s, "seconds to wait for each later --measured file to appear (default 600)")
       ->check(CLI::Range(0.0, 86400.0));
   cr->callback([args, &global] { global.exit_code = run_plane(*args, "correct"); });
+  auto* bo = p->add_subcommand("backoff",
+                               "move robots out of a contact, one arm by 2 degrees or more, each move certified against the "
+                               "neighbours (after a collision and unlock, or a power loss mid-move)");
+  bo->add_option("ids", a.backoff_ids, "robots to move (3, 1-6, 1,4,9); default: every robot in contact");
+  bo->add_flag("--unlock", a.unlock, "first STOP_TRAJECTORY on every bus, which clears the collision flags (9.4.1)");
+  bo->callback([args, &global] { global.exit_code = run_plane(*args, "backoff"); });
   up->callback([args, &global] {
     if (args->plc.empty()) throw Exception(usage("fps plane upgrade needs --plc"));
     global.exit_code = run_plane(*args, "upgrade");

@@ -49,6 +49,6 @@ struct BackOffRequest {
 // the array). Everything else (no certified move, a neighbour whose position is unknown, a move
 // that failed) is in the report.
 boost::asio::awaitable<Result<BackOffReport>> back_off(Array& array, const plan::CollisionModel& model,
-                                                       BackOffRequest request = {});
+                                                       BackOffRequest request);
 
 }  // namespace axon::fps::host
