@@ -105,6 +105,25 @@ void bind_outcomes(py::module_& m) {
   py::class_<fps::UnlockOutcome>(m, "UnlockOutcome")
       .def_readonly("acknowledged", &fps::UnlockOutcome::acknowledged)
       .def_readonly("silent", &fps::UnlockOutcome::silent);
+  py::class_<fps::BackOffMove>(m, "BackOffMove", "One robot moved out of a contact, or why it was not.")
+      .def_readonly("id", &fps::BackOffMove::id)
+      .def_readonly("moved", &fps::BackOffMove::moved)
+      .def_property_readonly("arm", [](const fps::BackOffMove& b) {
+        return std::string(b.arm == 'a' ? "alpha" : b.arm == 'b' ? "beta" : "");
+      })
+      .def_readonly("step_deg", &fps::BackOffMove::step_deg)
+      .def_property_readonly("start", [](const fps::BackOffMove& b) { return std::pair{b.from.alpha, b.from.beta}; })
+      .def_property_readonly("end", [](const fps::BackOffMove& b) { return std::pair{b.to.alpha, b.to.beta}; })
+      .def_readonly("clearance_before_mm", &fps::BackOffMove::clearance_before_mm)
+      .def_readonly("clearance_after_mm", &fps::BackOffMove::clearance_after_mm)
+      .def_readonly("problem", &fps::BackOffMove::problem);
+  py::class_<fps::BackOffOutcome>(m, "BackOffOutcome")
+      .def_readonly("contacts_before", &fps::BackOffOutcome::contacts_before)
+      .def_readonly("moves", &fps::BackOffOutcome::moves)
+      .def_readonly("contacts_after", &fps::BackOffOutcome::contacts_after)
+      .def_readonly("ok", &fps::BackOffOutcome::ok)
+      .def_readonly("summary", &fps::BackOffOutcome::summary)
+      .def("__bool__", [](const fps::BackOffOutcome& o) { return o.ok; });
 }
 
 std::unique_ptr<Client> make_client(double reply_timeout_s, double call_timeout_s, double poll_interval_s,
@@ -147,6 +166,11 @@ void bind_client_moves(py::class_<Client>& c) {
        py::arg("seed") = 1, py::arg("park_bad_targets") = true, py::arg("allow_partial") = false,
        "Plans from where every robot of the layout stands to {id: (alpha, beta)} or a target file (robots not "
        "listed fold), verifies and runs it.")
+      .def("back_off", [](Client& c, const std::vector<std::uint16_t>& ids) {
+         return blocking(c, [&c, ids] { return c.back_off(ids); });
+       }, py::arg("ids") = std::vector<std::uint16_t>{},
+       "Moves robots out of a contact: the listed ones (after a collision and unlock(), 2 degrees or more away), "
+       "or every robot in contact; one arm at a time, each move certified against the neighbours. Needs the layout.")
       .def("emergency_stop", [](Client& c, const std::string& reason) {
          return blocking(c, [&c, reason] { return c.emergency_stop(reason); });
        }, py::arg("reason") = "emergency stop", "Locks the array and aborts every robot on every bus.")

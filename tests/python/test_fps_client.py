@@ -89,6 +89,26 @@ def test_a_collision_locks_the_array_and_moves_raise_collision_locked(client, be
     assert client.goto({rid: (50.0, 170.0)}).completed
 
 
+def test_after_a_collision_and_unlock_the_robot_backs_off_two_degrees(client, benchtop):
+    rid = client.robots[0]
+    benchtop.inject_collision(rid)
+    for _ in range(200):
+        if client.locked:
+            break
+        time.sleep(0.01)
+    with pytest.raises(axon.fps.CollisionLocked):
+        client.back_off([rid])
+    client.unlock()
+    before = benchtop.arms(rid)
+    out = client.back_off([rid])
+    assert out and out.ok, out.summary
+    assert [m.id for m in out.moves] == [rid] and out.moves[0].moved
+    assert out.moves[0].arm in ("alpha", "beta") and abs(out.moves[0].step_deg) >= 2.0
+    after = benchtop.arms(rid)
+    assert max(abs(after[0] - before[0]), abs(after[1] - before[1])) == pytest.approx(abs(out.moves[0].step_deg), abs=0.1)
+    assert client.back_off().contacts_before == []  # nothing in contact: nothing to do
+
+
 def test_calls_on_an_unopened_client_and_unknown_robots_raise_their_types(benchtop):
     fps = axon.fps.Client()
     with pytest.raises(axon.fps.InvalidArgument):
