@@ -8,6 +8,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace axon::actor {
 namespace {
 
@@ -87,6 +89,31 @@ TEST_F(FpsActorOnBenchtop, ACollisionLocksAndEveryListenerGetsTheAlert) {
   ASSERT_TRUE(u);
   EXPECT_EQ(code_of(*u), ':') << u->body;
   EXPECT_EQ(body_of(*u)["locked"], false);
+}
+
+// After the collision and unlock, `backoff ID` moves the robot the document's 2 degrees away and
+// says how; an id that is not on the buses is refused with the reason.
+TEST_F(FpsActorOnBenchtop, BackoffMovesTheRobotThatCollidedAwayAfterUnlock) {
+  const auto id = first_robot();
+  plane.inject_collision(id);
+  ASSERT_TRUE(out.wait_for([](const Message& m) { return body_of(m).contains("collision_alert"); }));
+  core.handle(command("unlock", "u"));
+  ASSERT_TRUE(out.final_of("u"));
+  core.handle(command("backoff " + std::to_string(id), "b"));
+  const auto b = out.final_of("b");
+  ASSERT_TRUE(b);
+  EXPECT_EQ(code_of(*b), ':') << b->body;
+  const auto kw = body_of(*b)["back_off"];
+  EXPECT_EQ(kw["ok"], true);
+  ASSERT_EQ(kw["moves"].size(), 1u) << b->body;
+  EXPECT_EQ(kw["moves"][0]["id"], id);
+  EXPECT_EQ(kw["moves"][0]["moved"], true);
+  EXPECT_GE(std::abs(kw["moves"][0]["step_deg"].get<double>()), 2.0);
+  core.handle(command("backoff 4000", "bad"));
+  const auto bad = out.final_of("bad");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(code_of(*bad), 'f');
+  EXPECT_NE(body_of(*bad)["error"].get<std::string>().find("robot 4000 is not on the buses"), std::string::npos) << bad->body;
 }
 
 }  // namespace

@@ -250,6 +250,9 @@ def check_commands(c, port, actor_proc):
     assert c.command('goto %d 20 170' % ids[0])[-1][0] == 'f'
     r = c.command('unlock')
     assert r[-1][0] == ':' and r[-1][1]['locked'] is False, r
+    r = c.command('backoff %d' % ids[3])  # the document's move away after a collision
+    assert r[-1][0] == ':' and r[-1][1]['back_off']['ok'] is True, r
+    assert r[-1][1]['back_off']['moves'][0]['moved'] is True, r
     assert any('robots' in kw for _, kw in c.broadcasts), 'no periodic status broadcast'
 
 

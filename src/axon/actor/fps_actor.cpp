@@ -52,6 +52,17 @@ std::optional<double> number(const std::string& s) {
 }
 
 // `ID ALPHA BETA` triplets; ID `all` stands for every known robot.
+// A robot id argument of `verb`, one of the robots found on the buses.
+std::uint16_t robot_id(const std::string& arg, const std::vector<std::uint16_t>& known, std::string_view verb) {
+  const auto id = number(arg);
+  const bool whole = id && *id >= 0 && *id <= 65535 && *id == static_cast<double>(static_cast<std::uint16_t>(*id));
+  if (!whole) throw Exception(Error(CoreErrc::invalid_argument, fmt::format("{}: {:?} is not a robot id", verb, arg)));
+  const auto robot = static_cast<std::uint16_t>(*id);
+  if (std::find(known.begin(), known.end(), robot) == known.end())
+    throw Exception(Error(CoreErrc::invalid_argument, fmt::format("{}: robot {} is not on the buses", verb, robot)));
+  return robot;
+}
+
 std::map<std::uint16_t, fps::Angles> parse_targets(const std::vector<std::string>& args,
                                                    const std::vector<std::uint16_t>& known) {
   if (args.empty() || args.size() % 3 != 0)
@@ -66,15 +77,22 @@ std::map<std::uint16_t, fps::Angles> parse_targets(const std::vector<std::string
       for (auto id : known) targets[id] = {*alpha, *beta};
       continue;
     }
-    const auto id = number(args[i]);
-    const bool whole = id && *id >= 0 && *id <= 65535 && *id == static_cast<double>(static_cast<std::uint16_t>(*id));
-    if (!whole) throw Exception(Error(CoreErrc::invalid_argument, fmt::format("goto: {:?} is not a robot id", args[i])));
-    const auto robot = static_cast<std::uint16_t>(*id);
-    if (std::find(known.begin(), known.end(), robot) == known.end())
-      throw Exception(Error(CoreErrc::invalid_argument, fmt::format("goto: robot {} is not on the buses", robot)));
-    targets[robot] = {*alpha, *beta};
+    targets[robot_id(args[i], known, "goto")] = {*alpha, *beta};
   }
   return targets;
+}
+
+json back_off_json(const fps::BackOffOutcome& out) {
+  json moves = json::array();
+  for (const auto& m : out.moves)
+    moves.push_back({{"id", m.id},
+                     {"moved", m.moved},
+                     {"arm", m.arm == 'a' ? "alpha" : m.arm == 'b' ? "beta" : ""},
+                     {"step_deg", m.step_deg},
+                     {"clearance_before_mm", m.clearance_before_mm},
+                     {"clearance_after_mm", m.clearance_after_mm},
+                     {"problem", m.problem}});
+  return {{"ok", out.ok}, {"contacts_before", out.contacts_before}, {"moves", moves}, {"contacts_after", out.contacts_after}};
 }
 
 }  // namespace
@@ -192,6 +210,17 @@ struct FpsActor::Impl {
     c.finish({{"stopped", {{"while_moving", false}}}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}});
   }
 
+  void back_off(Command& c) {
+    std::lock_guard lock(device);
+    std::vector<std::uint16_t> ids;
+    for (const auto& a : c.args()) ids.push_back(robot_id(a, client.robots(), "backoff"));
+    const auto out = client.back_off(ids);
+    remember(client.status());
+    json kw{{"back_off", back_off_json(out)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
+    if (out.ok) c.finish(std::move(kw));
+    else c.fail(out.summary, std::move(kw));
+  }
+
   void unlock(Command& c) {
     std::lock_guard lock(device);
     const auto out = client.unlock();
@@ -265,6 +294,7 @@ FpsActor::FpsActor(ActorCore& core, fps::Client& client, FpsActorOptions options
   core.add({"stop", "stop", false, [i](Command& c) { i->stop(c); }});
   core.add({"abort", "abort", false, [i](Command& c) { i->stop(c); }});
   core.add({"unlock", "unlock", true, [i](Command& c) { i->unlock(c); }});
+  core.add({"backoff", "backoff [ID ...] (no ID: every robot in contact)", true, [i](Command& c) { i->back_off(c); }});
   impl_->watcher = std::thread([i] { i->watch(); });
 }
 

@@ -5,13 +5,14 @@
 //   goto ID ALPHA BETA [...]     moves one robot or several at once (ID `all`: every robot)
 //   stop | abort                 aborts every robot (during a move this also locks the array)
 //   unlock                       clears collision flags and the lock
+//   backoff [ID ...]             moves robots out of a contact (fps::Client::back_off)
 //
 // and writes unsolicited keywords to every listener: `locked`/`locked_by` and a `collision_alert`
 // when the array locks (checked every FpsActorOptions::watch_period_s, 20 ms by default, on a
 // thread of its own), the status every status_period_s, and `move_progress` to the commander of a
 // running move every progress_period_s.
 //
-// goto and unlock are exclusive: a second one while one runs is refused. The client is called by
+// goto, unlock and backoff are exclusive: a second one while one runs is refused. The client is called by
 // one command at a time; a status asked during a move answers from the status read before it
 // (keyword `stale`), with the move's progress. The collision safety stays the client's own
 // (fps::Client: any collision report locks the array and aborts every robot), bus or no bus.
