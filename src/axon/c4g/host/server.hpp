@@ -30,6 +30,7 @@
 // for drive off.
 #pragma once
 
+#include "axon/c4g/host/controller_watch.hpp"
 #include "axon/c4g/host/cycle_thread.hpp"
 #include "axon/c4g/host/pcap_recorder.hpp"
 #include "axon/c4g/host/safety.hpp"
@@ -140,6 +141,8 @@ struct ServerOptions {
   // Soft control switching intervals T1, T2, T3 of the controller (the PC infers the switch's phase
   // from the modes and these; they must match the controller's configuration).
   protocol::SwitchTimes soft_switch{};
+  // How the controller's errors are recognised from the packets (controller_watch.hpp).
+  ControllerWatchOptions watch{};
 };
 
 enum class ServerState : std::uint8_t {
@@ -205,6 +208,8 @@ class Server : private CycleHandler {
   [[nodiscard]] const ServerCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] Safety& safety() noexcept { return safety_; }
   [[nodiscard]] const Safety& safety() const noexcept { return safety_; }
+  // The controller's errors as the packets show them, named as the manual names them (any thread).
+  [[nodiscard]] const ControllerWatch& controller_errors() const noexcept { return watch_; }
   [[nodiscard]] const SwitchTracker& switch_tracker_unsafe() const noexcept { return switch_; }  // cycle thread only
   [[nodiscard]] const CycleThread& cycle() const noexcept { return *cycle_; }
   [[nodiscard]] const core::RealtimeReport& realtime_report() const noexcept { return cycle_->realtime_report(); }
@@ -299,6 +304,7 @@ class Server : private CycleHandler {
   std::int32_t last_num_ = -1;           // the session's latest protocol number (-1: none yet)
   int late_in_row_ = 0;
   SwitchTracker switch_;
+  ControllerWatch watch_;
   std::array<float, protocol::kMaxAxes> last_target_{};
   std::array<bool, protocol::kMaxAxes> have_target_{};
   std::array<bool, protocol::kMaxAxes> exit_sent_{};
