@@ -240,6 +240,33 @@ TEST(ControllerErrorsAgainstSim, RepliesThatComeTooLateEndInTheCommunicationErro
   EXPECT_EQ(server->controller_errors().last(), E::communication);
 }
 
+// Modes 1xx (not available on the controller, manual 14.13): the PC's measure reaches the controller
+// in D3 and, with no processing documented, moves nothing.
+TEST(ControllerErrorsAgainstSim, SensorModesCarryThePcsMeasureToTheController) {
+  for (int mode : {101, 102, 103}) {
+    Pc pc;
+    auto k = std::make_shared<int>(0);
+    pc.cycle = [k, mode](const H::CycleContext& ctx, H::ReplyBuilder& r) {
+      if (ctx.request.axes[0].mode != mode) return;
+      for (std::size_t i = 0; i < r.axis_count(); ++i) r.set_measure(i, 0.25f + 0.01f * static_cast<float>(i));
+      if (++*k > 50) r.exit_from_open(1);
+    };
+    auto server = serve(pc);
+    const auto run = play(*server, "steps:\n  - drive_on\n  - go_open: {type: B, mode: " + std::to_string(mode) +
+                                       "}\n  - wait_for_pc: {timeout: 5}\n  - exit_open\n");
+    server->stop();
+    EXPECT_TRUE(run.c->scenario_done()) << run.log();
+    EXPECT_EQ(run.c->stats().refused_requests, 0u) << run.log();
+    EXPECT_FLOAT_EQ(run.c->axis_measure(0), 0.25f) << "mode " << mode;
+    EXPECT_FLOAT_EQ(run.c->axis_measure(5), 0.30f) << "mode " << mode;
+    EXPECT_EQ(server->safety().reason(), H::FaultReason::none) << server->summary();
+    EXPECT_EQ(server->counters().unused_fields.load(), 0u);
+    const auto joints = run.c->joint_degrees(1);
+    ASSERT_EQ(joints.size(), 6u);
+    for (double j : joints) EXPECT_NEAR(j, 0.0, 1e-3) << "mode " << mode;  // a measure moves nothing
+  }
+}
+
 TEST(ControllerErrorsAgainstSim, ANormalEndIsNoError) {
   Pc pc;
   increments(pc, 0.005f, 50);

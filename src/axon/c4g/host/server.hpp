@@ -88,6 +88,9 @@ class ReplyBuilder {
   [[nodiscard]] std::size_t axis_count() const noexcept { return reply_.count; }
   protocol::Axis& axis(std::size_t open_index) noexcept { return reply_.axes[open_index < protocol::kMaxAxes ? open_index : 0]; }
   void set_mode(std::size_t open_index, std::int32_t mode) noexcept { axis(open_index).mode = mode; }
+  // Modes 1xx (101 accelerometer, 102 camera, 103 force/torque): the external sensor's measure for
+  // an axis, in the sensor's own unit; it travels in D3, the only field those modes use.
+  void set_measure(std::size_t open_index, float value) noexcept { axis(open_index).d3 = value; }
   // Asks the controller to leave the open mode for an arm (1..4): INFPAR byte = 1.
   void exit_from_open(std::size_t arm) noexcept { reply_.infpar = protocol::request_exit_from_open(reply_.infpar, arm); }
   void set_cmd(std::int32_t cmd) noexcept { reply_.cmd = cmd; }
