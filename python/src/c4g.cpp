@@ -211,6 +211,8 @@ void bind_report(py::module_& m) {
       .def_readonly("freezes", &ServeStats::freezes)
       .def_readonly("frozen_cycles", &ServeStats::frozen_cycles)
       .def_readonly("safety_fault", &ServeStats::safety_fault, "'none', or what latched drive off.")
+      .def_readonly("controller_errors", &ServeStats::controller_errors,
+                    "'none', or the controller's errors the packets showed by the manual's names (docs/c4g-errors.md).")
       .def_readonly("currents_clamped", &ServeStats::currents_clamped)
       .def_readonly("timing", &ServeStats::timing)
       .def("__repr__", [](const ServeStats& s) {

@@ -28,17 +28,17 @@ std::string temp_path(const std::string& name) {
 std::uint16_t get16(const u_char* p) { return static_cast<std::uint16_t>((p[0] << 8) | p[1]); }
 std::uint32_t get32(const u_char* p) { return (std::uint32_t{get16(p)} << 16) | get16(p + 2); }
 
-struct Packet {
+struct CapturedPacket {
   std::int64_t ns;
   std::uint32_t caplen, len;
   std::vector<u_char> bytes;
 };
 
-std::vector<Packet> read_back(const std::string& path, int* linktype) {
+std::vector<CapturedPacket> read_back(const std::string& path, int* linktype) {
   char err[PCAP_ERRBUF_SIZE];
   pcap_t* p = pcap_open_offline_with_tstamp_precision(path.c_str(), PCAP_TSTAMP_PRECISION_NANO, err);
   EXPECT_NE(p, nullptr) << err;
-  std::vector<Packet> out;
+  std::vector<CapturedPacket> out;
   if (!p) return out;
   *linktype = pcap_datalink(p);
   pcap_pkthdr* h;

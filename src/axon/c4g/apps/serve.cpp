@@ -93,6 +93,7 @@ std::string ServeReport::json() const {
                    {"freezes", c.freezes},
                    {"frozen_cycles", c.frozen_cycles},
                    {"safety_fault", c.safety_fault},
+                   {"controller_errors", c.controller_errors},
                    {"currents_clamped", c.currents_clamped},
                    {"timing", timing_json(c.timing)}};
   if (c.csv) {
@@ -271,6 +272,7 @@ ServeReport ServeSession::report(std::string reason) const {
   st.frozen_cycles = c.frozen_cycles.load();
   st.safety_fault = std::string(host::to_string(s.safety().reason()));
   st.currents_clamped = s.safety().counters().currents_clamped.load();
+  st.controller_errors = s.controller_errors().names();
   st.timing = timing_of(s);
   if (const auto* csv = recorder_->csv.get()) {
     st.csv = true;

@@ -70,6 +70,8 @@ struct ServeStats {
   std::uint64_t packets = 0, init_packets = 0, cyclic_packets = 0, protocol_errors = 0, safe_replies = 0;
   std::uint64_t refused_mode_changes = 0, controller_late = 0, freezes = 0, frozen_cycles = 0;
   std::string safety_fault = "none";
+  // The controller's errors the packets showed, by the manual's names ("none", or "NAME xN, ...").
+  std::string controller_errors = "none";
   std::uint64_t currents_clamped = 0;
   ServeTiming timing;
   // Recorders (csv_*: only with a CSV; pcap_*: only with a capture).

@@ -86,7 +86,7 @@ std::int32_t read_i32(std::span<const std::byte> in, std::size_t offset) noexcep
 }  // namespace
 
 Server::Server(Controller& controller, const ServerOptions& options, net::SocketAddress allowed)
-    : controller_(controller), options_(options), safety_(options.safety), peer_(allowed), switch_(options.soft_switch) {}
+    : controller_(controller), options_(options), safety_(options.safety), peer_(allowed), switch_(options.soft_switch), watch_(options.watch) {}
 
 Result<std::unique_ptr<Server>> Server::start(Controller& controller, const ServerOptions& options) {
   AXON_TRY(protocol::validate(options.soft_switch));
@@ -146,6 +146,7 @@ void Server::on_timeout(bool before_first) noexcept {
   if (before_first) return;
   state_.store(ServerState::silent, std::memory_order_release);
   peer_.forget();  // the session is over: the controller may come back from another port
+  watch_.on_silence();
   controller_.on_silence();
 }
 
@@ -211,6 +212,7 @@ std::size_t Server::answer_init(std::span<const std::byte> in, std::span<std::by
     if (have_axes_) {
       axes_ = map.value();
       safety_.configure(init_, axes_);
+      watch_.configure(init_, axes_);
     } else {
       bump(counters_.protocol_errors);
     }
@@ -333,6 +335,7 @@ bool Server::numbering_restarted(std::int32_t num) const noexcept {
 void Server::start_session_over() noexcept {
   bump(counters_.controller_restarts);
   have_init_ = false;
+  watch_.reset();
   init_requested_at_ = cyclic_count_;
   state_.store(ServerState::syncing, std::memory_order_release);
   controller_.on_silence();
@@ -488,6 +491,7 @@ std::size_t Server::answer_cyclic(std::span<const std::byte> in, const net::Data
     if (options_.verify_reply_fields) safety_.trip(FaultReason::unused_field, f.axis);
   }
   safety_.apply(request_, reply_);
+  watch_.observe(request_, reply_);
   return encode(request_, reply_, out);
 }
 
@@ -511,6 +515,7 @@ std::string Server::summary() const {
   fmt::format_to(it, "Safety: {} (axis {}), currents clamped {}, drive-off replies {}, following-error replies {}\n",
                  to_string(safety_.reason()), safety_.fault_axis(), safety_.counters().currents_clamped.load(),
                  safety_.counters().drive_off_replies.load(), safety_.counters().following_error_replies.load());
+  out += watch_.summary();
   out += cycle_->summary();
   if (recorder_)
     fmt::format_to(it, "Capture {}: {} written, {} dropped, {} rotations, {} write failures\n", recorder_->path(),

@@ -30,6 +30,7 @@
 // for drive off.
 #pragma once
 
+#include "axon/c4g/host/controller_watch.hpp"
 #include "axon/c4g/host/cycle_thread.hpp"
 #include "axon/c4g/host/pcap_recorder.hpp"
 #include "axon/c4g/host/safety.hpp"
@@ -87,6 +88,9 @@ class ReplyBuilder {
   [[nodiscard]] std::size_t axis_count() const noexcept { return reply_.count; }
   protocol::Axis& axis(std::size_t open_index) noexcept { return reply_.axes[open_index < protocol::kMaxAxes ? open_index : 0]; }
   void set_mode(std::size_t open_index, std::int32_t mode) noexcept { axis(open_index).mode = mode; }
+  // Modes 1xx (101 accelerometer, 102 camera, 103 force/torque): the external sensor's measure for
+  // an axis, in the sensor's own unit; it travels in D3, the only field those modes use.
+  void set_measure(std::size_t open_index, float value) noexcept { axis(open_index).d3 = value; }
   // Asks the controller to leave the open mode for an arm (1..4): INFPAR byte = 1.
   void exit_from_open(std::size_t arm) noexcept { reply_.infpar = protocol::request_exit_from_open(reply_.infpar, arm); }
   void set_cmd(std::int32_t cmd) noexcept { reply_.cmd = cmd; }
@@ -140,6 +144,8 @@ struct ServerOptions {
   // Soft control switching intervals T1, T2, T3 of the controller (the PC infers the switch's phase
   // from the modes and these; they must match the controller's configuration).
   protocol::SwitchTimes soft_switch{};
+  // How the controller's errors are recognised from the packets (controller_watch.hpp).
+  ControllerWatchOptions watch{};
 };
 
 enum class ServerState : std::uint8_t {
@@ -205,6 +211,8 @@ class Server : private CycleHandler {
   [[nodiscard]] const ServerCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] Safety& safety() noexcept { return safety_; }
   [[nodiscard]] const Safety& safety() const noexcept { return safety_; }
+  // The controller's errors as the packets show them, named as the manual names them (any thread).
+  [[nodiscard]] const ControllerWatch& controller_errors() const noexcept { return watch_; }
   [[nodiscard]] const SwitchTracker& switch_tracker_unsafe() const noexcept { return switch_; }  // cycle thread only
   [[nodiscard]] const CycleThread& cycle() const noexcept { return *cycle_; }
   [[nodiscard]] const core::RealtimeReport& realtime_report() const noexcept { return cycle_->realtime_report(); }
@@ -299,6 +307,7 @@ class Server : private CycleHandler {
   std::int32_t last_num_ = -1;           // the session's latest protocol number (-1: none yet)
   int late_in_row_ = 0;
   SwitchTracker switch_;
+  ControllerWatch watch_;
   std::array<float, protocol::kMaxAxes> last_target_{};
   std::array<bool, protocol::kMaxAxes> have_target_{};
   std::array<bool, protocol::kMaxAxes> exit_sent_{};

@@ -102,6 +102,11 @@ Result<Controller> Controller::create(RobotConfig robot, Scenario scenario, Cont
     ax.mode = start == P::kModeUnspecified ? 0 : start;
     ax.last_request = ax.mode;
   }
+  // A start-up mode on an axis the open-axis lists leave out: the controller ignores it and says so.
+  for (std::size_t arm = 1; arm <= P::kMaxArms; ++arm)
+    for (std::size_t axis = 1; axis <= P::kAxesPerArm; ++axis)
+      if (c.robot_.init.modes[arm - 1][axis - 1] != 0 && !c.map_.open_index(arm, axis))
+        c.emit(EventLevel::error, event::kAxisNotPresent, fmt::format("C4GOpen: Arm {} Axis {} not present", arm, axis));
   return c;
 }
 
@@ -296,6 +301,7 @@ void Controller::end_cycle() {
       break;
   }
 
+  check_offset_limit();
   step_physics();
   check_following_error();
   check_soft_switch();
@@ -502,6 +508,10 @@ void Controller::handle_mode_request(std::size_t i, std::int32_t req, const std:
   }
   if (!drives_on(ax.arm)) {
     refuse("the drives are off: open modes are set once they are on (chapter 11)");
+    return;
+  }
+  if (selector_prog_) {
+    refuse("the state selector is in PROG: the open modes work in AUTO only (chapter 2)");
     return;
   }
   if (a.move.active) {
@@ -753,11 +763,13 @@ void Controller::step_physics() {
         vel = pc.d2 / period_;
         acc = (vel - ax.ref_vel) / period_;
         break;
-      case 5:  // relative trajectory: the PC's delta per cycle is integrated onto the trajectory
-        ax.offset += pc.d2;
+      case 5: {  // relative trajectory: the PC's delta per cycle, scaled by the general override, is integrated
+        const double delta = pc.d2 * override_percent_ / 100.0;
+        ax.offset += delta;
         dsa_ref = reported = ax.traj_pos + ax.offset;
-        vel = ax.traj_vel + pc.d2 / period_;
+        vel = ax.traj_vel + delta / period_;
         break;
+      }
       case 7:  // additive position correction (none in 170)
         if (m != P::code(P::Mode::mode7_standby_exit)) {
           ax.offset += pc.d1;
@@ -823,6 +835,51 @@ void Controller::check_soft_switch() {
   }
 }
 
+// Modes 7, 8, 9 (chapter 14.17.1): the controller keeps checking the offset between a reference
+// position and the one scheduled before it. Only mode 7 lets the PC move the reference (8 and 9 act
+// on the loops), so only its correction can trip it.
+void Controller::check_offset_limit() {
+  const double limit = robot_.max_offset_speed * period_;
+  for (std::size_t i = 0; i < map_.count(); ++i) {
+    AxisSim& ax = axes_[i];
+    if (!arms_[ax.arm].powered || base_mode(ax.mode) != 7 || ax.mode == P::code(P::Mode::mode7_standby_exit)) continue;
+    if (std::fabs(ax.pc.d1) <= limit) continue;
+    emit(EventLevel::error, event::kOffsetLimit,
+         fmt::format("arm {} axis {}: reference offset {:.4f} motor turns in one cycle over the limit {:.4f} (mode {})", ax.arm,
+                     ax.axis, ax.pc.d1, limit, mode_text(ax.mode)));
+    ax.pc = P::Axis{};
+    drive_off(ax.arm, 0);
+  }
+}
+
+void Controller::force_mode0(std::size_t arm) {
+  ArmSim& a = arms_[arm];
+  const std::size_t first = map_.arm_first(arm), n = map_.arm_count(arm);
+  bool any = false;
+  for (std::size_t i = first; i < first + n; ++i) any |= axes_[i].mode != 0 && !is_special(axes_[i].mode);
+  if (!any) return;
+  emit(EventLevel::error, event::kForcedMode0, fmt::format("C4GOpen: arm {} , forced 0 modality", arm));
+  for (std::size_t i = first; i < first + n; ++i) {
+    AxisSim& ax = axes_[i];
+    if (ax.mode == 0 || is_special(ax.mode)) continue;
+    // No exit: the trajectory generator's position (pos_i) is not brought to the PC's (pos_k).
+    const std::int32_t base = base_mode(ax.mode);
+    const double before = base == 1 || base == 2 ? ax.model.position() : ax.dsa_ref;
+    const double jump = ax.traj_pos - before;
+    if (std::fabs(jump) > 1e-3)
+      emit(EventLevel::warning, event::kPositionJump,
+           fmt::format("arm {} axis {}: mode {} left without its exit: the reference jumps {:.4f} motor turns (pos_i not "
+                       "updated to pos_k; recovery: $C4G_PA := 1, C4GOPEN_MODE := 0, CSA, CCRC)",
+                       arm, ax.axis, mode_text(ax.mode), jump));
+    ax.offset = 0;
+    ax.exit.active = false;
+    ax.scs.clear();
+    set_mode(i, 0, {});
+  }
+  a.open = false;
+  exit_requested_[arm] = false;
+}
+
 // ---- the robot program ----------------------------------------------------------------------
 
 std::vector<std::size_t> Controller::step_arms(const Step& s) const {
@@ -886,6 +943,10 @@ bool Controller::start_step(const Step& s) {
         ArmSim& a = arms_[arm];
         if (!drives_on(arm)) {
           fail_scenario(s, fmt::format("arm {}: drives are not on", arm));
+          return false;
+        }
+        if (selector_prog_ && s.mode != 0) {
+          fail_scenario(s, "the state selector is in PROG: the open modes work in AUTO only (chapter 2)");
           return false;
         }
         const bool switches = s.mode == 1 || s.mode == 2;  // soft switching needs a still robot (T1..T3)
@@ -978,6 +1039,14 @@ bool Controller::start_step(const Step& s) {
       return true;
     }
     case StepKind::run: running_forever_ = true; return true;
+    case StepKind::selector:
+      if (selector_prog_ != (s.value == 1)) {
+        selector_prog_ = s.value == 1;
+        for (std::size_t arm = 1; arm <= P::kMaxArms; ++arm)
+          if (arms_[arm].present) force_mode0(arm);
+      }
+      return true;
+    case StepKind::general_override: override_percent_ = s.value; return true;
     case StepKind::delay:
     case StepKind::wait_for_pc: return true;
   }
@@ -1000,7 +1069,9 @@ bool Controller::step_complete(const Step& s) {
         for (std::size_t arm : step_arms(s))
           if (arms_[arm].open) return false;
       return true;
-    case StepKind::cmd: return true;
+    case StepKind::cmd:
+    case StepKind::selector:
+    case StepKind::general_override: return true;
     case StepKind::wait_for_pc:
       for (std::size_t arm : step_arms(s))
         if (arms_[arm].open) {

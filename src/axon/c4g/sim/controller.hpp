@@ -188,6 +188,9 @@ class Controller {
   void step_physics();
   void check_following_error();
   void check_soft_switch();
+  void check_offset_limit();
+  // The state selector moved: every arm not in mode 0 is forced there, without its exit.
+  void force_mode0(std::size_t arm);
   void run_scenario();
   bool start_step(const Step& s);
   bool step_complete(const Step& s);
@@ -223,7 +226,9 @@ class Controller {
   int consecutive_misses_ = 0;
   bool comm_error_ = false;
   bool frozen_active_ = false;
-  bool scenario_started_ = false;  // the robot program runs once the cyclic exchange started
+  bool scenario_started_ = false;
+  bool selector_prog_ = false;    // the state selector in PROG (open modes need AUTO)
+  int override_percent_ = 100;    // the general override: scales mode 5's increments  // the robot program runs once the cyclic exchange started
   std::array<bool, protocol::kMaxArms + 1> exit_requested_{};
   // Program-issued special codes waiting for their packet: 502 -> freeze, 503 -> back to 0,
   // 504 -> end, 506 -> initialization packet.

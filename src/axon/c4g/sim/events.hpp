@@ -17,6 +17,17 @@ inline constexpr std::string_view kSocketError = "ERR_C4GOPEN_SKT_UDP";         
 inline constexpr std::string_view kConfigurationError = "ERR_C4GOPEN";            // bad axis configuration
 inline constexpr std::string_view kFollowErrorFromPc = "ERR_C4GOPEN_FOLLOW_ERROR";  // 508 from the PC
 inline constexpr std::string_view kDriveOffFromPc = "ERR_C4GOPEN_DRIVEOFF_SERVER";  // 505 from the PC
+// The state selector moved between AUTO and PROG while an arm was in an open mode: mode 0 forced.
+inline constexpr std::string_view kForcedMode0 = "ERR_C4GOPEN_SET_0_MODALITY";
+// The open modality configured on an axis that is not open (a start-up mode on a closed axis).
+inline constexpr std::string_view kAxisNotPresent = "ERR_C4GOPEN_CONFIGURATION_AX";
+// Not in the table: the maximum offset between a reference position and the one scheduled before
+// it (the controller's check in modes 7, 8 and 9, chapter 14.17); the drives go off.
+inline constexpr std::string_view kOffsetLimit = "OFFSET_LIMIT";
+// Not in the table: an open mode left without its exit (forced mode 0, drive off) while the PC's
+// accumulated positions (pos_k) differed from the trajectory generator's (pos_i): the reference
+// jumps by the difference (the manual's warning in mode 5).
+inline constexpr std::string_view kPositionJump = "POSITION_JUMP";
 // Not in the open interface's table: the controller's own following-error check (the DSA's).
 inline constexpr std::string_view kFollowErrorController = "DSA_FOLLOWING_ERROR";
 // Not in the table either: the robot moved during soft control switching (T1, T2 or T3), which the

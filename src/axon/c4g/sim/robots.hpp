@@ -56,6 +56,10 @@ struct RobotConfig {
   double drive_off_s = 0.05;       // length of the drive-off procedure (mode 505 shown meanwhile)
   SoftSwitchConfig scs;            // soft control switching entering/leaving modes 1 and 2
   int standby_cycles = 3;          // cycles spent in a standby code (4', 5', 7'', ...) when leaving
+  // Modes 7, 8, 9: the largest offset between a reference position and the one scheduled before it
+  // [motor turns/s, times the period per cycle] (the manual gives no figure; above the Server's
+  // default continuity limit of 100 turns/s so that a PC's own check refuses first).
+  double max_offset_speed = 150.0;
 };
 
 // The manual's initialization example: one six-axis arm, 2 ms, software 3.11.115.

@@ -140,13 +140,25 @@ Result<Step> parse_step(const core::ConfigNode& item) {
     AXON_TRY(value, args->get_in<int>("value", 0, 255));
     s.arm = arm;
     s.value = value;
+  } else if (key == "selector") {
+    s.kind = StepKind::selector;
+    if (!args) return item.error(CoreErrc::config_bad_value, "'selector' needs auto or prog");
+    AXON_TRY(v, args->as<std::string>());
+    if (v != "auto" && v != "prog") return args->error(CoreErrc::config_bad_value, "the state selector is auto or prog");
+    s.value = v == "prog" ? 1 : 0;
+  } else if (key == "override") {
+    s.kind = StepKind::general_override;
+    if (!args) return item.error(CoreErrc::config_bad_value, "'override' needs a percentage");
+    AXON_TRY(v, args->as<int>());
+    if (v < 1 || v > 100) return args->error(CoreErrc::config_bad_value, "the general override is 1..100 %");
+    s.value = v;
   } else if (key == "restart" || key == "exit_open" || key == "run") {
     s.kind = key == "restart" ? StepKind::restart : key == "exit_open" ? StepKind::exit_open : StepKind::run;
     if (args) return args->error(CoreErrc::config_bad_value, fmt::format("'{}' takes no arguments", key));
   } else {
     return item.error(CoreErrc::config_unknown_key,
                       fmt::format("unknown step '{}' (drive_on, drive_off, go_open, wait_for_pc, move, delay, cmd, "
-                                  "freeze_passive, restart, exit_open, run)",
+                                  "freeze_passive, restart, exit_open, selector, override, run)",
                                   key));
   }
   return s;
@@ -167,6 +179,8 @@ std::string_view to_string(StepKind k) noexcept {
     case StepKind::restart: return "restart";
     case StepKind::exit_open: return "exit_open";
     case StepKind::run: return "run";
+    case StepKind::selector: return "selector";
+    case StepKind::general_override: return "override";
   }
   return "?";
 }

@@ -15,6 +15,9 @@
 //     - freeze_passive: 0.2              # mode 502, no packets for 0.2 s, then 503 and mode 0
 //     - restart                          # mode 506: a new initialization packet, then the cycle
 //     - exit_open                        # mode 504: the exchange ends for good (last step only)
+//     - selector: prog                   # the state selector to PROG (or auto): an arm in an open
+//                                        #   mode is forced to mode 0 (ERR_C4GOPEN_SET_0_MODALITY)
+//     - override: 50                     # general override [%] ($GEN_OVR): scales mode 5's increments
 //     - run                              # keep running until the simulator is stopped
 //
 // Errors name the file, line and column (core::ConfigNode).
@@ -30,7 +33,7 @@
 
 namespace axon::c4g::sim {
 
-enum class StepKind { drive_on, drive_off, go_open, wait_for_pc, move, delay, cmd, freeze_passive, restart, exit_open, run };
+enum class StepKind { drive_on, drive_off, go_open, wait_for_pc, move, delay, cmd, freeze_passive, restart, exit_open, run, selector, general_override };
 std::string_view to_string(StepKind k) noexcept;
 
 enum class OpenType { a, b };
@@ -43,7 +46,7 @@ struct Step {
   OpenType type = OpenType::a;           // go_open
   std::vector<std::optional<double>> deg;  // move: per logical axis, nullopt keeps the axis where it is
   double seconds = 0;                    // move duration, delay, freeze_passive, wait_for_pc timeout (0: none)
-  int value = 0;                         // cmd byte
+  int value = 0;                         // cmd byte; selector: 1 PROG, 0 AUTO; override: percent
   std::string where;                     // "file:line:col" of the step, for messages
 };
 
