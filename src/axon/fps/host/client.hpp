@@ -92,6 +92,10 @@ struct PlanSettings {
   std::uint64_t seed = 1;        // the planner's nudges
   bool park_bad_targets = true;  // false: a bad target fails the call instead of parking that robot
   bool allow_partial = false;    // move the others when some robots cannot reach their targets
+  // Targets outside their robots' safe zones (spec section 11: the arms' length and angle errors;
+  // docs/fps-plan.md): true refuses the call (PlanErrc::outside_safe_zone naming the robots and by
+  // how much) before anything moves; false only reports them in PlanOutcome.
+  bool refuse_outside_safe_zone = false;
 };
 
 struct PlanOutcome {
@@ -103,6 +107,8 @@ struct PlanOutcome {
   double min_clearance_mm = 0;
   std::map<std::uint16_t, Angles> ends;  // where the plan leaves each robot
   std::string notes;               // targets parked, robots held (one line each)
+  std::vector<std::uint16_t> outside_safe_zone;  // robots whose targets leave their safe zones
+  std::string safe_zone;           // why, one line each ("robot 12: target 0.180 mm beyond ...")
 };
 
 struct PlanAndMoveOutcome {
