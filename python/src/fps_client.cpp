@@ -113,7 +113,7 @@ void bind_outcomes(py::module_& m) {
 std::unique_ptr<Client> make_client(double reply_timeout_s, double call_timeout_s, double poll_interval_s,
                                     double discover_window_s, double position_tolerance_deg) {
   return std::make_unique<Client>(
-      fps::ClientConfig{reply_timeout_s, call_timeout_s, poll_interval_s, discover_window_s, position_tolerance_deg});
+      fps::ClientConfig{reply_timeout_s, call_timeout_s, poll_interval_s, discover_window_s, position_tolerance_deg, false, false});
 }
 
 fps::PlanSettings plan_settings(double speed_deg_s, double buffer_mm, std::uint64_t seed, bool park_bad_targets,

@@ -314,6 +314,20 @@ TEST(Client, OpenedFromBusSpecsPlansOnceGivenTheLayout) {
   EXPECT_LT(error_deg(*plane.arms(1), {30, 150}), 0.1);
 }
 
+TEST(Client, TheVersionByteOrderOptionReachesEveryRobotsRead) {
+  sim::SimulatedPlane plane("benchtop", fast_plane());  // robots send the field's order
+  auto config = fast_client();
+  config.document_version_byte_order = true;
+  Client fps(config);
+  fps.open(plane.plane());
+  const auto robots = fps.discover();
+  ASSERT_EQ(robots.size(), 6u);
+  for (const auto& r : robots) {
+    EXPECT_TRUE(r.firmware.empty()) << r.id << ": " << r.firmware;
+    EXPECT_NE(r.error.find("byte order"), std::string::npos) << r.id << ": " << r.error;
+  }
+}
+
 TEST(Client, CallsBeforeOpenAreErrors) {
   Client fps;
   EXPECT_FALSE(fps.is_open());

@@ -112,6 +112,8 @@ struct Client::Impl {
     o.client.timeout = duration_of(config.reply_timeout_s);
     o.positioner.poll_interval = duration_of(config.poll_interval_s);
     o.positioner.position_tolerance = config.position_tolerance_deg;
+    if (config.field_firmware_history) o.positioner.firmware_history = protocol::FirmwareHistory::field;
+    if (config.document_version_byte_order) o.positioner.version_byte_order = protocol::VersionByteOrder::document;
     o.discover_window = duration_of(config.discover_window_s);
     return o;
   }

@@ -48,6 +48,11 @@ struct ClientConfig {
   double poll_interval_s = 0.25;   // status polling while robots move
   double discover_window_s = 0.5;  // GET_ID answers collected by discovery
   double position_tolerance_deg = 0.1;  // a move ends this close to its target, per arm
+  // Firmware versions (docs/fps-host.md): the field's command history (the precise-move switches
+  // from 04.01.17 on; commands a robot's version lacks fail with HostErrc::firmware_lacks unsent)
+  // instead of the document's, and GET_FIRMWARE_VERSION's bytes in the document's order.
+  bool field_firmware_history = false;
+  bool document_version_byte_order = false;
 };
 
 // One robot's row of status(): plain values.
