@@ -23,49 +23,53 @@ ArrayOptions array_with(FirmwareHistory history, protocol::VersionByteOrder orde
   return o;
 }
 
-// Robot 7 runs 04.01.16, robot 8 04.01.17, both with the field's command history.
-void add_old_and_new(SimRig& rig) {
+// What robots 7 (04.01.16) and 8 (04.01.17), both with the field's command history, answered to a
+// host following `history` that switched their precise moves off, and whether they still have it on.
+struct SwitchOff {
+  Result<void> old_robot = ok(), new_robot = ok();
+  bool old_still_on = false, new_still_on = false;
+};
+
+SwitchOff switch_precise_off(FirmwareHistory history) {
+  SimRig rig(1, fast_sim(), array_with(history));
   for (const auto& [id, version] : {std::pair<std::uint16_t, protocol::FirmwareVersion>{7, {4, 1, 16}}, {8, {4, 1, 17}}}) {
     rig.add(id, 0, [version](sim::PositionerConfig& c) {
       c.firmware = version;
       c.firmware_history = FirmwareHistory::field;
     });
   }
+  rig.start();
+  SwitchOff out;
+  rig.run([&]() -> asio::awaitable<void> {
+    co_await rig.discover();
+    out.old_robot = co_await rig.array->find(7)->set_precise_move(Arm::both, false);
+    out.new_robot = co_await rig.array->find(8)->set_precise_move(Arm::both, false);
+  });
+  out.old_still_on = rig.model(7).status().has(StatusBit::precise_move_alpha);
+  out.new_still_on = rig.model(8).status().has(StatusBit::precise_move_alpha);
+  return out;
 }
 
 TEST(FirmwareGatesSim, AHostThatKnowsTheHistoryRefusesAGatedCommandBeforeSendingIt) {
-  SimRig rig(1, fast_sim(), array_with(FirmwareHistory::field));
-  add_old_and_new(rig);
-  rig.start();
-  rig.run([&]() -> asio::awaitable<void> {
-    co_await rig.discover();
-    auto r = co_await rig.array->find(7)->set_precise_move(Arm::both, false);
-    EXPECT_FALSE(r.has_value());
-    if (r) co_return;
-    EXPECT_EQ(r.error().code, HostErrc::firmware_lacks) << r.error().message();
-    EXPECT_NE(r.error().detail.find("positioner 7: firmware 04.01.16 lacks SWITCH_OFF_PRECISE_MOVE_ALPHA (129)"),
-              std::string::npos)
-        << r.error().detail;
-    EXPECT_TRUE(rig.model(7).status().has(StatusBit::precise_move_alpha));  // untouched
-    // The newer robot has the switches.
-    r = co_await rig.array->find(8)->set_precise_move(Arm::both, false);
-    EXPECT_TRUE(r.has_value()) << r.error().message();
-    EXPECT_FALSE(rig.model(8).status().has(StatusBit::precise_move_alpha));
-  });
+  const auto r = switch_precise_off(FirmwareHistory::field);
+  ASSERT_FALSE(r.old_robot.has_value());
+  EXPECT_EQ(r.old_robot.error().code, HostErrc::firmware_lacks) << r.old_robot.error().message();
+  EXPECT_NE(r.old_robot.error().detail.find("positioner 7: firmware 04.01.16 lacks SWITCH_OFF_PRECISE_MOVE_ALPHA (129)"),
+            std::string::npos)
+      << r.old_robot.error().detail;
+  EXPECT_TRUE(r.old_still_on);  // untouched
+  // The newer robot has the switches.
+  EXPECT_TRUE(r.new_robot.has_value()) << r.new_robot.error().message();
+  EXPECT_FALSE(r.new_still_on);
 }
 
 TEST(FirmwareGatesSim, AHostThatFollowsTheDocumentSendsItAndTheOldRobotAnswersUnknown) {
-  SimRig rig(1, fast_sim(), array_with(FirmwareHistory::document));
-  add_old_and_new(rig);
-  rig.start();
-  rig.run([&]() -> asio::awaitable<void> {
-    co_await rig.discover();
-    auto r = co_await rig.array->find(7)->set_precise_move(Arm::alpha, false);
-    EXPECT_FALSE(r.has_value());
-    if (r) co_return;
-    EXPECT_NE(r.error().code, HostErrc::firmware_lacks) << r.error().message();
-    EXPECT_TRUE(rig.model(7).status().has(StatusBit::precise_move_alpha));
-  });
+  const auto r = switch_precise_off(FirmwareHistory::document);
+  ASSERT_FALSE(r.old_robot.has_value());
+  EXPECT_NE(r.old_robot.error().code, HostErrc::firmware_lacks) << r.old_robot.error().message();
+  EXPECT_NE(r.old_robot.error().message().find("UNKNOWN_COMMAND"), std::string::npos) << r.old_robot.error().message();
+  EXPECT_TRUE(r.old_still_on);
+  EXPECT_TRUE(r.new_robot.has_value()) << r.new_robot.error().message();
 }
 
 TEST(FirmwareGatesSim, TheDocumentsByteOrderIsReadWhenBothSidesUseIt) {
