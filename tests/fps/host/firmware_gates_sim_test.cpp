@@ -72,30 +72,31 @@ TEST(FirmwareGatesSim, AHostThatFollowsTheDocumentSendsItAndTheOldRobotAnswersUn
   EXPECT_TRUE(r.new_robot.has_value()) << r.new_robot.error().message();
 }
 
-TEST(FirmwareGatesSim, TheDocumentsByteOrderIsReadWhenBothSidesUseIt) {
-  SimRig rig(1, fast_sim(), array_with(FirmwareHistory::document, protocol::VersionByteOrder::document));
+// Discovery's row of robot 7, which sends its version in the document's byte order, as a host
+// reading `host_order` sees it.
+StatusRow discovered_document_order_robot(protocol::VersionByteOrder host_order) {
+  SimRig rig(1, fast_sim(), array_with(FirmwareHistory::document, host_order));
   rig.add(7, 0, [](sim::PositionerConfig& c) { c.version_byte_order = protocol::VersionByteOrder::document; });
   rig.start();
+  StatusRow row;
   rig.run([&]() -> asio::awaitable<void> {
     const auto d = co_await rig.discover();
-    EXPECT_EQ(d.table.rows.size(), 1u);
-    if (d.table.rows.size() != 1) co_return;
-    EXPECT_EQ(d.table.rows[0].firmware, (protocol::FirmwareVersion{4, 1, 13})) << d.table.rows[0].error;
-    EXPECT_TRUE(d.table.rows[0].error.empty()) << d.table.rows[0].error;
+    if (d.table.rows.size() == 1) row = d.table.rows[0];
   });
+  return row;
+}
+
+TEST(FirmwareGatesSim, TheDocumentsByteOrderIsReadWhenBothSidesUseIt) {
+  const auto row = discovered_document_order_robot(protocol::VersionByteOrder::document);
+  EXPECT_EQ(row.firmware, (protocol::FirmwareVersion{4, 1, 13})) << row.error;
+  EXPECT_TRUE(row.error.empty()) << row.error;
 }
 
 TEST(FirmwareGatesSim, AByteOrderMismatchIsAnErrorNamingTheOption) {
-  SimRig rig;  // the host reads the field's order
-  rig.add(7, 0, [](sim::PositionerConfig& c) { c.version_byte_order = protocol::VersionByteOrder::document; });
-  rig.start();
-  rig.run([&]() -> asio::awaitable<void> {
-    const auto d = co_await rig.discover();
-    EXPECT_EQ(d.table.rows.size(), 1u);
-    if (d.table.rows.size() != 1) co_return;
-    EXPECT_FALSE(d.table.rows[0].firmware.has_value());
-    EXPECT_NE(d.table.rows[0].error.find("byte order"), std::string::npos) << d.table.rows[0].error;
-  });
+  const auto row = discovered_document_order_robot(protocol::VersionByteOrder::field);
+  EXPECT_EQ(row.id, 7);
+  EXPECT_FALSE(row.firmware.has_value());
+  EXPECT_NE(row.error.find("byte order"), std::string::npos) << row.error;
 }
 
 }  // namespace
