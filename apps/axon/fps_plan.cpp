@@ -46,6 +46,7 @@ struct PlanArgs {
   double speed = 12.0;
   double buffer = 2.0;
   bool allow_partial = false;
+  bool refuse_unsafe = false;
 };
 
 void write_file(const std::string& path, const std::string& text) {
@@ -75,23 +76,26 @@ Loaded load(const PlanArgs& a) {
   return {std::move(plane), std::move(model)};
 }
 
-// A target file's poses in model order; problems parking resolved are logged.
+// A target file's poses in model order; problems parking resolved are logged. `point_fibre`, when
+// given, receives which robots' targets are fibre points (the safe zone's reach check).
 std::vector<plan::Pose> file_poses(const plan::CollisionModel& model, const std::string& file, plan::TargetPolicy policy,
-                                   const char* what) {
+                                   const char* what, std::vector<std::optional<std::size_t>>* point_fibre = nullptr) {
   const auto targets = need(plan::load_targets(file));
   std::string notes;
   auto poses = plan::target_poses(model, targets, policy, &notes);
   if (!poses) throw Exception(Error(poses.error().code, fmt::format("{} '{}':\n{}", what, file, poses.error().detail)));
   if (!notes.empty()) spdlog::warn("{} '{}':\n{}", what, file, notes);
+  if (point_fibre) *point_fibre = plan::point_fibres(model, targets, poses.value());
   return std::move(poses).value();
 }
 
 // "folded", "random" (with the seed) or a target file resolved against the model.
 std::vector<plan::Pose> poses_from(const plan::CollisionModel& model, const std::string& spec, std::uint64_t seed,
-                                   plan::TargetPolicy policy, const char* what) {
+                                   plan::TargetPolicy policy, const char* what,
+                                   std::vector<std::optional<std::size_t>>* point_fibre = nullptr) {
   if (spec == "folded") return plan::folded_poses(model);
   if (spec == "random") return plan::random_poses(model, seed);
-  return file_poses(model, spec, policy, what);
+  return file_poses(model, spec, policy, what, point_fibre);
 }
 
 plan::PlannerOptions planner_options(const PlanArgs& a) {
@@ -99,6 +103,15 @@ plan::PlannerOptions planner_options(const PlanArgs& a) {
   o.speed = {a.speed, a.speed};
   o.seed = a.seed;
   return o;
+}
+
+// The targets outside their safe zones (spec section 11), the first ten of them.
+void print_safe_zone(const plan::SafeZoneReport& r) {
+  if (r.ok()) return;
+  constexpr std::size_t kShown = 10;
+  std::fprintf(stderr, "safe zone (spec section 11): the targets of %zu robots leave it\n", r.robots().size());
+  for (std::size_t i = 0; i < r.issues.size() && i < kShown; ++i) std::fprintf(stderr, "  %s\n", r.issues[i].to_string().c_str());
+  if (r.issues.size() > kShown) std::fprintf(stderr, "  ... %zu more\n", r.issues.size() - kShown);
 }
 
 void print_summary(const plan::CollisionModel& model, const plan::Plan& p) {
@@ -110,6 +123,7 @@ void print_summary(const plan::CollisionModel& model, const plan::Plan& p) {
                p.verified ? "verified by the checker" : "NOT verified");
   const auto s = p.summary(model);
   if (!s.empty()) std::fputs(s.c_str(), stderr);
+  print_safe_zone(p.safe_zone);
 }
 
 int run_plan(const PlanArgs& a) {
@@ -117,7 +131,8 @@ int run_plan(const PlanArgs& a) {
   if (a.to.empty()) throw Exception(Error(CoreErrc::invalid_argument, "give the targets: --to FILE or --to random"));
   plan::PlanRequest req;
   req.current = poses_from(model, a.from, a.seed + 1, plan::TargetPolicy::reject, "current poses");
-  req.target = poses_from(model, a.to, a.seed, a.reject ? plan::TargetPolicy::reject : plan::TargetPolicy::park, "targets");
+  req.target = poses_from(model, a.to, a.seed, a.reject ? plan::TargetPolicy::reject : plan::TargetPolicy::park, "targets",
+                          &req.point_fibre);
   req.frozen = plan::frozen_robots(plane);
   auto r = plan::plan_moves(model, req, planner_options(a));
   const plan::Plan p = need(std::move(r));
@@ -167,12 +182,14 @@ asio::awaitable<int> job_goto_all(const PlanArgs& a, host::Array& array) {
   host::PlanAndMoveOptions o;
   o.planner = planner_options(a);
   o.allow_partial = a.allow_partial;
+  o.refuse_outside_safe_zone = a.refuse_unsafe;
   o.on_plan = [&](const plan::Plan& p) {
     print_summary(model, p);
     if (!a.output.empty()) write_file(a.output, plan::plan_to_json(model, p, o.planner, plane.name()));
     spdlog::info("goto-all: {:.1f} s move", p.stats.duration_s);
   };
-  auto r = co_await host::plan_and_move(array, plane, model, file_poses(model, a.targets, policy, "targets"), o);
+  auto targets = file_poses(model, a.targets, policy, "targets", &o.point_fibre);
+  auto r = co_await host::plan_and_move(array, plane, model, std::move(targets), o);
   const auto done = need(std::move(r));
   if (!done.run) {
     std::puts("goto-all: every robot is already where it should be");
@@ -225,6 +242,8 @@ void add_fps_plan_commands(CLI::App& fps_cmd, GlobalOptions& global, FpsArrayRun
   ga->add_option("--save-plan", a.output, "also write the plan.json");
   ga->add_flag("--reject", a.reject, "fail on bad targets instead of parking those robots");
   ga->add_flag("--allow-partial", a.allow_partial, "move the others when some robots cannot reach their targets");
+  ga->add_flag("--refuse-unsafe", a.refuse_unsafe,
+               "refuse when targets leave their robots' safe zones (spec section 11) instead of only reporting them");
   ga->callback([args, with_array, &global] {
     global.exit_code = with_array([args](host::Array& array) { return job_goto_all(*args, array); }, true);
   });

@@ -91,7 +91,10 @@ void bind_outcomes(py::module_& m) {
         for (const auto& [id, a] : o.ends) out[id] = {a.alpha, a.beta};
         return out;
       }, "{id: (alpha, beta)} where the plan leaves each robot.")
-      .def_readonly("notes", &fps::PlanOutcome::notes);
+      .def_readonly("notes", &fps::PlanOutcome::notes)
+      .def_readonly("outside_safe_zone", &fps::PlanOutcome::outside_safe_zone,
+                    "Robots whose targets leave their safe zones (spec section 11).")
+      .def_readonly("safe_zone", &fps::PlanOutcome::safe_zone, "Why, one line per robot.");
   py::class_<fps::PlanAndMoveOutcome>(m, "PlanAndMoveOutcome")
       .def_readonly("plan", &fps::PlanAndMoveOutcome::plan)
       .def_readonly("moved", &fps::PlanAndMoveOutcome::moved)
@@ -129,12 +132,12 @@ void bind_outcomes(py::module_& m) {
 std::unique_ptr<Client> make_client(double reply_timeout_s, double call_timeout_s, double poll_interval_s,
                                     double discover_window_s, double position_tolerance_deg) {
   return std::make_unique<Client>(
-      fps::ClientConfig{reply_timeout_s, call_timeout_s, poll_interval_s, discover_window_s, position_tolerance_deg});
+      fps::ClientConfig{reply_timeout_s, call_timeout_s, poll_interval_s, discover_window_s, position_tolerance_deg, false, false});
 }
 
 fps::PlanSettings plan_settings(double speed_deg_s, double buffer_mm, std::uint64_t seed, bool park_bad_targets,
-                                bool allow_partial) {
-  return {speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial};
+                                bool allow_partial, bool refuse_outside_safe_zone) {
+  return {speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial, refuse_outside_safe_zone};
 }
 
 void bind_client_moves(py::class_<Client>& c) {
@@ -154,8 +157,8 @@ void bind_client_moves(py::class_<Client>& c) {
        "{id: (alpha, beta)}: each arm an (n, 2) array of degrees and seconds after the start (the robot adds "
        "where it stands); uploads, starts every robot together, follows and checks the ends.")
       .def("plan_and_move", [](Client& c, const py::object& targets, double speed_deg_s, double buffer_mm,
-                               std::uint64_t seed, bool park_bad_targets, bool allow_partial) {
-         const auto s = plan_settings(speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial);
+                               std::uint64_t seed, bool park_bad_targets, bool allow_partial, bool refuse_outside_safe_zone) {
+         const auto s = plan_settings(speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial, refuse_outside_safe_zone);
          if (py::isinstance<py::str>(targets)) {
            const auto file = targets.cast<std::string>();
            return blocking(c, [&c, file, s] { return c.plan_and_move(file, s); });
@@ -164,8 +167,9 @@ void bind_client_moves(py::class_<Client>& c) {
          return blocking(c, [&c, t, s] { return c.plan_and_move(t, s); });
        }, py::arg("targets"), py::kw_only(), py::arg("speed_deg_s") = 12.0, py::arg("buffer_mm") = 2.0,
        py::arg("seed") = 1, py::arg("park_bad_targets") = true, py::arg("allow_partial") = false,
+       py::arg("refuse_outside_safe_zone") = false,
        "Plans from where every robot of the layout stands to {id: (alpha, beta)} or a target file (robots not "
-       "listed fold), verifies and runs it.")
+       "listed fold), verifies and runs it; targets outside their safe zones are reported, or refused.")
       .def("back_off", [](Client& c, const std::vector<std::uint16_t>& ids) {
          return blocking(c, [&c, ids] { return c.back_off(ids); });
        }, py::arg("ids") = std::vector<std::uint16_t>{},

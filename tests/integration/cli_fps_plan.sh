@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Path planning on the command line: `fps plan` on the default 500-robot layout writes a verified
-# plan.json, `fps plot` draws it; `fps goto-all` plans from the simulated benchtop robots' positions,
+# plan.json, `fps plot` draws it, targets outside the safe zone are reported; `fps goto-all` plans from the simulated benchtop robots' positions,
 # runs the move and reports every robot completed at its target.
 source "$(dirname "$0")/lib.sh"
 DATA="$(cd "$(dirname "$0")/../../data/layouts" && pwd)"
@@ -49,6 +49,14 @@ grep -q '^plan: 6 robots' "$TMP/cal.err" && grep -q 'verified by the checker' "$
 printf 'targets:\n  - {robot: 99, alpha: 10, beta: 170}\n' >"$TMP/bad.yaml"
 if "$AXON" fps plan --layout "$DATA/benchtop.yaml" --to "$TMP/bad.yaml" 2>"$TMP/bad.err"; then fail "unknown robot accepted"; fi
 grep -q '99' "$TMP/bad.err" || fail "unknown robot not named: $(cat "$TMP/bad.err")"
+
+# A boss target 0.1 mm inside robot 1's reach plans, but leaves the safe zone (spec section 11):
+# a robot with arms at the tolerance could not reach it, and the summary says by how much.
+printf 'targets:\n  - {robot: 1, x: -22.3, y: 0, fibre: boss}\n' >"$TMP/edge.yaml"
+"$AXON" fps plan --layout "$DATA/benchtop.yaml" --to "$TMP/edge.yaml" 2>"$TMP/edge.err" \
+  || fail "plan of a target near the reach exited with $? ($(cat "$TMP/edge.err"))"
+grep -q 'safe zone (spec section 11): the targets of 1 robots leave it' "$TMP/edge.err" \
+  && grep -q 'robot 1: target 0.14[0-9] mm beyond' "$TMP/edge.err" || fail "safe zone not reported: $(cat "$TMP/edge.err")"
 
 # goto-all on the simulated benchtop (robots start folded at alpha 0, beta 180).
 cat >"$TMP/targets.yaml" <<'YAML'

@@ -7,8 +7,10 @@
 #include "axon/fps/sim/simulated_plane.hpp"
 
 #include "axon/fps/plan/layout_model.hpp"
+#include "axon/fps/plan/safe_zone.hpp"
 #include "axon/fps/plan/stop_sweep.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -292,6 +294,57 @@ TEST_F(ClientOnPlane, BadTargetsAreRefusedWhenNotParked) {
   }
 }
 
+// Targets for every robot of the layout: folded, except the first robot, whose arm comes closer
+// to a neighbour than both safe zones allow (spec section 11) without touching it.
+std::map<std::uint16_t, Angles> targets_with_one_outside_safe_zone(const FocalPlane& layout, std::uint16_t& outside) {
+  const auto model = plan::model_from_layout(layout).value();
+  std::vector<plan::Pose> poses(model.size(), plan::Pose{10, 170});
+  for (double a = 0; a < 360; a += 5) {
+    for (double b = 0; b < 180; b += 0.5) {
+      poses[0] = {a, b};
+      std::vector<plan::Segment> segs(model.size());
+      std::vector<plan::Contact> contacts;
+      model.segments(poses, segs);
+      if (model.find_contacts(segs, contacts) < 0.5) continue;
+      const auto r = plan::check_safe_zone(model, poses);
+      if (r.issues.size() != 1 || r.issues[0].kind != plan::SafeZoneIssue::Kind::robot_clearance) continue;
+      outside = static_cast<std::uint16_t>(r.issues[0].robot);
+      std::map<std::uint16_t, Angles> t;
+      for (std::size_t i = 0; i < model.size(); ++i)
+        t[static_cast<std::uint16_t>(model.robot(i).id())] = {poses[i].alpha_deg, poses[i].beta_deg};
+      return t;
+    }
+  }
+  ADD_FAILURE() << "no pose of the first robot is clear but outside the safe zone";
+  return {};
+}
+
+TEST_F(ClientOnPlane, TargetsOutsideTheSafeZoneAreRefusedBeforeAnythingMoves) {
+  std::uint16_t outside = 0;
+  const auto targets = targets_with_one_outside_safe_zone(plane.plane(), outside);
+  const auto before = *plane.arms(outside);
+  PlanSettings s;
+  s.refuse_outside_safe_zone = true;
+  try {
+    fps.plan_and_move(targets, s);
+    FAIL() << "targets outside the safe zone were planned and run";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), plan::PlanErrc::outside_safe_zone) << e.what();
+    EXPECT_NE(std::string(e.what()).find(fmt::format("robot {}: target", outside)), std::string::npos) << e.what();
+  }
+  EXPECT_LT(error_deg(*plane.arms(outside), before), 0.01);
+}
+
+TEST_F(ClientOnPlane, TargetsOutsideTheSafeZoneAreReportedAndRunByDefault) {
+  std::uint16_t outside = 0;
+  const auto targets = targets_with_one_outside_safe_zone(plane.plane(), outside);
+  const auto out = fps.plan_and_move(targets);
+  EXPECT_EQ(out.plan.outside_safe_zone, std::vector<std::uint16_t>{outside});
+  EXPECT_NE(out.plan.safe_zone.find("mm too close to robot"), std::string::npos) << out.plan.safe_zone;
+  ASSERT_TRUE(out.move.completed) << out.move.summary << out.plan.notes;
+  EXPECT_LT(error_deg(*plane.arms(outside), targets.at(outside)), 0.1);
+}
+
 TEST(Client, ACallThatOverrunsItsTimeoutStopsEveryRobotAndThrows) {
   auto slow = fast_plane();
   slow.time_scale = 2;  // the move takes seconds of wall time
@@ -348,6 +401,20 @@ TEST(Client, OpenedFromBusSpecsPlansOnceGivenTheLayout) {
   const auto out = fps.plan_and_move({{1, {30, 150}}});
   EXPECT_TRUE(out.move.completed) << out.move.summary;
   EXPECT_LT(error_deg(*plane.arms(1), {30, 150}), 0.1);
+}
+
+TEST(Client, TheVersionByteOrderOptionReachesEveryRobotsRead) {
+  sim::SimulatedPlane plane("benchtop", fast_plane());  // robots send the field's order
+  auto config = fast_client();
+  config.document_version_byte_order = true;
+  Client fps(config);
+  fps.open(plane.plane());
+  const auto robots = fps.discover();
+  ASSERT_EQ(robots.size(), 6u);
+  for (const auto& r : robots) {
+    EXPECT_TRUE(r.firmware.empty()) << r.id << ": " << r.firmware;
+    EXPECT_NE(r.error.find("byte order"), std::string::npos) << r.id << ": " << r.error;
+  }
 }
 
 TEST(Client, CallsBeforeOpenAreErrors) {

@@ -108,7 +108,7 @@ PlannerOptions one_thread() {
 TEST(LayoutGeometry, OldGeometryPlanTouchesTheTrueGeometryTheNewPlanDoesNot) {
   const GeometryProblem p;
   // Planned on the old geometry: clean in its own model...
-  PlanRequest old_req{p.start, p.targets(p.old_model), {}};
+  PlanRequest old_req{p.start, p.targets(p.old_model), {}, {}};
   const Plan old_plan = plan_moves(p.old_model, old_req, one_thread()).value();
   ASSERT_TRUE(old_plan.verified);
   EXPECT_EQ(old_plan.not_reached, 0u) << old_plan.summary(p.old_model);
@@ -136,7 +136,7 @@ TEST(LayoutGeometry, OldGeometryPlanTouchesTheTrueGeometryTheNewPlanDoesNot) {
 
   // Planned on the true geometry: the impossible targets are parked, with the reason, and the
   // plan checks clean on the true geometry, by the planner and by an independent checker run.
-  PlanRequest req{p.start, p.targets(p.true_model), {}};
+  PlanRequest req{p.start, p.targets(p.true_model), {}, {}};
   const Plan plan = plan_moves(p.true_model, req, one_thread()).value();
   EXPECT_TRUE(plan.verified);
   EXPECT_EQ(plan.robots[0].status, RobotPlan::Status::parked);

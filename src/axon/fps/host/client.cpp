@@ -69,10 +69,12 @@ MoveOutcome outcome_of(const std::map<std::uint16_t, host::ArmAngles>& targets, 
 
 PlanOutcome plan_outcome(const plan::CollisionModel& model, const plan::Plan& p, std::string notes) {
   PlanOutcome out{p.verified, model.size(), p.not_reached, p.stats.duration_s, p.stats.plan_s, p.check.min_clearance_mm,
-                  {}, std::move(notes)};
+                  {}, std::move(notes), {}, {}};
   for (std::size_t i = 0; i < model.size() && i < p.robots.size(); ++i)
     out.ends[static_cast<std::uint16_t>(model.robot(i).id())] = {p.robots[i].end.alpha_deg, p.robots[i].end.beta_deg};
   out.notes += p.summary(model);
+  for (const auto id : p.safe_zone.robots()) out.outside_safe_zone.push_back(static_cast<std::uint16_t>(id));
+  out.safe_zone = p.safe_zone.summary();
   return out;
 }
 
@@ -111,6 +113,8 @@ struct Client::Impl {
     o.client.timeout = duration_of(config.reply_timeout_s);
     o.positioner.poll_interval = duration_of(config.poll_interval_s);
     o.positioner.position_tolerance = config.position_tolerance_deg;
+    if (config.field_firmware_history) o.positioner.firmware_history = protocol::FirmwareHistory::field;
+    if (config.document_version_byte_order) o.positioner.version_byte_order = protocol::VersionByteOrder::document;
     o.discover_window = duration_of(config.discover_window_s);
     return o;
   }
@@ -343,6 +347,8 @@ PlanAndMoveOutcome plan_and_move_on(Client::Impl& impl, const std::vector<plan::
   o.planner.speed = {s.speed_deg_s, s.speed_deg_s};
   o.planner.seed = s.seed;
   o.allow_partial = s.allow_partial;
+  o.refuse_outside_safe_zone = s.refuse_outside_safe_zone;
+  o.point_fibre = plan::point_fibres(*model, targets, poses);
   const FocalPlane& plane = *impl.layout;
   return impl.run([&array, &plane, model, poses, o, notes]() -> asio::awaitable<PlanAndMoveOutcome> {
     auto r = co_await host::plan_and_move(array, plane, *model, poses, o);

@@ -48,6 +48,11 @@ struct ClientConfig {
   double poll_interval_s = 0.25;   // status polling while robots move
   double discover_window_s = 0.5;  // GET_ID answers collected by discovery
   double position_tolerance_deg = 0.1;  // a move ends this close to its target, per arm
+  // Firmware versions (docs/fps-host.md): the field's command history (the precise-move switches
+  // from 04.01.17 on; commands a robot's version lacks fail with HostErrc::firmware_lacks unsent)
+  // instead of the document's, and GET_FIRMWARE_VERSION's bytes in the document's order.
+  bool field_firmware_history = false;
+  bool document_version_byte_order = false;
 };
 
 // One robot's row of status(): plain values.
@@ -92,6 +97,10 @@ struct PlanSettings {
   std::uint64_t seed = 1;        // the planner's nudges
   bool park_bad_targets = true;  // false: a bad target fails the call instead of parking that robot
   bool allow_partial = false;    // move the others when some robots cannot reach their targets
+  // Targets outside their robots' safe zones (spec section 11: the arms' length and angle errors;
+  // docs/fps-plan.md): true refuses the call (PlanErrc::outside_safe_zone naming the robots and by
+  // how much) before anything moves; false only reports them in PlanOutcome.
+  bool refuse_outside_safe_zone = false;
 };
 
 struct PlanOutcome {
@@ -103,6 +112,8 @@ struct PlanOutcome {
   double min_clearance_mm = 0;
   std::map<std::uint16_t, Angles> ends;  // where the plan leaves each robot
   std::string notes;               // targets parked, robots held (one line each)
+  std::vector<std::uint16_t> outside_safe_zone;  // robots whose targets leave their safe zones
+  std::string safe_zone;           // why, one line each ("robot 12: target 0.180 mm beyond ...")
 };
 
 struct PlanAndMoveOutcome {

@@ -29,6 +29,7 @@ class HostCategory final : public std::error_category {
       case HostErrc::upgrade_failed: return "firmware upgrade failed; see the per-positioner report";
       case HostErrc::wrong_executor: return "all buses of one array must run on the same executor";
       case HostErrc::invalid_argument: return "invalid argument";
+      case HostErrc::firmware_lacks: return "the robot's firmware version lacks this command or status layout";
     }
     return "unknown fps host error";
   }

@@ -27,6 +27,7 @@ enum class HostErrc {
   upgrade_failed,        // firmware upgrade did not verify (see the per-robot report)
   wrong_executor,        // buses given to one Array live on different executors
   invalid_argument,      // a bad option or input from the caller
+  firmware_lacks,        // the robot's firmware version lacks the command or the status layout (firmware_gates.hpp)
 };
 
 const std::error_category& host_category() noexcept;

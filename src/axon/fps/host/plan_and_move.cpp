@@ -40,13 +40,16 @@ Result<plan::PlanRequest> request_from_status(const FocalPlane& plane, const pla
 
 namespace {
 
-// The plan may move robots only when the checker verified it and, unless partial moves are
-// allowed, every robot reaches its target.
-Result<void> plan_usable(const plan::Plan& p, bool allow_partial) {
+// The plan may move robots only when the checker verified it, unless partial moves are allowed
+// every robot reaches its target, and when asked every target lies within its safe zone.
+Result<void> plan_usable(const plan::Plan& p, const PlanAndMoveOptions& o) {
   if (!p.verified) return Error(plan::PlanErrc::robot_collision, "the checker rejected the plan: not moving");
-  if (p.not_reached > 0 && !allow_partial)
+  if (p.not_reached > 0 && !o.allow_partial)
     return Error(plan::PlanErrc::robot_collision,
                  fmt::format("{} robots cannot reach their targets; allow partial moves to move the rest", p.not_reached));
+  if (o.refuse_outside_safe_zone && !p.safe_zone.ok())
+    return Error(plan::PlanErrc::outside_safe_zone,
+                 fmt::format("robots {} (not moving):\n{}", fmt::join(p.safe_zone.robots(), " "), p.safe_zone.summary()));
   return ok();
 }
 
@@ -58,11 +61,12 @@ asio::awaitable<Result<PlanAndMoveReport>> plan_and_move(Array& array, const Foc
   const auto table = co_await array.status_table(true);
   auto req = request_from_status(plane, model, table, std::move(targets));
   if (!req) co_return req.error();
+  req.value().point_fibre = options.point_fibre;
   auto planned = plan::plan_moves(model, req.value(), options.planner);
   if (!planned) co_return planned.error();
   PlanAndMoveReport report{std::move(planned).value(), std::nullopt};
   if (options.on_plan) options.on_plan(report.plan);
-  if (auto usable = plan_usable(report.plan, options.allow_partial); !usable) co_return usable.error();
+  if (auto usable = plan_usable(report.plan, options); !usable) co_return usable.error();
   auto uploads = plan_trajectories(model, report.plan);
   if (!uploads) co_return uploads.error();
   if (uploads.value().empty()) co_return report;

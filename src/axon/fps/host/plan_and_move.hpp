@@ -29,6 +29,12 @@ namespace axon::fps::host {
 struct PlanAndMoveOptions {
   plan::PlannerOptions planner;
   bool allow_partial = false;  // move the others when some robots cannot reach their targets
+  // Targets that leave their robots' safe zones (Plan::safe_zone, spec section 11): refused with
+  // PlanErrc::outside_safe_zone naming them before anything moves; false: only reported.
+  bool refuse_outside_safe_zone = false;
+  // Per robot (model order), the fibre whose point its target is (plan::point_fibres): the safe
+  // zone's reach check; empty: targets are poses.
+  std::vector<std::optional<std::size_t>> point_fibre;
   TrajectoryOptions trajectory;
   // Called with the plan once it is made, before anything moves (a summary, a saved plan.json),
   // also when it is then refused.
@@ -52,7 +58,8 @@ struct PlanAndMoveReport {
 
 // The whole sequence. `targets`: one pose per robot, model order (plan::target_poses). Errors:
 // request_from_status's, the planner's, PlanErrc::robot_collision when the checker rejected the
-// plan or robots cannot reach their targets (without allow_partial), and run_trajectories' own
+// plan or robots cannot reach their targets (without allow_partial), PlanErrc::outside_safe_zone
+// (with refuse_outside_safe_zone), and run_trajectories' own
 // (locked, ...). What the run did per robot is in the report.
 asio::awaitable<Result<PlanAndMoveReport>> plan_and_move(Array& array, const FocalPlane& plane,
                                                          const plan::CollisionModel& model, std::vector<plan::Pose> targets,

@@ -88,7 +88,16 @@ Result<void> Positioner::still_free() const {
   return lock->interrupted(id_);
 }
 
+Result<void> Positioner::firmware_gate(CommandId c) const {
+  if (!firmware_ || firmware_->is_bootloader()) return ok();
+  auto why = protocol::firmware_lacks(c, *firmware_, options_.firmware_history);
+  if (c == CommandId::get_status && why.empty()) why = protocol::status_layout_unknown(*firmware_);
+  if (why.empty()) return ok();
+  return Error(HostErrc::firmware_lacks, fmt::format("positioner {}: {}; not sent", id_, why));
+}
+
 asio::awaitable<Result<void>> Positioner::simple(CommandId c) {
+  if (auto g = firmware_gate(c); !g) co_return g.error();
   auto r = co_await client_->request(id_, c);
   if (!r) co_return r.error();
   co_return ok();
@@ -97,13 +106,18 @@ asio::awaitable<Result<void>> Positioner::simple(CommandId c) {
 // --- reads ---------------------------------------------------------------------------------------
 
 asio::awaitable<Result<protocol::FirmwareVersion>> Positioner::read_firmware_version() {
-  auto r = co_await client_->call<CommandId::get_firmware_version>(id_);
+  auto r = co_await client_->request(id_, CommandId::get_firmware_version);
   if (!r) co_return r.error();
-  firmware_ = r.value().version;
+  auto v = protocol::FirmwareVersion::decode(r.value().payload, options_.version_byte_order);
+  if (!v)
+    co_return Error(v.error().code, fmt::format("positioner {}: firmware version: {} (is the byte order option right?)", id_,
+                                                v.error().detail));
+  firmware_ = v.value();
   co_return *firmware_;
 }
 
 asio::awaitable<Result<PositionerStatus>> Positioner::read_status() {
+  if (auto g = firmware_gate(CommandId::get_status); !g) co_return g.error();
   auto r = co_await client_->request(id_, CommandId::get_status);
   if (!r) co_return r.error();
   if (r.value().payload.size() == protocol::BootloaderStatus::kWireSize) {

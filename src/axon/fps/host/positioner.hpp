@@ -18,6 +18,7 @@
 
 #include "axon/core/error.hpp"
 #include "axon/fps/host/command_client.hpp"
+#include "axon/fps/protocol/firmware_gates.hpp"
 #include "axon/fps/protocol/firmware_version.hpp"
 #include "axon/fps/protocol/payloads.hpp"
 #include "axon/fps/protocol/status.hpp"
@@ -54,6 +55,11 @@ struct PositionerOptions {
   core::Duration datum_calibration_timeout = 300s;
   core::Duration cogging_calibration_timeout = 3600s;  // the document allows up to 40 min
   std::size_t trajectory_window = 8;          // trajectory points in flight to one robot
+  // How the robots order GET_FIRMWARE_VERSION's bytes (protocol/firmware_version.hpp).
+  protocol::VersionByteOrder version_byte_order = protocol::VersionByteOrder::field;
+  // Which commands a firmware version has (protocol/firmware_gates.hpp): a gated command is
+  // refused with HostErrc::firmware_lacks before it is sent, once the robot's version is known.
+  protocol::FirmwareHistory firmware_history = protocol::FirmwareHistory::document;
 };
 
 // Hears about collision flags a positioner finds while polling a robot (the backup for a lost
@@ -119,8 +125,10 @@ class Positioner {
   [[nodiscard]] bool in_bootloader() const noexcept { return firmware_ && firmware_->is_bootloader(); }
 
   // --- reads -----------------------------------------------------------------------------------
+  // Decoded in PositionerOptions::version_byte_order; the version then gates what is sent.
   asio::awaitable<Result<protocol::FirmwareVersion>> read_firmware_version();
   // Main application status. A 4-byte answer means the bootloader runs: HostErrc::not_ready.
+  // Application firmware known to predate the 64-bit status word: HostErrc::firmware_lacks, not sent.
   asio::awaitable<Result<protocol::PositionerStatus>> read_status();
   // Bootloader status. An 8-byte answer means the main application runs: HostErrc::not_in_bootloader.
   asio::awaitable<Result<protocol::BootloaderStatus>> read_bootloader_status();
@@ -150,7 +158,8 @@ class Positioner {
   asio::awaitable<Result<void>> set_position(ArmAngles position);
   // Commands 118..125: control loop and collision detection per arm (Arm::both sends both).
   asio::awaitable<Result<void>> set_loop(Arm arm, Loop loop, bool collision_detection);
-  asio::awaitable<Result<void>> set_precise_move(Arm arm, bool on);  // 128..131
+  // 128..131; gated (PositionerOptions::firmware_history): HostErrc::firmware_lacks, not sent.
+  asio::awaitable<Result<void>> set_precise_move(Arm arm, bool on);
   asio::awaitable<Result<void>> set_led(bool on);                    // 126 / 127
   // 116 / 117. After switching on, the sensors take about 5 s to wake; moves before then are
   // refused with HALL_SENSORS_DISABLED.
@@ -196,6 +205,9 @@ class Positioner {
   // HostErrc::locked while the client's lock is held (a motion step under way ends).
   Result<void> still_free() const;
   asio::awaitable<Result<void>> simple(protocol::CommandId c);
+  // HostErrc::firmware_lacks when the robot's known application version lacks `c` (or, for
+  // GET_STATUS, the status layout).
+  [[nodiscard]] Result<void> firmware_gate(protocol::CommandId c) const;
   asio::awaitable<Result<MoveResult>> move(ArmAngles value, bool relative);
   // wait_for a step the robot runs; stops the robot when the host gives up on it.
   asio::awaitable<Result<protocol::PositionerStatus>> watch_motion(std::function<bool(const protocol::PositionerStatus&)> done,

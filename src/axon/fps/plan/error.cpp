@@ -27,6 +27,8 @@ class PlanCategory final : public std::error_category {
         return "target file cannot be read; see docs/fps-plan.md for the format";
       case PlanErrc::bad_trajectory:
         return "invalid trajectory: points need finite values and strictly increasing times";
+      case PlanErrc::outside_safe_zone:
+        return "targets outside their robots' safe zones: a robot within the arm tolerances may miss them or touch";
     }
     return "unknown fps planning error";
   }

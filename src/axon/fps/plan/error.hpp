@@ -19,6 +19,7 @@ enum class PlanErrc {
   obstacle_collision,  // the target pose brings the beta arm too close to a fiducial or obstacle
   bad_target_file,     // the target file cannot be parsed (syntax, missing or contradicting columns)
   bad_trajectory,      // a trajectory is empty, has decreasing times or non-finite values
+  outside_safe_zone,   // targets leave their robots' safe zones (spec section 11; safe_zone.hpp)
 };
 
 const std::error_category& plan_category() noexcept;

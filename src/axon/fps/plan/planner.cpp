@@ -376,6 +376,7 @@ Result<Plan> plan_moves(const CollisionModel& model, const PlanRequest& request,
   }
   Setup setup{plan, target, still, request.current};
   hold_start_contacts(model, setup);
+  if (o.safe_zone) plan.safe_zone = check_safe_zone(model, request.target, {still, request.point_fibre}, *o.safe_zone);
   std::vector<Segment> segs(n);
   std::vector<Contact> contacts;
 

@@ -16,9 +16,11 @@
 
 #include "axon/fps/plan/checker.hpp"
 #include "axon/fps/plan/collision.hpp"
+#include "axon/fps/plan/safe_zone.hpp"
 #include "axon/fps/plan/trajectory.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -63,12 +65,18 @@ struct PlannerOptions {
   bool verify = true;             // run the checker on the result
   CheckOptions check{};           // the checker's settings (full buffer)
   bool parallel = true;           // plan both halves on two threads
+  // The targets' check against the robots' safe zones (spec section 11, safe_zone.hpp), reported
+  // in Plan::safe_zone; it changes nothing in the plan (nullopt: not checked).
+  std::optional<SafeZoneOptions> safe_zone = SafeZoneOptions{};
 };
 
 struct PlanRequest {
   std::vector<Pose> current;  // one per robot, model order
   std::vector<Pose> target;   // one per robot, model order
   std::vector<bool> frozen;   // optional: robots that must not move (disabled, offline)
+  // optional: per robot, the fibre whose focal-plane point its target is (point_fibres(), for the
+  // safe zone's reach check); empty or nullopt: an explicit pose.
+  std::vector<std::optional<std::size_t>> point_fibre;
 };
 
 struct RobotPlan {
@@ -110,6 +118,7 @@ struct Plan {
   std::size_t not_reached = 0;                // parked + held
   bool verified = false;                      // the checker ran and found no contact
   CheckReport check;                          // the checker's report (if verify)
+  SafeZoneReport safe_zone;                   // targets outside their robots' safe zones (if checked)
   PlanStats stats;
 
   [[nodiscard]] bool ok() const noexcept { return not_reached == 0 && (verified || check.samples == 0); }

@@ -220,7 +220,7 @@ void PositionerModel::handle_application(const proto::Message& m, const proto::C
   switch (c.id) {
     case CommandId::get_id: return done(ResponseCode::accepted, proto::PositionerIdReply{config_.id}.encode());
     case CommandId::get_firmware_version:
-      return done(ResponseCode::accepted, proto::FirmwareVersionReply{flash_.main.version}.encode());
+      return done(ResponseCode::accepted, flash_.main.version.encode(config_.version_byte_order));
     case CommandId::get_status: return done(ResponseCode::accepted, proto::StatusReply{status()}.encode());
 
     case CommandId::send_new_trajectory: {

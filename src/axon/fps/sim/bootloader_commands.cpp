@@ -19,7 +19,7 @@ void PositionerModel::handle_bootloader(const proto::Message& m, const proto::Co
   switch (c.id) {
     case CommandId::get_id: return done(ResponseCode::accepted, proto::PositionerIdReply{config_.id}.encode());
     case CommandId::get_firmware_version:
-      return done(ResponseCode::accepted, proto::FirmwareVersionReply{config_.bootloader}.encode());
+      return done(ResponseCode::accepted, config_.bootloader.encode(config_.version_byte_order));
     case CommandId::get_status:
       return done(ResponseCode::accepted, proto::BootloaderStatusReply{boot_.status}.encode());
 

@@ -62,18 +62,6 @@ Result<E> choice(const core::ConfigNode& node, std::string_view key,
 
 }  // namespace
 
-bool firmware_takes(protocol::CommandId c, protocol::FirmwareVersion version, FirmwareHistory history) noexcept {
-  using protocol::CommandId;
-  switch (c) {
-    case CommandId::switch_on_precise_move_alpha:
-    case CommandId::switch_off_precise_move_alpha:
-    case CommandId::switch_on_precise_move_beta:
-    case CommandId::switch_off_precise_move_beta:
-      return history == FirmwareHistory::document || version.has_precise_move_switches();
-    default: return true;
-  }
-}
-
 Result<void> PositionerConfig::validate() const {
   if (id < 1 || id > 2047) return bad("id", fmt::format("{} is not within 1..2047", id));
   if (firmware.is_bootloader()) return bad("firmware", "must not have the bootloader's middle number 80");
@@ -122,7 +110,7 @@ Result<void> PositionerConfig::validate() const {
 
 namespace {
 constexpr std::string_view kKeys[] = {
-    "id", "firmware", "bootloader", "get_holding_current_on_112", "firmware_history", "start_without_trajectory", "gear_ratio", "hard_stop_lower_deg",
+    "id", "firmware", "bootloader", "get_holding_current_on_112", "firmware_history", "version_byte_order", "start_without_trajectory", "gear_ratio", "hard_stop_lower_deg",
     "hard_stop_upper_deg", "default_speed_rpm", "min_speed_rpm", "max_speed_rpm", "max_current_percent",
     "default_drive_current_percent", "precise_approach_deg", "datum_backoff_deg", "motor_calibration_turns",
     "datum_spread_motor_deg", "motors_calibrated", "datums_calibrated", "cogging_calibrated", "datums_initialized",
@@ -179,6 +167,12 @@ Result<PositionerConfig> PositionerConfig::from_config(const core::ConfigNode& n
                                            {{"document", FirmwareHistory::document}, {"field", FirmwareHistory::field}});
     if (!v) return v.error();
     c.firmware_history = v.value();
+  }
+  if (node.has("version_byte_order")) {
+    const auto v = choice<protocol::VersionByteOrder>(
+        node, "version_byte_order", {{"field", protocol::VersionByteOrder::field}, {"document", protocol::VersionByteOrder::document}});
+    if (!v) return v.error();
+    c.version_byte_order = v.value();
   }
   if (node.has("start_without_trajectory")) {
     const auto v = choice<EmptyStart>(node, "start_without_trajectory",

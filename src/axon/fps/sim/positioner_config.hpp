@@ -10,6 +10,7 @@
 #include "axon/core/error.hpp"
 #include "axon/fps/layout/arm_lengths.hpp"
 #include "axon/fps/protocol/commands.hpp"
+#include "axon/fps/protocol/firmware_gates.hpp"
 #include "axon/fps/protocol/firmware_version.hpp"
 #include "axon/fps/sim/sim_time.hpp"
 
@@ -32,23 +33,11 @@ enum class EmptyStart : std::uint8_t {
   refuse,  // code 2 INVALID_TRAJECTORY (the simulator's behaviour before issue 14)
 };
 
-// Which commands an application firmware version takes beyond the document's table 6.
-enum class FirmwareHistory : std::uint8_t {
-  document,  // every command of table 6 (which describes 04.01.13) in every version modelled
-  field,     // as above, but the precise-move switches 128..131 only from 04.01.17 on (FIELD-NOTES:
-             // hosts in service send them from that version); older versions answer 13, unknown
-};
-
-// The oldest application firmware modelled: from 04.01.00 on the status word is the 64-bit one of
-// the document (FIELD-NOTES); the 32-bit layout of older versions is not described anywhere we can
-// cite, so older versions are refused rather than answered wrongly.
-inline constexpr protocol::FirmwareVersion kOldestModelledFirmware{4, 1, 0};
-
-// Does application firmware `version` know command `c` at all? A command it does not know is
-// answered 13 (UNKNOWN_COMMAND, table 3); check_device_request decides the rest (mode, broadcast,
-// size).
-[[nodiscard]] bool firmware_takes(protocol::CommandId c, protocol::FirmwareVersion version,
-                                  FirmwareHistory history) noexcept;
+// The version gates (which commands a version has, the oldest modelled status layout) are the
+// host's too: protocol/firmware_gates.hpp.
+using protocol::FirmwareHistory;
+using protocol::firmware_takes;
+using protocol::kOldestModelledFirmware;
 
 struct PositionerConfig {
   // Identity.
@@ -57,6 +46,9 @@ struct PositionerConfig {
   protocol::FirmwareVersion bootloader{3, 80, 1};          // middle number 80
   protocol::DeviceOptions device_options{};                // firmware quirks (112 read as a get)
   FirmwareHistory firmware_history = FirmwareHistory::document;  // commands per version
+  // How GET_FIRMWARE_VERSION's reply orders its bytes (firmware_version.hpp): the field's order,
+  // or the document's prose order for firmware that really does it.
+  protocol::VersionByteOrder version_byte_order = protocol::VersionByteOrder::field;
   EmptyStart start_without_trajectory = EmptyStart::accept;   // START_TRAJECTORY with nothing loaded
 
   // Mechanics.
@@ -119,6 +111,7 @@ struct PositionerConfig {
 
   // Reads the keys present in `node` on top of `base` (unknown keys are errors). Keys: id, firmware
   // ("04.01.13"), bootloader, get_holding_current_on_112, firmware_history (document | field),
+  // version_byte_order (field | document),
   // start_without_trajectory (accept | refuse), gear_ratio, hard_stop_lower_deg and
   // hard_stop_upper_deg ([alpha, beta] or one number), default_speed_rpm, min_speed_rpm,
   // max_speed_rpm, max_current_percent, default_drive_current_percent, precise_approach_deg,
