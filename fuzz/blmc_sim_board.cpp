@@ -8,8 +8,11 @@
 //   1  time step: one byte of milliseconds (x 16 when op bit 2 is set)
 //   2  fault: one byte (kind % 5; bit 4 a one-second cause, bit 5 persistent); op bit 2 power-cycles instead
 //   3  shaft state of a motor: one byte (bit 0 motor), one byte position, one byte velocity
-// Nothing may crash, every frame the board sends must decode as a board message, and the motors'
-// state must stay finite with readings within +-100 revolutions.
+// Nothing may crash, every frame the board sends must decode as a board message (a status with
+// the undocumented error code 6 decodes to ProtocolErrc::unknown_error_code, and only after that
+// fault was injected), and the motors' state must stay finite with readings within +-100
+// revolutions.
+#include "axon/blmc/protocol/error.hpp"
 #include "axon/blmc/protocol/frames.hpp"
 #include "axon/blmc/sim/board.hpp"
 #include "axon/can/frame.hpp"
@@ -39,6 +42,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   sim::BoardTime now{0};
   std::vector<can::Frame> out;
   std::size_t i = 0;
+  bool undocumented = false;  // the undocumented error code was injected (it stays latched)
   const auto next = [&]() -> std::uint8_t { return i < size ? data[i++] : 0; };
   while (i < size) {
     const std::uint8_t op = next();
@@ -63,6 +67,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if ((op & 4) != 0) {
           board.power_cycle();
         } else {
+          undocumented = undocumented || static_cast<sim::FaultKind>(b % 5) == sim::FaultKind::undocumented;
           board.inject(static_cast<sim::FaultKind>(b % 5), (b & 16) != 0 ? std::chrono::seconds(1) : sim::BoardTime{0},
                        (b & 32) != 0);
         }
@@ -78,7 +83,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     out.clear();
     board.advance(now, out);
-    for (const auto& f : out) require(protocol::decode_from_board(f).has_value());
+    for (const auto& f : out) {
+      const auto decoded = protocol::decode_from_board(f);
+      require(decoded.has_value() || (undocumented && decoded.error().code == protocol::ProtocolErrc::unknown_error_code));
+    }
     for (std::size_t m = 0; m < 2; ++m) {
       const auto& motor = board.motor(m);
       require(std::isfinite(motor.continuous_position_rev()) && std::isfinite(motor.velocity_rev_s()));

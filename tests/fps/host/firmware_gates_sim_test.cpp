@@ -32,8 +32,9 @@ struct SwitchOff {
 
 SwitchOff switch_precise_off(FirmwareHistory history) {
   SimRig rig(1, fast_sim(), array_with(history));
-  for (const auto& [id, version] : {std::pair<std::uint16_t, protocol::FirmwareVersion>{7, {4, 1, 16}}, {8, {4, 1, 17}}}) {
-    rig.add(id, 0, [version](sim::PositionerConfig& c) {
+  for (const auto& robot : {std::pair<std::uint16_t, protocol::FirmwareVersion>{7, {4, 1, 16}}, {8, {4, 1, 17}}}) {
+    const auto version = robot.second;  // (clang 14 cannot capture a structured binding)
+    rig.add(robot.first, 0, [version](sim::PositionerConfig& c) {
       c.firmware = version;
       c.firmware_history = FirmwareHistory::field;
     });
