@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-namespace axon::c4g::test {
+namespace axon::c4g::manual_programs_test {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
@@ -154,4 +154,4 @@ TEST(ManualPrograms, Mode8And9ThePcAddsToTheControllersLoopsDuringTheMove) {
 }
 
 }  // namespace
-}  // namespace axon::c4g::test
+}  // namespace axon::c4g::manual_programs_test

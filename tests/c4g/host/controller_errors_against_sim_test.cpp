@@ -20,7 +20,7 @@
 #include <optional>
 #include <thread>
 
-namespace axon::c4g::test {
+namespace axon::c4g::controller_errors_test {
 namespace {
 
 namespace P = protocol;
@@ -280,4 +280,4 @@ TEST(ControllerErrorsAgainstSim, ANormalEndIsNoError) {
 }
 
 }  // namespace
-}  // namespace axon::c4g::test
+}  // namespace axon::c4g::controller_errors_test
