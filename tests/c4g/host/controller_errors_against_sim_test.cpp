@@ -1,6 +1,7 @@
 // The controller's documented errors and checks (manual chapters 14.8, 14.17.1, 17), raised by the
 // simulator and recognised by the Server from its packets (host::ControllerWatch), over loopback
 // UDP. The simulator takes the lenient reply window: the subject is the errors, not the latency.
+#include "c4g/host/sim_events.hpp"
 #include "axon/c4g/host/server.hpp"
 #include "axon/c4g/protocol/mode.hpp"
 #include "axon/c4g/sim/client_runner.hpp"
@@ -49,14 +50,9 @@ struct Run {
   std::optional<S::Controller> c;
   std::vector<S::Event> events;
   [[nodiscard]] bool has(std::string_view name, std::string_view text = {}) const {
-    return std::any_of(events.begin(), events.end(),
-                       [&](const S::Event& e) { return e.name == name && e.text.find(text) != std::string::npos; });
+    return test::has_event(events, name, text);
   }
-  [[nodiscard]] std::string log() const {
-    std::string out;
-    for (const auto& e : events) out += e.name + ": " + e.text + "\n";
-    return out;
-  }
+  [[nodiscard]] std::string log() const { return test::event_log(events); }
 };
 
 Run play(const H::Server& server, std::string_view yaml, S::RobotConfig robot = S::six_axis_robot(), double max_s = 10) {

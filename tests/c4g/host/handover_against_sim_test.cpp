@@ -3,6 +3,7 @@
 // over loopback UDP. The PC's part: a trajectory of its own in mode 4 (type A), corrections on the
 // controller's move in mode 7 (type B), each ended by exit-from-open; type B is run with the PC's
 // exit before and after the end of the controller's move (the manual: either order must work).
+#include "c4g/host/sim_events.hpp"
 #include "axon/c4g/host/server.hpp"
 #include "axon/c4g/protocol/mode.hpp"
 #include "axon/c4g/sim/client_runner.hpp"
@@ -76,14 +77,9 @@ struct Outcome {
   bool done = false, comm_error = false;
   std::uint64_t refused = 0;
   [[nodiscard]] bool has(std::string_view name, std::string_view text) const {
-    return std::any_of(events.begin(), events.end(),
-                       [&](const S::Event& e) { return e.name == name && e.text.find(text) != std::string::npos; });
+    return test::has_event(events, name, text);
   }
-  [[nodiscard]] std::string log() const {
-    std::string out;
-    for (const auto& e : events) out += e.name + ": " + e.text + "\n";
-    return out;
-  }
+  [[nodiscard]] std::string log() const { return test::event_log(events); }
 };
 
 Outcome run_example(const H::Server& server) {
