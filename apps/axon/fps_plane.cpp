@@ -10,6 +10,7 @@
 #include "axon/fps/host/plane_upgrade.hpp"
 #include "axon/fps/host/trajectory_build.hpp"
 #include "axon/fps/host/trajectory_speed.hpp"
+#include "axon/fps/host/troubleshoot.hpp"
 #include "checks.hpp"
 #include "id_list.hpp"
 #include "fps_json.hpp"
@@ -72,6 +73,12 @@ struct PlaneArgs {
   double wait_s = 600;            // correct: for each measurement file to appear
   std::vector<std::string> backoff_ids;  // backoff: empty = every robot in contact
   bool unlock = false;                   // backoff: STOP_TRAJECTORY on every bus first
+  std::vector<std::string> friction_ids; // friction: empty = every robot
+  std::string history;                   // friction: the history CSV
+  host::FrictionOptions friction;        // friction: speeds, step, growth limit, reference speed
+  int hall_id = 0;                       // halltest
+  host::HallTestOptions hall;            // halltest: step, speed, tolerance
+  std::string arm = "both";              // friction, halltest: alpha, beta or both
 };
 
 
@@ -363,6 +370,69 @@ asio::awaitable<int> plane_back_off(host::FocalPlaneArray& fpa, const PlaneArgs&
   co_return rep.ok() ? 0 : 1;
 }
 
+json friction_json(const host::FrictionReport& rep) {
+  json arms = json::array();
+  for (const auto& f : rep.arms) {
+    json points = json::array();
+    for (const auto& p : f.points)
+      points.push_back({{"speed_rpm", p.speed_rpm}, {"current_percent", p.current_percent}, {"readings", p.readings},
+                        {"move_s", p.move_s}, {"eta_s", p.eta_s}});
+    json fit = f.fit ? json{{"stiction_percent", f.fit->stiction_percent},
+                            {"viscous_percent_per_krpm", f.fit->viscous_percent_per_krpm}, {"rms_percent", f.fit->rms_percent}}
+                     : json(nullptr);
+    arms.push_back({{"id", f.id}, {"arm", f.arm == 'a' ? "alpha" : "beta"}, {"verdict", host::to_string(f.verdict)},
+                    {"fit", fit}, {"points", points}, {"step_deg", f.step_deg}, {"move_ratio", f.move_ratio},
+                    {"baseline_time_utc", f.baseline ? json(f.baseline->time_utc) : json(nullptr)},
+                    {"growth", f.growth}, {"move_growth", f.move_growth}, {"problem", f.problem}, {"advice", f.advice}});
+  }
+  return {{"ok", rep.ok()}, {"time_utc", rep.time_utc}, {"arms", arms}};
+}
+
+json hall_json(const host::HallTestReport& rep) {
+  json arms = json::array();
+  for (const auto& f : rep.arms)
+    arms.push_back({{"id", f.id}, {"arm", f.arm == 'a' ? "alpha" : "beta"}, {"verdict", host::to_string(f.verdict)},
+                    {"step_deg", f.step_deg}, {"hall_before_deg", f.hall_before_deg}, {"hall_after_deg", f.hall_after_deg},
+                    {"position_before_deg", f.position_before_deg}, {"position_after_deg", f.position_after_deg},
+                    {"tracking_error_deg", f.tracking_error_deg}, {"restored", f.restored}, {"problem", f.problem},
+                    {"advice", f.advice}});
+  return {{"ok", rep.ok()}, {"arms", arms}};
+}
+
+void choose_arms(const std::string& arm, bool& alpha, bool& beta) {
+  alpha = arm != "beta";
+  beta = arm != "alpha";
+}
+
+// `fps plane friction` (interface document 9.4.2): the trend against the history file, which gets
+// the new records; 0 when nothing increased or failed.
+asio::awaitable<int> plane_friction(host::FocalPlaneArray& fpa, const PlaneArgs& a, const fps::FocalPlane& plane) {
+  const auto model = need(fps::plan::model_from_layout(plane));
+  auto o = a.friction;
+  choose_arms(a.arm, o.alpha, o.beta);
+  if (!a.history.empty()) o.history = need(host::load_friction_history(a.history));
+  std::vector<std::uint16_t> ids;
+  if (!a.friction_ids.empty()) ids = need(parse_id_lists(a.friction_ids));
+  auto r = co_await host::friction_survey(fpa.array(), model, std::move(ids), std::move(o));
+  const auto rep = need(std::move(r));
+  if (!a.history.empty()) need(host::append_friction_history(a.history, rep.records()));
+  if (a.json) print_plane_json(friction_json(rep));
+  else std::fputs(rep.summary().c_str(), stdout);
+  co_return rep.ok() ? 0 : 1;
+}
+
+// `fps plane halltest ID` (9.4.3); 0 when every arm tested is ok.
+asio::awaitable<int> plane_hall_test(host::FocalPlaneArray& fpa, const PlaneArgs& a, const fps::FocalPlane& plane) {
+  const auto model = need(fps::plan::model_from_layout(plane));
+  auto o = a.hall;
+  choose_arms(a.arm, o.alpha, o.beta);
+  auto r = co_await host::hall_test(fpa.array(), model, static_cast<std::uint16_t>(a.hall_id), o);
+  const auto rep = need(std::move(r));
+  if (a.json) print_plane_json(hall_json(rep));
+  else std::fputs(rep.summary().c_str(), stdout);
+  co_return rep.ok() ? 0 : 1;
+}
+
 // One `fps plane` action on the connected plane; returns the exit code.
 asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a, const std::string& action,
                                   const fps::FocalPlane& plane, const SetOnSignal& set_on_signal,
@@ -385,6 +455,10 @@ asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a
   if (action == "backoff") {
     stop_robots_on_signal(set_on_signal, fpa.array());
     rc = co_await plane_back_off(fpa, a, plane);
+  }
+  if (action == "friction" || action == "halltest") {
+    stop_robots_on_signal(set_on_signal, fpa.array());
+    rc = action == "friction" ? co_await plane_friction(fpa, a, plane) : co_await plane_hall_test(fpa, a, plane);
   }
   if (action == "correct") rc = co_await plane_correct(fpa, a, plane, set_on_signal);
   if (action == "upgrade") {
@@ -452,7 +526,7 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions& global) {
   p->require_subcommand(1);
   p->add_option("--layout", a.layout, "layout: default, benchtop or FILE (gateway addresses from it)")->required();
   p->add_option("--plc", a.plc, "the PLC at HOST[:PORT] (needed for --sync)");
-  p->add_flag("--json", a.json, "check, status, move: one JSON document on stdout and nothing else");
+  p->add_flag("--json", a.json, "check, status, move, backoff, friction, halltest: one JSON document on stdout and nothing else");
   p->fallthrough();  // --json may also follow the action
   p->add_subcommand("check", "GET_ID on every bus at once, compared with the layout")->callback([args, &global] {
     global.exit_code = run_plane(*args, "check");
@@ -519,6 +593,29 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions& global) {
   bo->add_option("ids", a.backoff_ids, "robots to move (3, 1-6, 1,4,9); default: every robot in contact");
   bo->add_flag("--unlock", a.unlock, "first STOP_TRAJECTORY on every bus, which clears the collision flags (9.4.1)");
   bo->callback([args, &global] { global.exit_code = run_plane(*args, "backoff"); });
+  auto* fr = p->add_subcommand("friction",
+                               "friction trend (interface document 9.4.2): per arm, test moves there and back at several "
+                               "speeds, current against speed fitted and compared with the arm's first record in --history");
+  fr->add_option("ids", a.friction_ids, "robots to measure (3, 1-6, 1,4,9); default: every robot");
+  fr->add_option("--history", a.history, "CSV history of earlier fits; the new ones are appended (created when missing)");
+  fr->add_option("--speeds", a.friction.speeds_rpm, "motor speeds in rpm (default 1000 2000 3000 4000)")->delimiter(',');
+  fr->add_option("--step", a.friction.step_deg, "test move in degrees at the arm (default 10)")->check(CLI::Range(2.01, 45.0));
+  fr->add_option("--growth-limit", a.friction.growth_limit, "increased beyond this growth, e.g. 0.25 = +25 % (default)")
+      ->check(positive());
+  fr->add_option("--reference-rpm", a.friction.reference_rpm, "speed the trend compares the current at (default 3000)")
+      ->check(positive());
+  fr->add_option("--arm", a.arm, "alpha, beta or both (default)")->check(CLI::IsMember({"alpha", "beta", "both"}));
+  fr->callback([args, &global] { global.exit_code = run_plane(*args, "friction"); });
+  auto* ht = p->add_subcommand("halltest",
+                               "hall sensor and motor test of one robot (interface document 9.4.3): open loop without "
+                               "collision detection, a slow move, hall against position; closed loop restored");
+  ht->add_option("id", a.hall_id, "the robot")->required()->check(CLI::Range(1, 2047));
+  ht->add_option("--step", a.hall.step_deg, "test move in degrees (default 5)")->check(CLI::Range(0.51, 45.0));
+  ht->add_option("--speed", a.hall.speed_rpm, "motor speed in rpm (default 1000)")->check(CLI::Range(1, 10000));
+  ht->add_option("--tolerance", a.hall.tolerance_deg, "hall against position after the move, degrees (default 0.04)")
+      ->check(positive());
+  ht->add_option("--arm", a.arm, "alpha, beta or both (default)")->check(CLI::IsMember({"alpha", "beta", "both"}));
+  ht->callback([args, &global] { global.exit_code = run_plane(*args, "halltest"); });
   up->callback([args, &global] {
     if (args->plc.empty()) throw Exception(usage("fps plane upgrade needs --plc"));
     global.exit_code = run_plane(*args, "upgrade");

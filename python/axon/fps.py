@@ -10,6 +10,12 @@ import numpy as np
 
 from ._axon.fps import (
     BadTarget,
+    FrictionFinding,
+    FrictionFit,
+    FrictionPoint,
+    FrictionReport,
+    HallFinding,
+    HallTestReport,
     Cancelled,
     Client,
     Closed,

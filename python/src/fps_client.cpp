@@ -140,6 +140,103 @@ fps::PlanSettings plan_settings(double speed_deg_s, double buffer_mm, std::uint6
   return {speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial, refuse_outside_safe_zone};
 }
 
+const char* arm_name(char a) { return a == 'a' ? "alpha" : "beta"; }
+
+char arm_letter(const std::string& arm) {
+  if (arm == "alpha" || arm == "a") return 'a';
+  if (arm == "beta" || arm == "b") return 'b';
+  throw Exception(Error(CoreErrc::invalid_argument, fmt::format("arm '{}': use 'alpha' or 'beta'", arm)));
+}
+
+// The troubleshooting results (host/troubleshoot_types.hpp): interface document 9.4.2 and 9.4.3.
+void bind_troubleshoot(py::module_& m) {
+  using namespace fps::host;
+  py::class_<FrictionPoint>(m, "FrictionPoint", "The median current at one motor speed during the test moves.")
+      .def_readonly("speed_rpm", &FrictionPoint::speed_rpm)
+      .def_readonly("current_percent", &FrictionPoint::current_percent)
+      .def_readonly("readings", &FrictionPoint::readings)
+      .def_readonly("move_s", &FrictionPoint::move_s)
+      .def_readonly("eta_s", &FrictionPoint::eta_s);
+  py::class_<FrictionFit>(m, "FrictionFit", "current = stiction + viscous * rpm / 1000 (percent).")
+      .def_readonly("stiction_percent", &FrictionFit::stiction_percent)
+      .def_readonly("viscous_percent_per_krpm", &FrictionFit::viscous_percent_per_krpm)
+      .def_readonly("rms_percent", &FrictionFit::rms_percent)
+      .def("at", &FrictionFit::at, py::arg("rpm"), "The fitted current (percent) at a motor speed.");
+  py::class_<FrictionFinding>(m, "FrictionFinding", "One arm's friction trend.")
+      .def_readonly("id", &FrictionFinding::id)
+      .def_property_readonly("arm", [](const FrictionFinding& f) { return arm_name(f.arm); })
+      .def_property_readonly("verdict", [](const FrictionFinding& f) { return to_string(f.verdict); },
+                             "ok, increased, baseline (the first record) or failed")
+      .def_readonly("points", &FrictionFinding::points)
+      .def_readonly("fit", &FrictionFinding::fit)
+      .def_readonly("growth", &FrictionFinding::growth, "current at the reference speed against the first record, minus 1")
+      .def_property_readonly("baseline_time_utc", [](const FrictionFinding& f) {
+        return f.baseline ? std::optional<std::string>(f.baseline->time_utc) : std::nullopt;
+      })
+      .def_readonly("step_deg", &FrictionFinding::step_deg)
+      .def_readonly("problem", &FrictionFinding::problem)
+      .def_readonly("advice", &FrictionFinding::advice);
+  py::class_<FrictionReport>(m, "FrictionReport")
+      .def_readonly("time_utc", &FrictionReport::time_utc)
+      .def_readonly("arms", &FrictionReport::arms)
+      .def_property_readonly("ok", &FrictionReport::ok)
+      .def_property_readonly("summary", &FrictionReport::summary)
+      .def("__bool__", &FrictionReport::ok);
+  py::class_<HallFinding>(m, "HallFinding", "One arm's hall sensor and motor test.")
+      .def_readonly("id", &HallFinding::id)
+      .def_property_readonly("arm", [](const HallFinding& f) { return arm_name(f.arm); })
+      .def_property_readonly("verdict", [](const HallFinding& f) { return to_string(f.verdict); },
+                             "ok, no_hall_change, inaccurate or failed")
+      .def_readonly("step_deg", &HallFinding::step_deg)
+      .def_readonly("hall_before_deg", &HallFinding::hall_before_deg)
+      .def_readonly("hall_after_deg", &HallFinding::hall_after_deg)
+      .def_readonly("position_before_deg", &HallFinding::position_before_deg)
+      .def_readonly("position_after_deg", &HallFinding::position_after_deg)
+      .def_readonly("tracking_error_deg", &HallFinding::tracking_error_deg)
+      .def_readonly("restored", &HallFinding::restored, "closed loop with collision detection again afterwards")
+      .def_readonly("problem", &HallFinding::problem)
+      .def_readonly("advice", &HallFinding::advice);
+  py::class_<HallTestReport>(m, "HallTestReport")
+      .def_readonly("arms", &HallTestReport::arms)
+      .def_property_readonly("ok", &HallTestReport::ok)
+      .def_property_readonly("summary", &HallTestReport::summary)
+      .def("__bool__", &HallTestReport::ok);
+}
+
+void bind_client_troubleshoot(py::class_<Client>& c) {
+  c.def("friction_survey", [](Client& c, const std::vector<std::uint16_t>& ids, std::vector<double> speeds_rpm,
+                              double step_deg, double growth_limit, double reference_rpm, bool alpha, bool beta,
+                              const std::string& history_file) {
+         fps::host::FrictionOptions o;
+         o.speeds_rpm = std::move(speeds_rpm);
+         o.step_deg = step_deg;
+         o.growth_limit = growth_limit;
+         o.reference_rpm = reference_rpm;
+         o.alpha = alpha;
+         o.beta = beta;
+         return blocking(c, [&c, ids, o, history_file] { return c.friction_survey(ids, o, history_file); });
+       }, py::arg("ids") = std::vector<std::uint16_t>{}, py::kw_only(),
+       py::arg("speeds_rpm") = std::vector<double>{1000, 2000, 3000, 4000}, py::arg("step_deg") = 10.0,
+       py::arg("growth_limit") = 0.25, py::arg("reference_rpm") = 3000.0, py::arg("alpha") = true, py::arg("beta") = true,
+       py::arg("history_file") = "",
+       "Friction trend (interface document 9.4.2): per arm, test moves there and back at each motor speed, the "
+       "current fitted against speed and judged against the arm's first record in history_file (CSV; the new "
+       "records are appended). Every test move is proven clear of the neighbours first. Needs the layout.")
+      .def("hall_test", [](Client& c, std::uint16_t id, double step_deg, std::uint32_t speed_rpm, double tolerance_deg,
+                           bool alpha, bool beta) {
+         fps::host::HallTestOptions o;
+         o.step_deg = step_deg;
+         o.speed_rpm = speed_rpm;
+         o.tolerance_deg = tolerance_deg;
+         o.alpha = alpha;
+         o.beta = beta;
+         return blocking(c, [&c, id, o] { return c.hall_test(id, o); });
+       }, py::arg("id"), py::kw_only(), py::arg("step_deg") = 5.0, py::arg("speed_rpm") = 1000,
+       py::arg("tolerance_deg") = 0.04, py::arg("alpha") = true, py::arg("beta") = true,
+       "Hall sensor and motor test (9.4.3): per arm, open loop without collision detection, hall and position "
+       "around a slow move, then closed loop with detection again. Needs the layout.");
+}
+
 void bind_client_moves(py::class_<Client>& c) {
   c.def("goto", [](Client& c, const std::map<std::uint16_t, std::pair<double, double>>& targets) {
          const auto t = angles_of(targets);
@@ -214,6 +311,7 @@ void bind_client(py::module_& m) {
         c.close();
       });
   bind_client_moves(c);
+  bind_client_troubleshoot(c);
 }
 
 void bind_plane(py::module_& m) {
@@ -246,6 +344,18 @@ void bind_plane(py::module_& m) {
       .def_property_readonly("collisions", &SimulatedPlane::collisions, "Collisions the simulator saw.")
       .def("inject_collision", &SimulatedPlane::inject_collision, py::arg("id"),
            "Makes the robot report a collision of its beta arm now (it stops and sets the flag).")
+      .def("set_friction_fault", [](SimulatedPlane& s, std::uint16_t id, const std::string& arm, int level) {
+             const char a = arm_letter(arm);
+             py::gil_scoped_release release;
+             s.set_friction_fault(id, a, level);
+           }, py::arg("id"), py::arg("arm"), py::arg("level"),
+           "Extra friction on one arm ('alpha' or 'beta'), on the collision margin's scale (0 removes it).")
+      .def("set_hall_fault", [](SimulatedPlane& s, std::uint16_t id, const std::string& arm, const std::string& fault) {
+             const char a = arm_letter(arm);
+             py::gil_scoped_release release;
+             s.set_hall_fault(id, a, fault);
+           }, py::arg("id"), py::arg("arm"), py::arg("fault"),
+           "A hall sensor 'stuck', a motor 'dead', or 'none', on one arm.")
       .def("stop", &SimulatedPlane::stop, py::call_guard<py::gil_scoped_release>())
       .def("__enter__", [](py::object self) { return self; })
       .def("__exit__", [](SimulatedPlane& s, py::args) {
@@ -258,6 +368,7 @@ void bind_plane(py::module_& m) {
 
 void bind_fps_client(py::module_& m) {
   bind_outcomes(m);
+  bind_troubleshoot(m);
   bind_client(m);
   bind_plane(m);
 }

@@ -4,6 +4,7 @@
 #include "axon/core/loop_thread.hpp"
 #include "axon/fps/host/array.hpp"
 #include "axon/fps/host/back_off.hpp"
+#include "axon/fps/host/troubleshoot.hpp"
 #include "axon/fps/host/datum_check.hpp"
 #include "axon/fps/host/focal_plane_array.hpp"
 #include "axon/fps/host/plan_and_move.hpp"
@@ -287,6 +288,33 @@ BackOffOutcome Client::back_off(const std::vector<std::uint16_t>& ids) {
     request.ids = ids;
     auto r = co_await host::back_off(array, *model, request);
     co_return outcome_of(need(std::move(r)));
+  });
+}
+
+host::FrictionReport Client::friction_survey(const std::vector<std::uint16_t>& ids, host::FrictionOptions options,
+                                            const std::string& history_file) {
+  auto& array = impl_->open_array();
+  auto model = datum_model(*impl_);
+  if (!model) throw Exception(Error(host::HostErrc::invalid_argument, "friction_survey needs the layout: open(plane) or set_layout()"));
+  if (!history_file.empty()) {
+    auto earlier = need(host::load_friction_history(history_file));
+    options.history.insert(options.history.end(), earlier.begin(), earlier.end());
+  }
+  auto report = impl_->run([&array, ids, model, options]() -> asio::awaitable<host::FrictionReport> {
+    auto r = co_await host::friction_survey(array, *model, ids, options);
+    co_return need(std::move(r));
+  });
+  if (!history_file.empty()) need(host::append_friction_history(history_file, report.records()));
+  return report;
+}
+
+host::HallTestReport Client::hall_test(std::uint16_t id, const host::HallTestOptions& options) {
+  auto& array = impl_->open_array();
+  auto model = datum_model(*impl_);
+  if (!model) throw Exception(Error(host::HostErrc::invalid_argument, "hall_test needs the layout: open(plane) or set_layout()"));
+  return impl_->run([&array, id, model, options]() -> asio::awaitable<host::HallTestReport> {
+    auto r = co_await host::hall_test(array, *model, id, options);
+    co_return need(std::move(r));
   });
 }
 

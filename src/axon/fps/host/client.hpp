@@ -26,6 +26,7 @@
 // interrupt(), locked(), lock_reason() are the exceptions: any thread may call them (while open).
 #pragma once
 
+#include "axon/fps/host/troubleshoot_types.hpp"
 #include "axon/fps/layout/focal_plane.hpp"
 
 #include <cstdint>
@@ -228,6 +229,22 @@ class Client {
   // moved is in the outcome with the reason. Needs the layout (HostErrc::invalid_argument); refused
   // while locked (HostErrc::locked).
   BackOffOutcome back_off(const std::vector<std::uint16_t>& ids = {});
+
+  // Troubleshooting false collisions (host/troubleshoot.hpp; the interface document's 9.4.2 and
+  // 9.4.3). Both need the layout (HostErrc::invalid_argument): every test move (one arm, a few
+  // degrees and back) is proven clear of the neighbours' read positions first, and a robot with no
+  // room is not tested. Refused while locked (HostErrc::locked); a collision during a test move
+  // locks the array as any collision does.
+  //
+  // The friction trend of the listed robots (empty: every robot found): current against motor
+  // speed fitted per arm, judged against the arm's first record in `history_file` (a CSV file, read
+  // when it exists; the new records are appended to it; "" keeps no history, so every arm is a
+  // baseline). Robots that are not neighbours are measured at the same time.
+  host::FrictionReport friction_survey(const std::vector<std::uint16_t>& ids = {}, host::FrictionOptions options = {},
+                                       const std::string& history_file = "");
+  // The hall sensor and motor test of one robot, arm by arm, in open loop without collision
+  // detection; closed loop with detection is restored afterwards (HallFinding::restored).
+  host::HallTestReport hall_test(std::uint16_t id, const host::HallTestOptions& options = {});
 
   // Locks the array and aborts every robot on every bus; moves are refused until unlock().
   StopOutcome emergency_stop(const std::string& reason = "emergency stop");

@@ -12,6 +12,8 @@
 #include <boost/asio/awaitable.hpp>
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
 namespace axon::fps::host {
 
@@ -19,6 +21,13 @@ namespace axon::fps::host {
 // HostErrc::unknown_positioner (the robot is not in the model or the array),
 // HostErrc::not_ready naming a neighbour whose position could not be read (an unknown pose cannot
 // be proven clear) or, when the sweep is not clear, every body in the way with its clearance.
+// The pose of every robot of `model`, read from the robot at `index` and its neighbours (the others
+// never meet it and are left at 0, 0). A position that cannot be read is HostErrc::not_ready:
+// "<what> refused: the position of neighbour 7 is unknown (...)": an unknown pose cannot be proven
+// clear.
+boost::asio::awaitable<Result<std::vector<plan::Pose>>> read_poses_around(Array& array, const plan::CollisionModel& model,
+                                                                          std::size_t index, const std::string& what);
+
 boost::asio::awaitable<Result<plan::StopSweep>> check_datum_sweep(Array& array, const plan::CollisionModel& model,
                                                                   std::uint16_t id, Arm arm);
 

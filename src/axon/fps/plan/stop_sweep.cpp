@@ -51,6 +51,21 @@ std::vector<double> angles_down(double from, double lo, double overtravel, doubl
   return out;
 }
 
+// Any pose of a region lies within `slack` (mm of the moving segment) of a grid pose: each body is
+// clear when its worst grid clearance exceeds that.
+StopSweep sweep_verdict(std::vector<Body>& bodies, double slack) {
+  StopSweep out;
+  out.min_clearance_mm = std::numeric_limits<double>::infinity();
+  std::sort(bodies.begin(), bodies.end(), [](const Body& x, const Body& y) { return x.worst < y.worst; });
+  for (const Body& body : bodies) {
+    const double bound = body.worst - slack;
+    out.min_clearance_mm = std::min(out.min_clearance_mm, bound);
+    if (bound < 0) out.in_the_way.push_back(fmt::format("{} ({:.3f} mm)", body.name, bound));
+  }
+  out.clear = out.in_the_way.empty();
+  return out;
+}
+
 }  // namespace
 
 StopSweep check_sweep_to_stops(const CollisionModel& model, std::size_t i, std::span<const Pose> poses,
@@ -72,17 +87,39 @@ StopSweep check_sweep_to_stops(const CollisionModel& model, std::size_t i, std::
     for (double a : alphas)
       for (double b : betas) visit(a, b);
   }
-  // Any pose of the region lies within half a grid step (per arm) of a grid pose.
-  const double slack = grid_slack(r, o.grid_deg);
-  StopSweep out;
-  out.min_clearance_mm = std::numeric_limits<double>::infinity();
-  std::sort(bodies.begin(), bodies.end(), [](const Body& x, const Body& y) { return x.worst < y.worst; });
-  for (const Body& body : bodies) {
-    const double bound = body.worst - slack;
-    out.min_clearance_mm = std::min(out.min_clearance_mm, bound);
-    if (bound < 0) out.in_the_way.push_back(fmt::format("{} ({:.3f} mm)", body.name, bound));
+  return sweep_verdict(bodies, grid_slack(r, o.grid_deg));
+}
+
+StopSweep check_arm_sweep(const CollisionModel& model, std::size_t i, std::span<const Pose> poses, char arm,
+                          double to_deg, double grid_deg, double approach_deg) {
+  const Positioner& r = model.robot(i);
+  auto bodies = standing_bodies(model, i, poses);
+  const Pose from = poses[i];
+  const double start = arm == 'a' ? from.alpha_deg : from.beta_deg;
+  const double other = arm == 'a' ? from.beta_deg : from.alpha_deg;
+  // Grid points from lo to hi, both ends included.
+  auto span = [grid_deg](double lo, double hi) {
+    const int n = std::max(1, static_cast<int>(std::ceil((hi - lo) / grid_deg)));
+    std::vector<double> v;
+    for (int k = 0; k <= n; ++k) v.push_back(lo + (hi - lo) * k / n);
+    return v;
+  };
+  const auto turning = span(std::min(start, to_deg) - approach_deg, std::max(start, to_deg) + approach_deg);
+  const auto standing = span(other - approach_deg, other + approach_deg);
+  for (const double d : turning) {
+    for (const double e : standing) {
+      const Segment s = r.collision_segment(arm == 'a' ? Pose{d, e} : Pose{e, d});
+      for (Body& body : bodies) body.worst = std::min(body.worst, segment_distance(s, body.seg) - body.limit);
+    }
   }
-  out.clear = out.in_the_way.empty();
+  auto out = sweep_verdict(bodies, grid_slack(r, grid_deg));
+  const AngleLimits& l = r.limits();
+  const bool inside = arm == 'a' ? to_deg >= l.alpha_min_deg && to_deg <= l.alpha_max_deg
+                                 : to_deg >= l.beta_min_deg && to_deg <= l.beta_max_deg;
+  if (!inside) {
+    out.in_the_way.insert(out.in_the_way.begin(), fmt::format("angle limit ({} {:.1f} deg)", arm == 'a' ? "alpha" : "beta", to_deg));
+    out.clear = false;
+  }
   return out;
 }
 

@@ -44,6 +44,16 @@ struct StopSweep {
 StopSweep check_sweep_to_stops(const CollisionModel& model, std::size_t i, std::span<const Pose> poses,
                                const StopSweepOptions& options = {});
 
+// Robot `i` turning one arm ('a' or 'b') alone from poses[i] to `to_deg` and back (the test moves
+// of the troubleshooting chapter, 9.4.2 and 9.4.3); the others stand at their poses. A go-to move
+// ends with the firmware's precise approach, a back-and-forth of both arms (0.9 deg in the
+// simulator), so the region is the rectangle of the turning arm's range widened by `approach_deg`
+// at both ends and the other arm within `approach_deg` of where it is. Proven as the stop sweep is,
+// on a grid of `grid_deg`; a target outside the arm's angle limits is not clear ("angle limit" in
+// in_the_way).
+StopSweep check_arm_sweep(const CollisionModel& model, std::size_t i, std::span<const Pose> poses, char arm,
+                          double to_deg, double grid_deg = 0.5, double approach_deg = 1.0);
+
 // ---- Backing off ---------------------------------------------------------------------------------
 // After a collision the document (9.4.1) asks for the flags to be cleared and the robot moved away
 // by at least 2 degrees; after a power loss mid-move, robots that stopped dead may stand inside a

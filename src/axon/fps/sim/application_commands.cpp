@@ -403,7 +403,7 @@ void PositionerModel::handle_application(const proto::Message& m, const proto::C
         const ArmState& s = arms_[a];
         if (!s.moving) return static_cast<std::int32_t>(cal_.holding_current[a]);
         const double v = s.phys.speed_at(now_);
-        const double magnitude = s.closed_loop ? 15.0 + 25.0 * std::min(1.0, std::abs(v) / max_arm_speed())
+        const double magnitude = s.closed_loop ? friction_current_percent(a, v * config_.gear_ratio / 6.0)
                                                : static_cast<double>(s.drive_current);
         const auto value = static_cast<std::int32_t>(std::lround(magnitude));
         return torque && v < 0 ? -value : value;

@@ -78,8 +78,49 @@ Result<std::map<std::uint16_t, net::Endpoint>> gateway_endpoints(const FocalPlan
   return out;
 }
 
+namespace {
+
+Result<Arm> arm_of(const core::ConfigNode& item) {
+  AXON_TRY(arm, item.get<std::string>("arm"));
+  if (arm == "alpha") return Arm::alpha;
+  if (arm == "beta") return Arm::beta;
+  return item.error(CoreErrc::config_bad_value, fmt::format("arm '{}': use alpha or beta", arm));
+}
+
+// The scenario's friction: [{id, arm, level}] and hall: [{id, arm, fault}] lists.
+Result<void> read_arm_faults(const core::ConfigNode& node, Scenario& s) {
+  if (node.has("friction")) {
+    AXON_TRY(list, node.child("friction"));
+    AXON_TRY(items, list.items());
+    for (const auto& item : items) {
+      AXON_TRY(item.reject_unknown({"id", "arm", "level"}));
+      AXON_TRY(id, item.get_in<std::uint16_t>("id", 1, 2047));
+      AXON_TRY(arm, arm_of(item));
+      AXON_TRY(level, item.get_in<std::int32_t>("level", -30, 100));
+      s.friction.push_back({id, arm, level});
+    }
+  }
+  if (node.has("hall")) {
+    AXON_TRY(list, node.child("hall"));
+    AXON_TRY(items, list.items());
+    for (const auto& item : items) {
+      AXON_TRY(item.reject_unknown({"id", "arm", "fault"}));
+      AXON_TRY(id, item.get_in<std::uint16_t>("id", 1, 2047));
+      AXON_TRY(arm, arm_of(item));
+      AXON_TRY(fault, item.get<std::string>("fault"));
+      if (fault != "stuck" && fault != "dead")
+        return item.error(CoreErrc::config_bad_value, fmt::format("hall fault '{}': use stuck or dead", fault));
+      s.hall.push_back({id, arm, fault == "stuck" ? HallFault::stuck : HallFault::motor_dead});
+    }
+  }
+  return ok();
+}
+
+}  // namespace
+
 Result<Scenario> Scenario::from_config(const core::ConfigNode& node) {
-  AXON_TRY(node.reject_unknown({"datum_lost", "uncalibrated", "collided", "bootloader", "absent", "collide_on_move", "extra"}));
+  AXON_TRY(node.reject_unknown({"datum_lost", "uncalibrated", "collided", "bootloader", "absent", "collide_on_move", "extra",
+                                "friction", "hall"}));
   Scenario s;
   AXON_TRY(a, read_ids(node, "datum_lost"));
   s.datum_lost = std::move(a);
@@ -104,6 +145,7 @@ Result<Scenario> Scenario::from_config(const core::ConfigNode& node) {
       s.extra[id] = BusRef{gw, static_cast<std::uint8_t>(ch)};
     }
   }
+  AXON_TRY(read_arm_faults(node, s));
   return s;
 }
 
@@ -247,6 +289,13 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
         return Error(CoreErrc::invalid_argument, fmt::format("scenario: robot {} is not in layout '{}'", id, plane.name()));
     }
   }
+  std::vector<std::uint16_t> faulty;
+  for (const auto& f : sc.friction) faulty.push_back(f.id);
+  for (const auto& f : sc.hall) faulty.push_back(f.id);
+  for (auto id : faulty) {
+    if (plane.find(id) == nullptr && !sc.extra.contains(id))
+      return Error(CoreErrc::invalid_argument, fmt::format("scenario: robot {} is not in layout '{}'", id, plane.name()));
+  }
   for (const auto& [id, bus] : sc.extra) {
     if (plane.find(id) != nullptr)
       return Error(CoreErrc::invalid_argument, fmt::format("scenario: extra robot {} is already in the layout", id));
@@ -324,6 +373,16 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
     }
   }
 
+  for (const auto& f : sc.friction) {
+    if (s.simulator->find(f.id) != nullptr) {
+      AXON_TRY(s.simulator->set_friction_fault(f.id, f.arm, f.level));
+    }
+  }
+  for (const auto& f : sc.hall) {
+    if (s.simulator->find(f.id) != nullptr) {
+      AXON_TRY(s.simulator->set_hall_fault(f.id, f.arm, f.fault));
+    }
+  }
   if (!sc.collide_on_move.empty())
     asio::co_spawn(executor, Impl::watch_collisions(&s, s.alive, sc.collide_on_move), asio::detached);
 

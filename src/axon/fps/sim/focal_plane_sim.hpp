@@ -62,9 +62,23 @@ struct Scenario {
   std::set<std::uint16_t> collide_on_move;  // report a collision (beta) the first time they move
   // Robots the layout does not have, on a bus of the layout (discovery finds them "unexpected").
   std::map<std::uint16_t, BusRef> extra;
+  // Troubleshooting faults (PositionerModel::set_friction_fault, set_hall_fault) from the start.
+  struct FrictionFault {
+    std::uint16_t id = 0;
+    Arm arm = Arm::beta;
+    std::int32_t level = 0;
+  };
+  struct SensorFault {
+    std::uint16_t id = 0;
+    Arm arm = Arm::beta;
+    HallFault fault = HallFault::stuck;
+  };
+  std::vector<FrictionFault> friction;
+  std::vector<SensorFault> hall;
 
   // YAML: {datum_lost: [ids], uncalibrated: [...], collided: [...], bootloader: [...],
-  //        absent: [...], collide_on_move: [...], extra: [{id: 900, gateway: 1, bus: 2}]}.
+  //        absent: [...], collide_on_move: [...], extra: [{id: 900, gateway: 1, bus: 2}],
+  //        friction: [{id: 3, arm: beta, level: 10}], hall: [{id: 4, arm: alpha, fault: stuck|dead}]}.
   static Result<Scenario> from_config(const core::ConfigNode& node);
 };
 

@@ -87,6 +87,11 @@ Result<void> PositionerConfig::validate() const {
   if (max_current_percent > 100 || default_drive_current_percent > max_current_percent) {
     return bad("currents", "need default_drive_current_percent <= max_current_percent <= 100");
   }
+  for (Arm a : kArms) {
+    if (!finite_in(stiction_current_percent[a], 0, 100) || !finite_in(viscous_current_percent_per_krpm[a], 0, 100)) {
+      return bad("friction currents", "stiction_current_percent and viscous_current_percent_per_krpm must be within 0..100");
+    }
+  }
   if (!finite_in(precise_approach_deg, 0, 10)) return bad("precise_approach_deg", "must be within 0..10");
   if (!finite_in(datum_backoff_deg, 0, 90)) return bad("datum_backoff_deg", "must be within 0..90");
   if (!finite_in(motor_calibration_turns, 0, 1000)) return bad("motor_calibration_turns", "must be within 0..1000");
@@ -112,7 +117,7 @@ namespace {
 constexpr std::string_view kKeys[] = {
     "id", "firmware", "bootloader", "get_holding_current_on_112", "firmware_history", "version_byte_order", "start_without_trajectory", "gear_ratio", "hard_stop_lower_deg",
     "hard_stop_upper_deg", "default_speed_rpm", "min_speed_rpm", "max_speed_rpm", "max_current_percent",
-    "default_drive_current_percent", "precise_approach_deg", "datum_backoff_deg", "motor_calibration_turns",
+    "default_drive_current_percent", "stiction_current_percent", "viscous_current_percent_per_krpm", "precise_approach_deg", "datum_backoff_deg", "motor_calibration_turns",
     "datum_spread_motor_deg", "motors_calibrated", "datums_calibrated", "cogging_calibrated", "datums_initialized",
     "start_position_deg", "sync_line_low_at_power_on", "receive_buffer", "boot_time_s", "bootloader_timeout_s",
     "watchdog_timeout_s", "hall_wake_up_s", "led_blink_s", "motor_calibration_time_s", "cogging_calibration_time_s",
@@ -188,6 +193,8 @@ Result<PositionerConfig> PositionerConfig::from_config(const core::ConfigNode& n
   AXON_TRY(num("max_speed_rpm", c.max_speed_rpm));
   AXON_TRY(num("max_current_percent", c.max_current_percent));
   AXON_TRY(num("default_drive_current_percent", c.default_drive_current_percent));
+  AXON_TRY(arms("stiction_current_percent", c.stiction_current_percent));
+  AXON_TRY(arms("viscous_current_percent_per_krpm", c.viscous_current_percent_per_krpm));
   AXON_TRY(num("precise_approach_deg", c.precise_approach_deg));
   AXON_TRY(num("datum_backoff_deg", c.datum_backoff_deg));
   AXON_TRY(num("motor_calibration_turns", c.motor_calibration_turns));

@@ -64,6 +64,10 @@ struct PositionerConfig {
   double datum_backoff_deg = 5.0;                          // back-off between datum calibration hits
   double motor_calibration_turns = 3.0;                    // motor turns of the motor calibration sweep
   double datum_spread_motor_deg = 40.0;                    // spread of datum calibration hits (motor deg)
+  // Closed-loop motor current while an arm turns (GET_CURRENTS and 54/55), in percent: a stiction
+  // part plus a viscous part growing with the motor speed (interface document 9.4.2's model).
+  PerArm<double> stiction_current_percent{{15.0, 15.0}};
+  PerArm<double> viscous_current_percent_per_krpm{{5.0, 5.0}};
 
   // State at power-up (what the flash holds when the simulation starts).
   bool motors_calibrated = true;
@@ -114,7 +118,8 @@ struct PositionerConfig {
   // version_byte_order (field | document),
   // start_without_trajectory (accept | refuse), gear_ratio, hard_stop_lower_deg and
   // hard_stop_upper_deg ([alpha, beta] or one number), default_speed_rpm, min_speed_rpm,
-  // max_speed_rpm, max_current_percent, default_drive_current_percent, precise_approach_deg,
+  // max_speed_rpm, max_current_percent, default_drive_current_percent, stiction_current_percent and
+  // viscous_current_percent_per_krpm ([alpha, beta] or one number), precise_approach_deg,
   // datum_backoff_deg, motor_calibration_turns, datum_spread_motor_deg, motors_calibrated,
   // datums_calibrated, cogging_calibrated, datums_initialized, start_position_deg ([alpha, beta]),
   // sync_line_low_at_power_on, receive_buffer, boot_time_s, bootloader_timeout_s,

@@ -32,6 +32,15 @@ std::string_view to_string(Activity a) noexcept {
   return "?";
 }
 
+std::string_view to_string(HallFault f) noexcept {
+  switch (f) {
+    case HallFault::none: return "none";
+    case HallFault::stuck: return "stuck";
+    case HallFault::motor_dead: return "motor_dead";
+  }
+  return "?";
+}
+
 PositionerModel::PositionerModel(PositionerConfig config, SimTime now) : config_(std::move(config)), now_(now) {
   if (auto v = config_.validate(); !v) throw Exception(v.error());
   // The flash as the configuration describes it.
@@ -268,6 +277,21 @@ void PositionerModel::sync_recheck(Outbox& out) {
       protocol::Identifier{config_.id, protocol::number(protocol::CommandId::start_trajectory), 0, code}, {}});
 }
 
+Outbox PositionerModel::set_hall_fault(Arm arm, HallFault fault, SimTime now) {
+  Outbox out;
+  run_until(now, out);
+  if (fault == HallFault::stuck && hall_fault_[arm] != HallFault::stuck) hall_stuck_deg_[arm] = hall_deg(arm);
+  hall_fault_[arm] = fault;
+  return out;
+}
+
+double PositionerModel::friction_current_percent(Arm a, double motor_rpm) const noexcept {
+  const double level = friction_[a] ? std::max(0, *friction_[a]) : 0;
+  const double stiction = config_.stiction_current_percent[a] + level;
+  const double viscous = config_.viscous_current_percent_per_krpm[a] + level / 5.0;
+  return stiction + viscous * std::abs(motor_rpm) / 1000.0;
+}
+
 Outbox PositionerModel::inject_collision(Arm arm, SimTime now) {
   Outbox out;
   run_until(now, out);
@@ -303,6 +327,7 @@ double PositionerModel::reported_deg(Arm a) const noexcept { return belief(a) - 
 double PositionerModel::physical_deg(Arm a) const noexcept { return physical_at(a, now_); }
 
 double PositionerModel::hall_deg(Arm a) const noexcept {
+  if (hall_fault_[a] == HallFault::stuck) return hall_stuck_deg_[a];
   if (hall_unavailable()) return hall_frozen_[a];
   return physical_deg(a) + arms_[a].datum_err - cal_.offset_deg[a];
 }
@@ -316,12 +341,21 @@ void PositionerModel::start_commanded(Arm a, ArmPath cmd) {
   s.err0 = s.datum_err + s.slip;
   s.follows_hall = s.closed_loop;
   ArmPath raw = cmd.shifted(-s.err0);
+  // A dead motor, or a stuck sensor the closed loop commutates by, leaves the arm where it is.
+  const HallFault fault = hall_fault_[a];
+  if ((fault == HallFault::motor_dead || (fault == HallFault::stuck && s.closed_loop)) && raw.end() > raw.start()) {
+    ArmPath still(raw.start(), raw.at(raw.start()));
+    still.point(raw.end(), raw.at(raw.start()));
+    raw = std::move(still);
+  }
   s.collision_at.reset();
   if (s.detection) {
     // The arm stops at the first contact; the path need not be clamped.
     s.collision_at = raw.first_outside(lower_stop(a), upper_stop(a));
-    // Too much friction for the margin: the controller sees a stall right after the start.
-    if (friction_[a] && *friction_[a] > s.margin && raw.end() > raw.start()) {
+    // Too much friction for the margin, or a sensor that sees no motion: the controller takes it
+    // for a stall right after the start.
+    const bool stalls = (friction_[a] && *friction_[a] > s.margin) || fault != HallFault::none;
+    if (stalls && raw.end() > raw.start()) {
       const SimTime stall = raw.start() + std::min<SimDuration>(std::chrono::milliseconds(200), raw.end() - raw.start());
       if (!s.collision_at || stall < *s.collision_at) s.collision_at = stall;
     }

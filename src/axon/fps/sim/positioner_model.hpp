@@ -46,6 +46,14 @@ enum class RunState : std::uint8_t {
 };
 std::string_view to_string(RunState s) noexcept;
 
+// A broken sensor or motor phase on one arm (interface document 9.4.3).
+enum class HallFault : std::uint8_t {
+  none,
+  stuck,       // the hall reading no longer changes (a sensor wire came loose); the motor still turns
+  motor_dead,  // the arm does not turn (a loose motor cable, a failed h-bridge); the sensor is fine
+};
+std::string_view to_string(HallFault f) noexcept;
+
 enum class Activity : std::uint8_t {
   idle,
   go_to,                // GO_TO_ABSOLUTE/RELATIVE_POSITION
@@ -141,8 +149,20 @@ class PositionerModel {
   // Fault injection: extra friction on an arm (interface document 9.4.2). While `level` exceeds the
   // arm's collision margin (SET_COLLISION_MARGIN, -30..30) and detection is on, every move of that
   // arm ends in a false collision shortly after it starts; raising the margin above the level cures
-  // it. nullopt removes the fault.
+  // it. A positive level also raises the arm's closed-loop current while it turns: by `level`
+  // percent of stiction and level / 5 percent per 1000 rpm of viscous friction (9.4.2's model), so a
+  // friction trend sees it before the false collisions start. nullopt removes the fault.
   void set_friction_fault(Arm arm, std::optional<std::int32_t> level) noexcept { friction_[arm] = level; }
+  // Fault injection: a hall sensor or motor fault on `arm` (9.4.3). In closed loop, or with
+  // collision detection on, the firmware sees no motion and every move of that arm ends in a false
+  // collision shortly after it starts; in open loop without detection a stuck sensor's arm turns
+  // while GET_HALL_POSITION stays where it was, and a dead motor's arm stands still while the step
+  // counter (GET_CURRENT_POSITION) runs on. HallFault::none repairs it. Returns what advancing to
+  // `now` produced.
+  Outbox set_hall_fault(Arm arm, HallFault fault, SimTime now);
+  [[nodiscard]] HallFault hall_fault(Arm arm) const noexcept { return hall_fault_[arm]; }
+  // The closed-loop current of `arm` turning at `motor_rpm`, percent (stiction + viscous + fault).
+  [[nodiscard]] double friction_current_percent(Arm arm, double motor_rpm) const noexcept;
 
   // Observers.
   [[nodiscard]] std::uint16_t id() const noexcept { return config_.id; }
@@ -274,6 +294,8 @@ class PositionerModel {
   bool position_estimated_ = false;
   std::uint64_t noise_counter_ = 0;
   PerArm<std::optional<std::int32_t>> friction_{};
+  PerArm<HallFault> hall_fault_{};
+  PerArm<double> hall_stuck_deg_{};          // what a stuck sensor keeps reading
   ModelCounters counters_;
 };
 

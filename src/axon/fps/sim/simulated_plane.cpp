@@ -103,4 +103,30 @@ void SimulatedPlane::inject_collision(std::uint16_t id) {
   impl->loop.call([impl, id] { impl->sim->simulator().force_collision(id, Arm::beta).value(); });
 }
 
+namespace {
+Arm arm_of(char arm) {
+  if (arm == 'a') return Arm::alpha;
+  if (arm == 'b') return Arm::beta;
+  throw Exception(Error(CoreErrc::invalid_argument, fmt::format("arm '{}': use 'a' (alpha) or 'b' (beta)", arm)));
+}
+}  // namespace
+
+void SimulatedPlane::set_friction_fault(std::uint16_t id, char arm, int level) {
+  auto* impl = impl_.get();
+  const Arm a = arm_of(arm);
+  const auto fault = level == 0 ? std::nullopt : std::optional<std::int32_t>(level);
+  impl->loop.call([impl, id, a, fault] { impl->sim->simulator().set_friction_fault(id, a, fault).value(); });
+}
+
+void SimulatedPlane::set_hall_fault(std::uint16_t id, char arm, const std::string& fault) {
+  auto* impl = impl_.get();
+  const Arm a = arm_of(arm);
+  HallFault f = HallFault::none;
+  if (fault == "stuck") f = HallFault::stuck;
+  else if (fault == "dead" || fault == "motor_dead") f = HallFault::motor_dead;
+  else if (fault != "none")
+    throw Exception(Error(CoreErrc::invalid_argument, fmt::format("hall fault '{}': use stuck, dead or none", fault)));
+  impl->loop.call([impl, id, a, f] { impl->sim->simulator().set_hall_fault(id, a, f).value(); });
+}
+
 }  // namespace axon::fps::sim

@@ -57,6 +57,13 @@ class SimulatedPlane {
   // Makes robot `id` report a collision of its beta arm now (it stops and sets the flag), whatever
   // the geometry.
   void inject_collision(std::uint16_t id);
+  // Troubleshooting faults (interface document 9.4.2, 9.4.3) on one arm ('a' or 'b') of robot
+  // `id`: extra friction of `level` on the collision margin's scale (0 removes it; moves collide
+  // falsely while it exceeds the margin, and the current grows with it), or a hall sensor that
+  // reads "stuck", a motor that is "dead", or "none" (PositionerModel::set_hall_fault). An unknown
+  // robot, arm or fault throws axon::Exception.
+  void set_friction_fault(std::uint16_t id, char arm, int level);
+  void set_hall_fault(std::uint16_t id, char arm, const std::string& fault);
 
   // Stops the emulators and the simulator. Idempotent.
   void stop() noexcept;

@@ -561,6 +561,15 @@ Result<void> Simulator::set_friction_fault(std::uint16_t id, Arm arm, std::optio
   return ok();
 }
 
+Result<void> Simulator::set_hall_fault(std::uint16_t id, Arm arm, HallFault fault) {
+  const auto it = state_->by_id.find(id);
+  if (it == state_->by_id.end()) {
+    return make_error(CoreErrc::invalid_argument, fmt::format("simulator: no positioner {}", id));
+  }
+  state_->emit(*it->second, it->second->model.set_hall_fault(arm, fault, state_->event_time()));
+  return ok();
+}
+
 void Simulator::add_obstacle(Obstacle obstacle) {
   state_->obstacles.push_back(std::move(obstacle));
   state_->monitor_dirty = true;

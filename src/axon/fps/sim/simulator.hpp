@@ -124,6 +124,7 @@ class Simulator {
   // Faults.
   Result<void> force_collision(std::uint16_t id, Arm arm);
   Result<void> set_friction_fault(std::uint16_t id, Arm arm, std::optional<std::int32_t> level);
+  Result<void> set_hall_fault(std::uint16_t id, Arm arm, HallFault fault);
   void add_obstacle(Obstacle obstacle);
   void clear_obstacles();
 
