@@ -51,6 +51,7 @@ struct ActorFpsOptions {
   double time_scale = 10.0;
   std::uint64_t seed = 1;
   double status_period_s = 10.0;
+  std::string friction_history;    // the friction verb's CSV history
   double duration_s = 0;
 };
 
@@ -78,7 +79,10 @@ int run_actor_fps(const ActorFpsOptions& o) {
     else client.open(sim ? sim->plane() : need(resolve_layout(o.layout)));
     actor::BusActor bus({o.name, o.bus.link()});
     {
-      actor::FpsActor fps_actor(bus.core(), client, {o.status_period_s});
+      actor::FpsActorOptions fo;
+      fo.status_period_s = o.status_period_s;
+      fo.friction_history = o.friction_history;
+      actor::FpsActor fps_actor(bus.core(), client, fo);
       if (sim) add_simulator_verbs(bus.core(), *sim);
       bus.start();
       std::fprintf(stderr, "actor %s: %zu robots, commands on %s (exchange %s)\n", o.name.c_str(), client.robots().size(),
@@ -156,6 +160,8 @@ void add_actor_commands(CLI::App& app, GlobalOptions& global) {
   f->add_option("--time-scale", fo->time_scale, "simulator: simulated seconds per second (default 10)");
   f->add_option("--seed", fo->seed, "simulator: seed (default 1)");
   f->add_option("--status-period", fo->status_period_s, "seconds between status broadcasts (default 10; 0: none)");
+  f->add_option("--friction-history", fo->friction_history,
+                 "CSV history the friction verb judges against and appends to (default: none, every arm a baseline)");
   f->add_option("--duration", fo->duration_s, "stop after this many seconds (default: until Ctrl-C)");
   f->callback([fo, &global] { global.exit_code = run_actor_fps(*fo); });
 

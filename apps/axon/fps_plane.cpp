@@ -11,6 +11,7 @@
 #include "axon/fps/host/trajectory_build.hpp"
 #include "axon/fps/host/trajectory_speed.hpp"
 #include "axon/fps/host/troubleshoot.hpp"
+#include "axon/fps/host/troubleshoot_json.hpp"
 #include "checks.hpp"
 #include "id_list.hpp"
 #include "fps_json.hpp"
@@ -370,35 +371,6 @@ asio::awaitable<int> plane_back_off(host::FocalPlaneArray& fpa, const PlaneArgs&
   co_return rep.ok() ? 0 : 1;
 }
 
-json friction_json(const host::FrictionReport& rep) {
-  json arms = json::array();
-  for (const auto& f : rep.arms) {
-    json points = json::array();
-    for (const auto& p : f.points)
-      points.push_back({{"speed_rpm", p.speed_rpm}, {"current_percent", p.current_percent}, {"readings", p.readings},
-                        {"move_s", p.move_s}, {"eta_s", p.eta_s}});
-    json fit = f.fit ? json{{"stiction_percent", f.fit->stiction_percent},
-                            {"viscous_percent_per_krpm", f.fit->viscous_percent_per_krpm}, {"rms_percent", f.fit->rms_percent}}
-                     : json(nullptr);
-    arms.push_back({{"id", f.id}, {"arm", f.arm == 'a' ? "alpha" : "beta"}, {"verdict", host::to_string(f.verdict)},
-                    {"fit", fit}, {"points", points}, {"step_deg", f.step_deg}, {"move_ratio", f.move_ratio},
-                    {"baseline_time_utc", f.baseline ? json(f.baseline->time_utc) : json(nullptr)},
-                    {"growth", f.growth}, {"move_growth", f.move_growth}, {"problem", f.problem}, {"advice", f.advice}});
-  }
-  return {{"ok", rep.ok()}, {"time_utc", rep.time_utc}, {"arms", arms}};
-}
-
-json hall_json(const host::HallTestReport& rep) {
-  json arms = json::array();
-  for (const auto& f : rep.arms)
-    arms.push_back({{"id", f.id}, {"arm", f.arm == 'a' ? "alpha" : "beta"}, {"verdict", host::to_string(f.verdict)},
-                    {"step_deg", f.step_deg}, {"hall_before_deg", f.hall_before_deg}, {"hall_after_deg", f.hall_after_deg},
-                    {"position_before_deg", f.position_before_deg}, {"position_after_deg", f.position_after_deg},
-                    {"tracking_error_deg", f.tracking_error_deg}, {"restored", f.restored}, {"problem", f.problem},
-                    {"advice", f.advice}});
-  return {{"ok", rep.ok()}, {"arms", arms}};
-}
-
 void choose_arms(const std::string& arm, bool& alpha, bool& beta) {
   alpha = arm != "beta";
   beta = arm != "alpha";
@@ -416,7 +388,7 @@ asio::awaitable<int> plane_friction(host::FocalPlaneArray& fpa, const PlaneArgs&
   auto r = co_await host::friction_survey(fpa.array(), model, std::move(ids), std::move(o));
   const auto rep = need(std::move(r));
   if (!a.history.empty()) need(host::append_friction_history(a.history, rep.records()));
-  if (a.json) print_plane_json(friction_json(rep));
+  if (a.json) print_plane_json(host::to_json(rep));
   else std::fputs(rep.summary().c_str(), stdout);
   co_return rep.ok() ? 0 : 1;
 }
@@ -428,7 +400,7 @@ asio::awaitable<int> plane_hall_test(host::FocalPlaneArray& fpa, const PlaneArgs
   choose_arms(a.arm, o.alpha, o.beta);
   auto r = co_await host::hall_test(fpa.array(), model, static_cast<std::uint16_t>(a.hall_id), o);
   const auto rep = need(std::move(r));
-  if (a.json) print_plane_json(hall_json(rep));
+  if (a.json) print_plane_json(host::to_json(rep));
   else std::fputs(rep.summary().c_str(), stdout);
   co_return rep.ok() ? 0 : 1;
 }

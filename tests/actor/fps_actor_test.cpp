@@ -116,5 +116,31 @@ TEST_F(FpsActorOnBenchtop, BackoffMovesTheRobotThatCollidedAwayAfterUnlock) {
   EXPECT_NE(body_of(*bad)["error"].get<std::string>().find("robot 4000 is not on the buses"), std::string::npos) << bad->body;
 }
 
+// Troubleshooting verbs (interface document 9.4.3): a stuck hall sensor is found and the command
+// fails with the verdict in its keyword; bad arguments fail with a reason, nothing moves.
+TEST_F(FpsActorOnBenchtop, HalltestFindsAStuckSensorAndFailsWithTheVerdict) {
+  const auto id = first_robot();
+  plane.set_hall_fault(id, 'a', "stuck");
+  core.handle(command(fmt::format("halltest {}", id), "h"));
+  const auto h = out.final_of("h");
+  ASSERT_TRUE(h);
+  EXPECT_EQ(code_of(*h), 'f') << h->body;
+  const auto kw = body_of(*h)["hall_test"];
+  ASSERT_EQ(kw["arms"].size(), 2u) << h->body;
+  EXPECT_EQ(kw["arms"][0]["verdict"], "no_hall_change") << h->body;
+  EXPECT_EQ(kw["arms"][1]["verdict"], "ok") << h->body;
+  EXPECT_EQ(kw["arms"][0]["restored"], true);
+  EXPECT_EQ(body_of(*h)["locked"], false);
+  int n = 0;
+  for (const std::string& bad : {std::string("halltest"), fmt::format("halltest {} gamma", id), std::string("halltest 4000")}) {
+    const auto cid = fmt::format("bad{}", n++);
+    core.handle(command(bad, cid));
+    const auto b = out.final_of(cid);
+    ASSERT_TRUE(b) << bad;
+    EXPECT_EQ(code_of(*b), 'f') << bad;
+    EXPECT_TRUE(body_of(*b).contains("error")) << b->body;
+  }
+}
+
 }  // namespace
 }  // namespace axon::actor

@@ -253,6 +253,11 @@ def check_commands(c, port, actor_proc):
     r = c.command('backoff %d' % ids[3])  # the document's move away after a collision
     assert r[-1][0] == ':' and r[-1][1]['back_off']['ok'] is True, r
     assert r[-1][1]['back_off']['moves'][0]['moved'] is True, r
+    # Troubleshooting (interface document 9.4.3): the hall test of a healthy robot, one arm.
+    r = c.command('halltest %d beta' % ids[2])
+    assert r[-1][0] == ':' and r[-1][1]['hall_test']['ok'] is True, r
+    assert [a['arm'] for a in r[-1][1]['hall_test']['arms']] == ['beta'], r
+    assert c.command('halltest %d gamma' % ids[2])[-1][0] == 'f'
     assert any('robots' in kw for _, kw in c.broadcasts), 'no periodic status broadcast'
 
 

@@ -1,5 +1,7 @@
 #include "axon/actor/fps_actor.hpp"
 
+#include "axon/fps/host/troubleshoot_json.hpp"
+
 #include "axon/core/error.hpp"
 #include "axon/fps/host/client.hpp"
 
@@ -221,6 +223,30 @@ struct FpsActor::Impl {
     else c.fail(out.summary, std::move(kw));
   }
 
+  void friction(Command& c) {
+    std::lock_guard lock(device);
+    std::vector<std::uint16_t> ids;
+    for (const auto& a : c.args()) ids.push_back(robot_id(a, client.robots(), "friction"));
+    const auto report = client.friction_survey(ids, {}, options.friction_history);
+    json kw{{"friction", fps::host::to_json(report)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
+    if (report.ok()) c.finish(std::move(kw));
+    else c.fail(report.summary(), std::move(kw));
+  }
+
+  void hall_test(Command& c) {
+    const auto& args = c.args();
+    if (args.empty() || args.size() > 2 || (args.size() == 2 && args[1] != "alpha" && args[1] != "beta"))
+      throw Exception(Error(CoreErrc::invalid_argument, "halltest takes ID [alpha|beta]"));
+    std::lock_guard lock(device);
+    fps::host::HallTestOptions o;
+    o.alpha = args.size() == 1 || args[1] == "alpha";
+    o.beta = args.size() == 1 || args[1] == "beta";
+    const auto report = client.hall_test(robot_id(args[0], client.robots(), "halltest"), o);
+    json kw{{"hall_test", fps::host::to_json(report)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
+    if (report.ok()) c.finish(std::move(kw));
+    else c.fail(report.summary(), std::move(kw));
+  }
+
   void unlock(Command& c) {
     std::lock_guard lock(device);
     const auto out = client.unlock();
@@ -295,6 +321,10 @@ FpsActor::FpsActor(ActorCore& core, fps::Client& client, FpsActorOptions options
   core.add({"abort", "abort", false, [i](Command& c) { i->stop(c); }});
   core.add({"unlock", "unlock", true, [i](Command& c) { i->unlock(c); }});
   core.add({"backoff", "backoff [ID ...] (no ID: every robot in contact)", true, [i](Command& c) { i->back_off(c); }});
+  core.add({"friction", "friction [ID ...] (no ID: every robot; the friction trend, 9.4.2)", true,
+            [i](Command& c) { i->friction(c); }});
+  core.add({"halltest", "halltest ID [alpha|beta] (hall sensor and motor test, 9.4.3)", true,
+            [i](Command& c) { i->hall_test(c); }});
   impl_->watcher = std::thread([i] { i->watch(); });
 }
 

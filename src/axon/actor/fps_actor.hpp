@@ -6,13 +6,15 @@
 //   stop | abort                 aborts every robot (during a move this also locks the array)
 //   unlock                       clears collision flags and the lock
 //   backoff [ID ...]             moves robots out of a contact (fps::Client::back_off)
+//   friction [ID ...]            the friction trend (fps::Client::friction_survey, 9.4.2)
+//   halltest ID [alpha|beta]     the hall sensor and motor test (fps::Client::hall_test, 9.4.3)
 //
 // and writes unsolicited keywords to every listener: `locked`/`locked_by` and a `collision_alert`
 // when the array locks (checked every FpsActorOptions::watch_period_s, 20 ms by default, on a
 // thread of its own), the status every status_period_s, and `move_progress` to the commander of a
 // running move every progress_period_s.
 //
-// goto, unlock and backoff are exclusive: a second one while one runs is refused. The client is called by
+// goto, unlock, backoff, friction and halltest are exclusive: a second one while one runs is refused. The client is called by
 // one command at a time; a status asked during a move answers from the status read before it
 // (keyword `stale`), with the move's progress. The collision safety stays the client's own
 // (fps::Client: any collision report locks the array and aborts every robot), bus or no bus.
@@ -25,6 +27,7 @@
 #include "axon/actor/actor_core.hpp"
 
 #include <memory>
+#include <string>
 
 namespace axon::fps {
 class Client;
@@ -36,6 +39,7 @@ struct FpsActorOptions {
   double status_period_s = 10.0;   // 0: no periodic status
   double watch_period_s = 0.02;    // how often the lock is checked
   double progress_period_s = 1.0;  // move_progress while a goto runs
+  std::string friction_history{};  // friction's CSV history ("": none, every arm a baseline)
 };
 
 class FpsActor {
