@@ -52,6 +52,7 @@ struct ActorFpsOptions {
   std::uint64_t seed = 1;
   double status_period_s = 10.0;
   std::string friction_history;    // the friction verb's CSV history
+  std::string plc;                 // with --connect: the PLC at HOST[:PORT] (upgrade)
   double duration_s = 0;
 };
 
@@ -74,7 +75,9 @@ int run_actor_fps(const ActorFpsOptions& o) {
     std::unique_ptr<fps::sim::SimulatedPlane> sim;
     if (simulate) sim = std::make_unique<fps::sim::SimulatedPlane>(need(resolve_layout(o.layout)),
                                                                    fps::sim::SimulatedPlaneOptions{o.time_scale, o.seed});
-    fps::Client client;
+    fps::ClientConfig cc;
+    cc.plc_address = sim ? sim->plc_address() : o.plc;  // upgrade through the PLC
+    fps::Client client(cc);
     if (!o.buses.empty()) client.open(o.buses);
     else client.open(sim ? sim->plane() : need(resolve_layout(o.layout)));
     actor::BusActor bus({o.name, o.bus.link()});
@@ -160,6 +163,7 @@ void add_actor_commands(CLI::App& app, GlobalOptions& global) {
   f->add_option("--time-scale", fo->time_scale, "simulator: simulated seconds per second (default 10)");
   f->add_option("--seed", fo->seed, "simulator: seed (default 1)");
   f->add_option("--status-period", fo->status_period_s, "seconds between status broadcasts (default 10; 0: none)");
+  f->add_option("--plc", fo->plc, "with --connect: the PLC at HOST[:PORT], which upgrade needs (the simulator has its own)");
   f->add_option("--friction-history", fo->friction_history,
                  "CSV history the friction verb judges against and appends to (default: none, every arm a baseline)");
   f->add_option("--duration", fo->duration_s, "stop after this many seconds (default: until Ctrl-C)");

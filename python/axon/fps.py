@@ -34,14 +34,18 @@ from ._axon.fps import (
     PlcConnectFailed,
     RobotMove,
     RobotStatus,
+    RobotUpgrade,
     SimulatedPlane,
     StopOutcome,
     Timeout,
     UnknownPositioner,
     UnlockOutcome,
+    FirmwareOutcome,
+    SextantUpgrade,
     folded_poses,
     plan,
     random_poses,
+    simulated_firmware_image,
 )
 
 _ROBOT_FIELDS = ["id", "x_mm", "y_mm", "sextant", "gateway", "bus", "disabled", "offline"]

@@ -4,6 +4,7 @@
 #include "bindings.hpp"
 
 #include "axon/fps/host/client.hpp"
+#include "axon/fps/sim/firmware_marker.hpp"
 #include "axon/fps/sim/simulated_plane.hpp"
 
 #include <pybind11/numpy.h>
@@ -130,9 +131,9 @@ void bind_outcomes(py::module_& m) {
 }
 
 std::unique_ptr<Client> make_client(double reply_timeout_s, double call_timeout_s, double poll_interval_s,
-                                    double discover_window_s, double position_tolerance_deg) {
-  return std::make_unique<Client>(
-      fps::ClientConfig{reply_timeout_s, call_timeout_s, poll_interval_s, discover_window_s, position_tolerance_deg, false, false});
+                                    double discover_window_s, double position_tolerance_deg, const std::string& plc_address) {
+  return std::make_unique<Client>(fps::ClientConfig{reply_timeout_s, call_timeout_s, poll_interval_s, discover_window_s,
+                                                    position_tolerance_deg, false, false, plc_address});
 }
 
 fps::PlanSettings plan_settings(double speed_deg_s, double buffer_mm, std::uint64_t seed, bool park_bad_targets,
@@ -201,6 +202,63 @@ void bind_troubleshoot(py::module_& m) {
       .def_property_readonly("ok", &HallTestReport::ok)
       .def_property_readonly("summary", &HallTestReport::summary)
       .def("__bool__", &HallTestReport::ok);
+}
+
+void bind_upgrade(py::module_& m) {
+  py::class_<fps::SextantUpgrade>(m, "SextantUpgrade", "Where one sextant's firmware upgrade stands.")
+      .def_readonly("sextant", &fps::SextantUpgrade::sextant)
+      .def_readonly("robots", &fps::SextantUpgrade::robots)
+      .def_readonly("done", &fps::SextantUpgrade::done)
+      .def_readonly("failed", &fps::SextantUpgrade::failed)
+      .def_readonly("bytes", &fps::SextantUpgrade::bytes)
+      .def_readonly("seconds", &fps::SextantUpgrade::seconds)
+      .def_readonly("finished", &fps::SextantUpgrade::finished)
+      .def_readonly("text", &fps::SextantUpgrade::text)
+      .def("__repr__", [](const fps::SextantUpgrade& p) { return "<SextantUpgrade " + p.text + ">"; });
+  py::class_<fps::RobotUpgrade>(m, "RobotUpgrade", "One robot of a firmware upgrade.")
+      .def_readonly("id", &fps::RobotUpgrade::id)
+      .def_readonly("sextant", &fps::RobotUpgrade::sextant)
+      .def_readonly("outcome", &fps::RobotUpgrade::outcome, "ok, failed or not_attempted")
+      .def_readonly("attempts", &fps::RobotUpgrade::attempts)
+      .def_readonly("reason", &fps::RobotUpgrade::reason)
+      .def_readonly("half_written", &fps::RobotUpgrade::half_written)
+      .def_readonly("before", &fps::RobotUpgrade::before)
+      .def_readonly("after", &fps::RobotUpgrade::after);
+  py::class_<fps::FirmwareOutcome>(m, "FirmwareOutcome")
+      .def_readonly("ok", &fps::FirmwareOutcome::ok)
+      .def_readonly("robots", &fps::FirmwareOutcome::robots)
+      .def_readonly("summary", &fps::FirmwareOutcome::summary)
+      .def("__bool__", [](const fps::FirmwareOutcome& o) { return o.ok; });
+}
+
+void bind_client_upgrade(py::class_<Client>& c) {
+  c.def("upgrade_firmware", [](Client& c, const py::bytes& image, const std::string& expected_version,
+                               const std::vector<int>& sextants, unsigned retries, double power_off_s,
+                               const py::object& progress) {
+         const std::string raw = image;
+         const std::vector<std::uint8_t> bytes(raw.begin(), raw.end());
+         const fps::UpgradeSettings s{expected_version, sextants, retries, power_off_s};
+         // Called on the client's thread: the callback runs with the GIL, and what it raises is kept
+         // for later (the upgrade goes on: robots half-way through an image must not be left there).
+         std::function<void(const fps::SextantUpgrade&)> report;
+         std::optional<py::error_already_set> raised;
+         if (!progress.is_none())
+           report = [&progress, &raised](const fps::SextantUpgrade& p) {
+             py::gil_scoped_acquire gil;
+             try {
+               progress(p);
+             } catch (py::error_already_set& e) {
+               if (!raised) raised = std::move(e);
+             }
+           };
+         auto out = blocking(c, [&c, &bytes, s, &report] { return c.upgrade_firmware(bytes, s, report); });
+         if (raised) throw std::move(*raised);
+         return out;
+       }, py::arg("image"), py::kw_only(), py::arg("expected_version") = "", py::arg("sextants") = std::vector<int>{},
+       py::arg("retries") = 1, py::arg("power_off_s") = 1.0, py::arg("progress") = py::none(),
+       "Firmware of every robot, sextant by sextant through the PLC (Client(plc_address=...), open(layout)): "
+       "image as bytes; progress(SextantUpgrade) about once a second per sextant and at its end. Returns an "
+       "FirmwareOutcome; raise the call timeout first for a whole plane.");
 }
 
 void bind_client_troubleshoot(py::class_<Client>& c) {
@@ -286,7 +344,8 @@ void bind_client_moves(py::class_<Client>& c) {
 void bind_client(py::module_& m) {
   py::class_<Client> c(m, "Client", "The robots of a focal plane (or of some buses), from blocking calls.");
   c.def(py::init(&make_client), py::kw_only(), py::arg("reply_timeout_s") = 1.0, py::arg("call_timeout_s") = 600.0,
-        py::arg("poll_interval_s") = 0.25, py::arg("discover_window_s") = 0.5, py::arg("position_tolerance_deg") = 0.1)
+        py::arg("poll_interval_s") = 0.25, py::arg("discover_window_s") = 0.5, py::arg("position_tolerance_deg") = 0.1,
+        py::arg("plc_address") = "")
       .def("open", [](Client& c, const std::vector<std::string>& specs) { blocking(c, [&c, specs] { c.open(specs); }); },
            py::arg("bus_specs"), "Opens buses by spec (cannet://HOST:PORT/N, socketcand://..., socketcan:can0).")
       .def("open", [](Client& c, const fps::FocalPlane& plane, const std::map<std::uint16_t, std::string>& addresses) {
@@ -312,10 +371,17 @@ void bind_client(py::module_& m) {
       });
   bind_client_moves(c);
   bind_client_troubleshoot(c);
+  bind_client_upgrade(c);
 }
 
 void bind_plane(py::module_& m) {
   using fps::sim::SimulatedPlane;
+  m.def("simulated_firmware_image", [](const std::string& version, std::size_t size) {
+         const auto bytes = fps::sim::make_firmware_image(fps::protocol::FirmwareVersion::parse(version).value(), size).value();
+         return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+       }, py::arg("version"), py::arg("size") = 3000,
+       "A firmware image the simulated robots accept and then report as `version` (XX.YY.ZZ): for trying "
+       "Client.upgrade_firmware against a SimulatedPlane.");
   py::class_<SimulatedPlane>(m, "SimulatedPlane",
                              "A whole focal plane simulated in this process: its robots behind CAN@net gateway "
                              "emulators on loopback TCP, and the PLC emulator.")
@@ -369,6 +435,7 @@ void bind_plane(py::module_& m) {
 void bind_fps_client(py::module_& m) {
   bind_outcomes(m);
   bind_troubleshoot(m);
+  bind_upgrade(m);
   bind_client(m);
   bind_plane(m);
 }

@@ -2,13 +2,18 @@
 // replies go to a collector.
 #include "axon/actor/fps_actor.hpp"
 #include "axon/fps/host/client.hpp"
+#include "axon/fps/sim/firmware_marker.hpp"
 #include "axon/fps/sim/simulated_plane.hpp"
 #include "replies.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 namespace axon::actor {
 namespace {
@@ -140,6 +145,44 @@ TEST_F(FpsActorOnBenchtop, HalltestFindsAStuckSensorAndFailsWithTheVerdict) {
     EXPECT_EQ(code_of(*b), 'f') << bad;
     EXPECT_TRUE(body_of(*b).contains("error")) << b->body;
   }
+}
+
+// upgrade FILE VERSION through the embedded plane's PLC: `>` upgrade_progress, then `:` with every
+// robot on the new image; an unreadable file fails at once, nothing switched.
+TEST(FpsActorUpgrade, UpgradeReportsProgressAndEndsWithEveryRobotOnTheNewImage) {
+  fps::sim::SimulatedPlane plane{"benchtop", fps::sim::SimulatedPlaneOptions{20.0, 1, false, true}};
+  fps::ClientConfig cc;
+  cc.plc_address = plane.plc_address();
+  fps::Client client(cc);
+  test::Replies out;
+  ActorCore core{"fps", out.sink()};
+  client.open(plane.plane());
+  auto actor = std::make_unique<FpsActor>(core, client, FpsActorOptions{0.0, 0.02, 0.2});
+  const auto path = (std::filesystem::temp_directory_path() / fmt::format("axon-actor-image-{}.bin", ::getpid())).string();
+  {
+    const auto image = fps::sim::make_firmware_image({4, 2, 0}, 3000).value();
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
+  }
+  core.handle(command("upgrade " + path + " 04.02.00", "up"));
+  const auto r = out.final_of("up");
+  std::filesystem::remove(path);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(code_of(*r), ':') << r->body;
+  const auto kw = body_of(*r)["upgrade_result"];
+  EXPECT_EQ(kw["ok"], true);
+  ASSERT_EQ(kw["robots"].size(), 6u) << r->body;
+  for (const auto& robot : kw["robots"]) EXPECT_EQ(robot["after"], "04.02.00") << robot.dump();
+  bool finished = false;
+  for (const auto& m : out.of("up"))
+    if (code_of(m) == '>' && body_of(m).contains("upgrade_progress"))
+      finished = finished || body_of(m)["upgrade_progress"]["finished"].get<bool>();
+  EXPECT_TRUE(finished) << "no upgrade_progress at the sextant's end";
+  core.handle(command("upgrade /nonexistent/image.bin", "bad"));
+  const auto bad = out.final_of("bad");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(code_of(*bad), 'f');
+  EXPECT_NE(body_of(*bad)["error"].get<std::string>().find("cannot open"), std::string::npos) << bad->body;
+  actor.reset();
 }
 
 }  // namespace

@@ -258,6 +258,14 @@ def check_commands(c, port, actor_proc):
     assert r[-1][0] == ':' and r[-1][1]['hall_test']['ok'] is True, r
     assert [a['arm'] for a in r[-1][1]['hall_test']['arms']] == ['beta'], r
     assert c.command('halltest %d gamma' % ids[2])[-1][0] == 'f'
+    # Firmware of every robot through the embedded plane's PLC, with progress keywords on the way.
+    with tempfile.NamedTemporaryFile(suffix='.bin') as image:
+        image.write(b'AXON-FPS-FW:04.02.00' + bytes(3000))
+        image.flush()
+        r = c.command('upgrade %s 04.02.00' % image.name, timeout=60)
+    assert r[-1][0] == ':' and r[-1][1]['upgrade_result']['ok'] is True, r
+    assert {x['after'] for x in r[-1][1]['upgrade_result']['robots']} == {'04.02.00'}, r
+    assert any('upgrade_progress' in kw and kw['upgrade_progress']['finished'] for code, kw in r if code == '>'), r
     assert any('robots' in kw for _, kw in c.broadcasts), 'no periodic status broadcast'
 
 

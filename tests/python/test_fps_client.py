@@ -130,3 +130,19 @@ def test_moving_500_simulated_robots(tmp_path):
         worst = max(abs(a - b) for rid, end in done.plan.ends.items() for a, b in zip(plane.arms(rid), end))
         assert worst <= 0.1
         assert plane.collisions == 0
+
+
+def test_upgrade_firmware_reports_progress_and_every_robot_runs_the_new_image():
+    with axon.fps.SimulatedPlane("benchtop", time_scale=20.0) as plane:
+        with axon.fps.Client(poll_interval_s=0.02, discover_window_s=0.3, plc_address=plane.plc_address) as fps:
+            fps.open(plane.layout)
+            fps.discover()
+            lines = []
+            image = axon.fps.simulated_firmware_image("04.02.00")
+            out = fps.upgrade_firmware(image, expected_version="04.02.00", power_off_s=0.05, progress=lines.append)
+            assert out and out.ok, out.summary
+            assert {r.after for r in out.robots} == {"04.02.00"} and len(out.robots) == 6
+            assert lines and lines[-1].finished and lines[-1].done == 6, lines
+            assert {r.firmware for r in fps.status()} == {"04.02.00"}
+            with pytest.raises(axon.Error):
+                fps.upgrade_firmware(image, expected_version="four")

@@ -56,3 +56,4 @@ def test_troubleshooting_is_refused_while_locked(fps, slow_plane):
     fps.emergency_stop("operator")
     with pytest.raises(axon.fps.MotionLocked):
         fps.hall_test(1)
+

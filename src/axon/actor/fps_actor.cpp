@@ -12,6 +12,8 @@
 #include <charconv>
 #include <chrono>
 #include <condition_variable>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -247,6 +249,34 @@ struct FpsActor::Impl {
     else c.fail(report.summary(), std::move(kw));
   }
 
+  // upgrade FILE [XX.YY.ZZ]: the firmware of every robot through the PLC; `>` upgrade_progress
+  // about once a second per sextant, then the outcome.
+  void upgrade(Command& c) {
+    const auto& args = c.args();
+    if (args.empty() || args.size() > 2)
+      throw Exception(Error(CoreErrc::invalid_argument, "upgrade takes FILE [XX.YY.ZZ] (the version the robots must run)"));
+    std::ifstream in(args[0], std::ios::binary);
+    if (!in) throw Exception(Error(CoreErrc::invalid_argument, fmt::format("upgrade: cannot open {}", args[0])));
+    const std::vector<std::uint8_t> image((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    fps::UpgradeSettings s;
+    if (args.size() == 2) s.expected_version = args[1];
+    std::lock_guard lock(device);
+    const auto out = client.upgrade_firmware(image, s, [&c](const fps::SextantUpgrade& p) {
+      c.write(MessageCode::running, {{"upgrade_progress", {{"sextant", p.sextant}, {"robots", p.robots}, {"done", p.done},
+                                                           {"failed", p.failed}, {"bytes", p.bytes}, {"seconds", p.seconds},
+                                                           {"finished", p.finished}, {"text", p.text}}}});
+    });
+    remember(client.status());
+    json robots = json::array();
+    for (const auto& r : out.robots)
+      robots.push_back({{"id", r.id}, {"sextant", r.sextant}, {"outcome", r.outcome}, {"attempts", r.attempts},
+                        {"half_written", r.half_written}, {"before", r.before}, {"after", r.after}, {"reason", r.reason}});
+    json kw{{"upgrade_result", {{"ok", out.ok}, {"robots", robots}}}, {"locked", client.locked()},
+            {"locked_by", client.lock_reason()}};
+    if (out.ok) c.finish(std::move(kw));
+    else c.fail(out.summary, std::move(kw));
+  }
+
   void unlock(Command& c) {
     std::lock_guard lock(device);
     const auto out = client.unlock();
@@ -321,6 +351,8 @@ FpsActor::FpsActor(ActorCore& core, fps::Client& client, FpsActorOptions options
   core.add({"abort", "abort", false, [i](Command& c) { i->stop(c); }});
   core.add({"unlock", "unlock", true, [i](Command& c) { i->unlock(c); }});
   core.add({"backoff", "backoff [ID ...] (no ID: every robot in contact)", true, [i](Command& c) { i->back_off(c); }});
+  core.add({"upgrade", "upgrade FILE [XX.YY.ZZ] (firmware of every robot through the PLC)", true,
+            [i](Command& c) { i->upgrade(c); }});
   core.add({"friction", "friction [ID ...] (no ID: every robot; the friction trend, 9.4.2)", true,
             [i](Command& c) { i->friction(c); }});
   core.add({"halltest", "halltest ID [alpha|beta] (hall sensor and motor test, 9.4.3)", true,

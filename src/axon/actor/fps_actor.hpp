@@ -6,6 +6,7 @@
 //   stop | abort                 aborts every robot (during a move this also locks the array)
 //   unlock                       clears collision flags and the lock
 //   backoff [ID ...]             moves robots out of a contact (fps::Client::back_off)
+//   upgrade FILE [XX.YY.ZZ]      firmware of every robot through the PLC (fps::Client::upgrade_firmware)
 //   friction [ID ...]            the friction trend (fps::Client::friction_survey, 9.4.2)
 //   halltest ID [alpha|beta]     the hall sensor and motor test (fps::Client::hall_test, 9.4.3)
 //
@@ -14,7 +15,7 @@
 // thread of its own), the status every status_period_s, and `move_progress` to the commander of a
 // running move every progress_period_s.
 //
-// goto, unlock, backoff, friction and halltest are exclusive: a second one while one runs is refused. The client is called by
+// goto, unlock, backoff, upgrade, friction and halltest are exclusive: a second one while one runs is refused. The client is called by
 // one command at a time; a status asked during a move answers from the status read before it
 // (keyword `stale`), with the move's progress. The collision safety stays the client's own
 // (fps::Client: any collision report locks the array and aborts every robot), bus or no bus.

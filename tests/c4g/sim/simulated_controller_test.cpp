@@ -104,8 +104,12 @@ TEST(SimulatedController, AStreamPastAStrokeEndEndsTheSessionInASafetyStopWithDr
                                      [](const sim::Event& e) { return e.name == sim::event::kDriveOffFromPc; });
   EXPECT_TRUE(drive_off);
   ASSERT_EQ(seen.joint_degrees[1].size(), 6u);
-  // No command beyond 5 deg went out; the axis follows the last one within a few thousandths.
-  EXPECT_LT(seen.joint_degrees[1][0], 5.01);
+  // No command beyond 5 deg went out; the axis follows the last one within a few thousandths. A
+  // reply the controller missed (late on a loaded machine, seen once under ASan: 5.032 deg) lets the
+  // drives run one more cycle on the last velocity, 16 deg/s x 2 ms = 0.032 deg: what the PC did not
+  // answer in time it cannot stop, so each miss widens the bound by one cycle of travel.
+  const double coast = 0.032 * static_cast<double>(seen.stats.misses);
+  EXPECT_LT(seen.joint_degrees[1][0], 5.01 + coast) << seen.stats.misses << " replies missed";
   EXPECT_GT(seen.joint_degrees[1][0], 4.0);  // it did move up to the stroke end
 }
 

@@ -8,6 +8,7 @@
 #include "axon/fps/host/datum_check.hpp"
 #include "axon/fps/host/focal_plane_array.hpp"
 #include "axon/fps/host/plan_and_move.hpp"
+#include "axon/fps/host/plane_upgrade.hpp"
 #include "axon/fps/plan/layout_model.hpp"
 #include "axon/fps/plan/targets.hpp"
 #include "axon/net/endpoint.hpp"
@@ -181,6 +182,7 @@ void Client::open(const FocalPlane& plane, const std::map<std::uint16_t, std::st
   host::FocalPlaneArrayOptions o;
   o.array = impl_->array_options();
   for (const auto& [id, text] : gateway_addresses) o.addresses[id] = need(net::parse_endpoint(text, can::kCanNetPort));
+  if (!impl_->config.plc_address.empty()) o.plc = need(net::parse_endpoint(impl_->config.plc_address, 502));
   auto* impl = impl_.get();
   impl->run([impl, plane, o]() -> asio::awaitable<void> {
     auto connected = co_await host::FocalPlaneArray::connect(co_await asio::this_coro::executor, plane, o);
@@ -315,6 +317,42 @@ host::HallTestReport Client::hall_test(std::uint16_t id, const host::HallTestOpt
   return impl_->run([&array, id, model, options]() -> asio::awaitable<host::HallTestReport> {
     auto r = co_await host::hall_test(array, *model, id, options);
     co_return need(std::move(r));
+  });
+}
+
+namespace {
+
+std::string version_text(const std::optional<protocol::FirmwareVersion>& v) { return v ? v->to_string() : ""; }
+
+FirmwareOutcome outcome_of(const host::PlaneUpgradeReport& r) {
+  FirmwareOutcome out{r.ok(), {}, r.summary()};
+  for (const auto& rr : r.robots)
+    out.robots.push_back({rr.id, rr.sextant, host::to_string(rr.outcome), rr.attempts, rr.reason, rr.half_written,
+                          version_text(rr.before), version_text(rr.after)});
+  return out;
+}
+
+}  // namespace
+
+FirmwareOutcome Client::upgrade_firmware(const std::vector<std::uint8_t>& image, const UpgradeSettings& settings,
+                                        const std::function<void(const SextantUpgrade&)>& progress) {
+  impl_->open_array();
+  auto* fpa = impl_->plane_array.get();
+  if (!fpa) throw Exception(Error(host::HostErrc::invalid_argument, "upgrade_firmware needs a layout: open(plane)"));
+  if (!(settings.power_off_s >= 0 && settings.power_off_s <= 60))
+    throw Exception(Error(host::HostErrc::invalid_argument, "power_off_s must be within 0..60"));
+  host::PlaneUpgradeOptions o;
+  if (!settings.expected_version.empty()) o.expected_version = need(protocol::FirmwareVersion::parse(settings.expected_version));
+  o.sextants = settings.sextants;
+  o.retries = settings.retries;
+  o.power_off_time = duration_of(settings.power_off_s);
+  if (progress)
+    o.progress = [&progress](const host::SextantProgress& p) {
+      progress({p.sextant, p.total, p.done, p.failed, p.bytes, p.seconds, p.finished, p.to_text()});
+    };
+  return impl_->run([fpa, &image, o]() -> asio::awaitable<FirmwareOutcome> {
+    auto r = co_await host::upgrade_plane(*fpa, image, o);
+    co_return outcome_of(need(std::move(r)));
   });
 }
 

@@ -30,6 +30,7 @@
 #include "axon/fps/layout/focal_plane.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -54,6 +55,9 @@ struct ClientConfig {
   // instead of the document's, and GET_FIRMWARE_VERSION's bytes in the document's order.
   bool field_firmware_history = false;
   bool document_version_byte_order = false;
+  // The PLC (positioner power and the sync line) at HOST[:PORT] (port 502 by default), connected by
+  // open(plane); upgrade_firmware() needs it. "": none.
+  std::string plc_address{};
 };
 
 // One robot's row of status(): plain values.
@@ -172,6 +176,44 @@ struct BackOffOutcome {
   std::string summary;  // one line per move and contact
 };
 
+// What upgrade_firmware() does (host/plane_upgrade.hpp).
+struct UpgradeSettings {
+  std::string expected_version;  // "XX.YY.ZZ" every robot must run afterwards; "": reported, not checked
+  std::vector<int> sextants;     // empty: every sextant with robots, in order
+  unsigned retries = 1;          // extra attempts per robot that failed
+  double power_off_s = 1.0;      // positioner power off this long before each power-up
+};
+
+// Where one sextant's upgrade stands: the progress callback's argument, about once a second while
+// its robots receive the image and once at its end.
+struct SextantUpgrade {
+  int sextant = 0;
+  std::size_t robots = 0;  // of the sextant
+  std::size_t done = 0;    // upgraded and verified so far
+  std::size_t failed = 0;
+  std::uint64_t bytes = 0;  // image bytes the robots acknowledged
+  double seconds = 0;       // since the sextant started
+  bool finished = false;
+  std::string text;         // "sextant 2: 83/84 robots, 1 failed, 4.13 MB in 12.1 s (341.2 kB/s)"
+};
+
+struct RobotUpgrade {
+  std::uint16_t id = 0;
+  int sextant = 0;
+  std::string outcome;     // ok, failed, not_attempted
+  unsigned attempts = 0;
+  std::string reason;      // why not ok; notes when ok
+  bool half_written = false;  // its last transfer stopped part-way (it runs its previous firmware)
+  std::string before;      // application version before ("" unknown)
+  std::string after;       // what it runs at the end ("" no answer)
+};
+
+struct FirmwareOutcome {
+  bool ok = false;  // every robot runs the new image
+  std::vector<RobotUpgrade> robots;
+  std::string summary;  // one line per sextant, then one per robot that is not plainly ok
+};
+
 class Client {
  public:
   explicit Client(ClientConfig config = {});
@@ -245,6 +287,15 @@ class Client {
   // The hall sensor and motor test of one robot, arm by arm, in open loop without collision
   // detection; closed loop with detection is restored afterwards (HallFinding::restored).
   host::HallTestReport hall_test(std::uint16_t id, const host::HallTestOptions& options = {});
+
+  // Firmware of every robot of the layout, sextant by sextant through the PLC (host/plane_upgrade.hpp):
+  // each sextant power-cycled into the bootloader, its robots sent the image at once, failures
+  // retried, powered back into the application and every version read; the cold policy applied
+  // again at the end. Needs open(plane) with ClientConfig::plc_address (HostErrc::invalid_argument
+  // otherwise, nothing switched). `progress` is called on the client's thread (keep it short). A
+  // whole plane takes minutes: raise set_call_timeout() first (600 s by default).
+  FirmwareOutcome upgrade_firmware(const std::vector<std::uint8_t>& image, const UpgradeSettings& settings = {},
+                                  const std::function<void(const SextantUpgrade&)>& progress = {});
 
   // Locks the array and aborts every robot on every bus; moves are refused until unlock().
   StopOutcome emergency_stop(const std::string& reason = "emergency stop");

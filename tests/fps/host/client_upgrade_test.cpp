@@ -1,0 +1,75 @@
+// fps::Client::upgrade_firmware against an in-process simulated plane with its PLC emulator, over
+// real TCP on loopback: the sextant power-cycled into the bootloader through the PLC, every robot
+// sent the image, powered back, its version read; progress reported; no PLC: refused.
+#include "axon/fps/host/client.hpp"
+#include "axon/fps/host/error.hpp"
+#include "axon/fps/sim/firmware_marker.hpp"
+#include "axon/fps/sim/simulated_plane.hpp"
+
+#include <gtest/gtest.h>
+
+namespace axon::fps::client_upgrade_test {
+namespace {
+
+ClientConfig quick(const std::string& plc) {
+  ClientConfig c;
+  c.poll_interval_s = 0.02;
+  c.discover_window_s = 0.3;
+  c.call_timeout_s = 120;
+  c.plc_address = plc;
+  return c;
+}
+
+TEST(ClientUpgrade, EveryRobotRunsTheNewImageAndProgressIsReported) {
+  sim::SimulatedPlaneOptions so;
+  so.time_scale = 20;
+  sim::SimulatedPlane plane("benchtop", so);
+  Client fps(quick(plane.plc_address()));
+  fps.open(plane.plane());
+  ASSERT_EQ(fps.discover().size(), 6u);
+  const auto image = sim::make_firmware_image({4, 2, 0}, 3000).value();
+  std::vector<SextantUpgrade> seen;
+  UpgradeSettings s;
+  s.expected_version = "04.02.00";
+  s.power_off_s = 0.05;
+  const auto out = fps.upgrade_firmware(image, s, [&seen](const SextantUpgrade& p) { seen.push_back(p); });
+  EXPECT_TRUE(out.ok) << out.summary;
+  ASSERT_EQ(out.robots.size(), 6u) << out.summary;
+  for (const auto& r : out.robots) {
+    EXPECT_EQ(r.outcome, "ok") << r.id << ": " << r.reason;
+    EXPECT_EQ(r.before, "04.01.13") << r.id;
+    EXPECT_EQ(r.after, "04.02.00") << r.id;
+    EXPECT_EQ(r.attempts, 1u) << r.id;
+  }
+  ASSERT_FALSE(seen.empty());
+  EXPECT_TRUE(seen.back().finished);
+  EXPECT_EQ(seen.back().done, 6u);
+  EXPECT_EQ(seen.back().bytes, 6u * 3000u);
+  EXPECT_NE(seen.back().text.find("6/6 robots"), std::string::npos) << seen.back().text;
+  // The robots answer from the new application afterwards.
+  for (const auto& r : fps.status()) EXPECT_EQ(r.firmware, "04.02.00") << r.id;
+}
+
+TEST(ClientUpgrade, WithoutAPlcNothingIsSwitchedAndTheCallSaysWhy) {
+  sim::SimulatedPlaneOptions so;
+  so.time_scale = 20;
+  so.plc = false;
+  sim::SimulatedPlane plane("benchtop", so);
+  Client fps(quick(""));
+  fps.open(plane.plane());
+  fps.discover();
+  const auto image = sim::make_firmware_image({4, 2, 0}, 3000).value();
+  try {
+    fps.upgrade_firmware(image);
+    FAIL() << "an upgrade ran without a PLC";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), host::HostErrc::invalid_argument) << e.what();
+  }
+  UpgradeSettings bad;
+  bad.expected_version = "four";
+  EXPECT_THROW(fps.upgrade_firmware(image, bad), Exception);
+  for (const auto& r : fps.status()) EXPECT_EQ(r.firmware, "04.01.13") << r.id;
+}
+
+}  // namespace
+}  // namespace axon::fps::client_upgrade_test
