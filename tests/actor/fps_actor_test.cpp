@@ -121,6 +121,32 @@ TEST_F(FpsActorOnBenchtop, BackoffMovesTheRobotThatCollidedAwayAfterUnlock) {
   EXPECT_NE(body_of(*bad)["error"].get<std::string>().find("robot 4000 is not on the buses"), std::string::npos) << bad->body;
 }
 
+// plan: collision-free moves from where every robot stands, verified, then run; the robots not
+// named fold. discover answers the robots again.
+TEST_F(FpsActorOnBenchtop, PlanMovesTheNamedRobotCollisionFreeAndDiscoverListsEveryRobot) {
+  const auto id = first_robot();
+  core.handle(command(fmt::format("plan {} 30 150", id), "p"));
+  const auto r = out.final_of("p");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(code_of(*r), ':') << r->body;
+  const auto kw = body_of(*r);
+  EXPECT_EQ(kw["plan_result"]["verified"], true) << r->body;
+  EXPECT_EQ(kw["plan_result"]["moved"], true);
+  EXPECT_GE(kw["plan_result"]["min_clearance_mm"].get<double>(), 0.0);
+  const auto reached = plane.arms(id).value();
+  EXPECT_NEAR(reached.alpha, 30.0, 0.1);
+  EXPECT_NEAR(reached.beta, 150.0, 0.1);
+  EXPECT_EQ(plane.collisions(), 0u);
+  core.handle(command("plan", "p0"));
+  ASSERT_TRUE(out.final_of("p0"));
+  EXPECT_EQ(code_of(*out.final_of("p0")), 'f');
+  core.handle(command("discover", "d"));
+  const auto d = out.final_of("d");
+  ASSERT_TRUE(d);
+  EXPECT_EQ(code_of(*d), ':') << d->body;
+  EXPECT_EQ(body_of(*d)["robots"].size(), plane.plane().robots().size());
+}
+
 // Troubleshooting verbs (interface document 9.4.3): a stuck hall sensor is found and the command
 // fails with the verdict in its keyword; bad arguments fail with a reason, nothing moves.
 TEST_F(FpsActorOnBenchtop, HalltestFindsAStuckSensorAndFailsWithTheVerdict) {

@@ -253,6 +253,11 @@ def check_commands(c, port, actor_proc):
     r = c.command('backoff %d' % ids[3])  # the document's move away after a collision
     assert r[-1][0] == ':' and r[-1][1]['back_off']['ok'] is True, r
     assert r[-1][1]['back_off']['moves'][0]['moved'] is True, r
+    # Planned, collision-free moves (the robots not named fold), and discovery again.
+    r = c.command('plan %d 40 160' % ids[1])
+    assert r[-1][0] == ':' and r[-1][1]['plan_result']['verified'] is True, r
+    r = c.command('discover')
+    assert r[-1][0] == ':' and len(r[-1][1]['robots']) == len(ids), r
     # Troubleshooting (interface document 9.4.3): the hall test of a healthy robot, one arm.
     r = c.command('halltest %d beta' % ids[2])
     assert r[-1][0] == ':' and r[-1][1]['hall_test']['ok'] is True, r

@@ -177,25 +177,63 @@ struct FpsActor::Impl {
     const auto targets = parse_targets(c.args(), client.robots());
     if (client.locked())
       throw Exception(Error(CoreErrc::invalid_argument, fmt::format("locked ({}): unlock first", client.lock_reason())));
-    json started = json::array();
-    for (const auto& [id, a] : targets) started.push_back(json{{"id", id}, {"alpha", a.alpha}, {"beta", a.beta}});
-    c.write(MessageCode::running, {{"move_started", {{"robots", targets.size()}, {"targets", started}}}});
-    {
-      std::lock_guard s(state);
-      move = Move{&c, targets.size(), Clock::now()};
-    }
-    struct EndMove {
-      Impl& impl;
-      ~EndMove() {
-        std::lock_guard s(impl.state);
-        impl.move.reset();
-      }
-    } end_move{*this};
+    const auto tracking = start_move(c, targets);
     const auto out = client.goto_absolute(targets);
     remember(client.status());
     json kw{{"move_result", move_json(out)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
     if (out.completed) c.finish(std::move(kw));
     else c.fail(out.summary.empty() ? "not every robot reached its target" : out.summary, std::move(kw));
+  }
+
+  // A running move as status and move_progress show it, from move_started until the guard ends.
+  struct EndMove {
+    Impl& impl;
+    ~EndMove() {
+      std::lock_guard s(impl.state);
+      impl.move.reset();
+    }
+  };
+  [[nodiscard]] EndMove start_move(Command& c, const std::map<std::uint16_t, fps::Angles>& targets) {
+    json started = json::array();
+    for (const auto& [id, a] : targets) started.push_back(json{{"id", id}, {"alpha", a.alpha}, {"beta", a.beta}});
+    c.write(MessageCode::running, {{"move_started", {{"robots", targets.size()}, {"targets", started}}}});
+    std::lock_guard s(state);
+    move = Move{&c, targets.size(), Clock::now()};
+    return EndMove{*this};
+  }
+
+  // plan ID ALPHA BETA [...] | plan FILE: collision-free moves from where every robot stands (robots
+  // not listed fold), verified, then run (fps::Client::plan_and_move).
+  void plan(Command& c) {
+    std::unique_lock lock(device);
+    const auto& args = c.args();
+    if (args.empty()) throw Exception(Error(CoreErrc::invalid_argument, "plan takes ID ALPHA BETA triplets or a target FILE"));
+    const bool file = args.size() == 1;
+    const auto targets = file ? std::map<std::uint16_t, fps::Angles>{} : parse_targets(args, client.robots());
+    if (client.locked())
+      throw Exception(Error(CoreErrc::invalid_argument, fmt::format("locked ({}): unlock first", client.lock_reason())));
+    const auto tracking = start_move(c, targets);
+    const auto out = file ? client.plan_and_move(args[0]) : client.plan_and_move(targets);
+    remember(client.status());
+    const auto& p = out.plan;
+    json kw{{"plan_result", {{"verified", p.verified}, {"robots", p.robots}, {"not_reached", p.not_reached},
+                             {"move_s", p.move_s}, {"plan_s", p.plan_s}, {"min_clearance_mm", p.min_clearance_mm},
+                             {"notes", p.notes}, {"outside_safe_zone", p.outside_safe_zone}, {"moved", out.moved}}},
+            {"move_result", move_json(out.move)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
+    if (!out.moved || out.move.completed) c.finish(std::move(kw));
+    else c.fail(out.move.summary.empty() ? "not every robot reached its target" : out.move.summary, std::move(kw));
+  }
+
+  // GET_ID on every bus again, then every robot's firmware and status (robots found since start-up
+  // join).
+  void discover(Command& c) {
+    std::lock_guard lock(device);
+    const auto rows = client.discover();
+    remember(rows);
+    std::size_t ready = 0;
+    for (const auto& r : rows) ready += r.ready ? 1 : 0;
+    std::lock_guard s(state);
+    c.finish({{"robots", last_robots}, {"ready", ready}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}});
   }
 
   void stop(Command& c) {
@@ -347,6 +385,9 @@ FpsActor::FpsActor(ActorCore& core, fps::Client& client, FpsActorOptions options
   auto* i = impl_.get();
   core.add({"status", "status", false, [i](Command& c) { i->status(c); }});
   core.add({"goto", "goto ID ALPHA BETA [ID ALPHA BETA ...] (ID: a robot or all)", true, [i](Command& c) { i->go(c); }});
+  core.add({"plan", "plan ID ALPHA BETA [...] | plan FILE (collision-free, the others fold)", true,
+            [i](Command& c) { i->plan(c); }});
+  core.add({"discover", "discover", true, [i](Command& c) { i->discover(c); }});
   core.add({"stop", "stop", false, [i](Command& c) { i->stop(c); }});
   core.add({"abort", "abort", false, [i](Command& c) { i->stop(c); }});
   core.add({"unlock", "unlock", true, [i](Command& c) { i->unlock(c); }});
