@@ -140,6 +140,14 @@ TEST_F(FpsActorOnBenchtop, PlanMovesTheNamedRobotCollisionFreeAndDiscoverListsEv
   core.handle(command("plan", "p0"));
   ASSERT_TRUE(out.final_of("p0"));
   EXPECT_EQ(code_of(*out.final_of("p0")), 'f');
+  core.handle(command("check", "c"));
+  const auto ck = out.final_of("c");
+  ASSERT_TRUE(ck);
+  EXPECT_EQ(code_of(*ck), ':') << ck->body;
+  EXPECT_EQ(body_of(*ck)["layout_check"]["matched"].size(), plane.plane().robots().size()) << ck->body;
+  core.handle(command("cold", "cold"));  // this plane has no PLC
+  ASSERT_TRUE(out.final_of("cold"));
+  EXPECT_EQ(code_of(*out.final_of("cold")), 'f');
   core.handle(command("discover", "d"));
   const auto d = out.final_of("d");
   ASSERT_TRUE(d);

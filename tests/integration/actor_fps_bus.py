@@ -258,6 +258,10 @@ def check_commands(c, port, actor_proc):
     assert r[-1][0] == ':' and r[-1][1]['plan_result']['verified'] is True, r
     r = c.command('discover')
     assert r[-1][0] == ':' and len(r[-1][1]['robots']) == len(ids), r
+    r = c.command('check')
+    assert r[-1][0] == ':' and r[-1][1]['layout_check']['ok'] is True, r
+    r = c.command('cold')  # the embedded plane's PLC emulator
+    assert r[-1][0] == ':' and sorted(r[-1][1]['cold']['applied']) == sorted(ids), r
     # Troubleshooting (interface document 9.4.3): the hall test of a healthy robot, one arm.
     r = c.command('halltest %d beta' % ids[2])
     assert r[-1][0] == ':' and r[-1][1]['hall_test']['ok'] is True, r

@@ -1,6 +1,7 @@
 #include "axon/actor/fps_actor.hpp"
 
 #include "axon/fps/host/troubleshoot_json.hpp"
+#include "axon/fps/layout/layout_check_json.hpp"
 
 #include "axon/core/error.hpp"
 #include "axon/fps/host/client.hpp"
@@ -236,6 +237,29 @@ struct FpsActor::Impl {
     c.finish({{"robots", last_robots}, {"ready", ready}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}});
   }
 
+  // check: GET_ID on every bus, compared with the layout.
+  void check(Command& c) {
+    std::lock_guard lock(device);
+    const auto r = client.check_layout();
+    json kw{{"layout_check", fps::to_json(r)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
+    if (r.ok()) c.finish(std::move(kw));
+    else c.fail(r.to_text(), std::move(kw));
+  }
+
+  // cold: the cold-temperature policy once, from the PLC's temperatures to every robot.
+  void cold(Command& c) {
+    std::lock_guard lock(device);
+    const auto r = client.apply_cold_policy();
+    json failed = json::object();
+    for (const auto& [id, why] : r.failed) failed[std::to_string(id)] = why;
+    json kw{{"cold", {{"motor_rpm", r.motor_rpm}, {"alpha_holding_pct", r.alpha_holding_pct},
+                      {"beta_holding_pct", r.beta_holding_pct},
+                      {"coldest_c", r.coldest_c ? json(*r.coldest_c) : json(nullptr)}, {"coldest_sensor", r.coldest_sensor},
+                      {"applied", r.applied}, {"failed", failed}, {"text", r.text}}}};
+    if (r.failed.empty()) c.finish(std::move(kw));
+    else c.fail(r.text, std::move(kw));
+  }
+
   void stop(Command& c) {
     bool moving = false;
     {
@@ -388,6 +412,8 @@ FpsActor::FpsActor(ActorCore& core, fps::Client& client, FpsActorOptions options
   core.add({"plan", "plan ID ALPHA BETA [...] | plan FILE (collision-free, the others fold)", true,
             [i](Command& c) { i->plan(c); }});
   core.add({"discover", "discover", true, [i](Command& c) { i->discover(c); }});
+  core.add({"check", "check (GET_ID on every bus against the layout)", true, [i](Command& c) { i->check(c); }});
+  core.add({"cold", "cold (the cold-temperature policy once, from the PLC)", true, [i](Command& c) { i->cold(c); }});
   core.add({"stop", "stop", false, [i](Command& c) { i->stop(c); }});
   core.add({"abort", "abort", false, [i](Command& c) { i->stop(c); }});
   core.add({"unlock", "unlock", true, [i](Command& c) { i->unlock(c); }});

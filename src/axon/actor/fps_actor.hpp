@@ -6,6 +6,8 @@
 //   plan ID ALPHA BETA [...]     plans collision-free moves there (the others fold) and runs them;
 //   plan FILE                    the same with a target file (fps::Client::plan_and_move)
 //   discover                     GET_ID on every bus again, firmware and status of every robot
+//   check                        GET_ID on every bus against the layout (fps::Client::check_layout)
+//   cold                         the cold policy once, PLC temperatures to every robot
 //   stop | abort                 aborts every robot (during a move this also locks the array)
 //   unlock                       clears collision flags and the lock
 //   backoff [ID ...]             moves robots out of a contact (fps::Client::back_off)
@@ -18,7 +20,7 @@
 // thread of its own), the status every status_period_s, and `move_progress` to the commander of a
 // running move every progress_period_s.
 //
-// goto, plan, discover, unlock, backoff, upgrade, friction and halltest are exclusive: a second one while one runs is refused. The client is called by
+// goto, plan, discover, check, cold, unlock, backoff, upgrade, friction and halltest are exclusive: a second one while one runs is refused. The client is called by
 // one command at a time; a status asked during a move answers from the status read before it
 // (keyword `stale`), with the move's progress. The collision safety stays the client's own
 // (fps::Client: any collision report locks the array and aborts every robot), bus or no bus.

@@ -71,5 +71,40 @@ TEST(ClientUpgrade, WithoutAPlcNothingIsSwitchedAndTheCallSaysWhy) {
   for (const auto& r : fps.status()) EXPECT_EQ(r.firmware, "04.01.13") << r.id;
 }
 
+// The layout check and the cold policy of a plane with its PLC, from blocking calls.
+TEST(ClientPlc, TheLayoutCheckFindsEveryRobotAndTheColdPolicyReachesEveryRobot) {
+  sim::SimulatedPlaneOptions so;
+  so.time_scale = 20;
+  sim::SimulatedPlane plane("benchtop", so);
+  Client fps(quick(plane.plc_address()));
+  fps.open(plane.plane());
+  const auto check = fps.check_layout();
+  EXPECT_TRUE(check.ok()) << check.to_text();
+  EXPECT_EQ(check.matched.size(), 6u) << check.to_text();
+  fps.discover();
+  const auto cold = fps.apply_cold_policy();
+  EXPECT_EQ(cold.applied.size(), 6u) << cold.text;
+  EXPECT_TRUE(cold.failed.empty()) << cold.text;
+  EXPECT_TRUE(cold.coldest_c.has_value()) << cold.text;
+  EXPECT_GT(cold.motor_rpm, 0u);
+  EXPECT_FALSE(cold.text.empty());
+}
+
+TEST(ClientPlc, TheColdPolicyWithoutAPlcIsRefused) {
+  sim::SimulatedPlaneOptions so;
+  so.time_scale = 20;
+  so.plc = false;
+  sim::SimulatedPlane plane("benchtop", so);
+  Client fps(quick(""));
+  fps.open(plane.plane());
+  fps.discover();
+  try {
+    fps.apply_cold_policy();
+    FAIL() << "a cold policy ran without a PLC";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), host::HostErrc::invalid_argument) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace axon::fps::client_upgrade_test

@@ -4,6 +4,7 @@
 #include "axon/core/loop_thread.hpp"
 #include "axon/fps/host/array.hpp"
 #include "axon/fps/host/back_off.hpp"
+#include "axon/fps/host/cold_control.hpp"
 #include "axon/fps/host/troubleshoot.hpp"
 #include "axon/fps/host/datum_check.hpp"
 #include "axon/fps/host/focal_plane_array.hpp"
@@ -333,6 +334,27 @@ FirmwareOutcome outcome_of(const host::PlaneUpgradeReport& r) {
 }
 
 }  // namespace
+
+LayoutCheck Client::check_layout() {
+  impl_->open_array();
+  auto* fpa = impl_->plane_array.get();
+  if (!fpa) throw Exception(Error(host::HostErrc::invalid_argument, "check_layout needs a layout: open(plane)"));
+  return impl_->run([fpa]() -> asio::awaitable<LayoutCheck> { co_return co_await fpa->check_layout(); });
+}
+
+ColdOutcome Client::apply_cold_policy() {
+  impl_->open_array();
+  auto* fpa = impl_->plane_array.get();
+  if (!fpa) throw Exception(Error(host::HostErrc::invalid_argument, "apply_cold_policy needs a layout: open(plane)"));
+  const auto r = impl_->run([fpa]() -> asio::awaitable<host::ColdApplyReport> {
+    host::ColdControl cold(*fpa);
+    auto step = co_await cold.step(true);
+    co_return need(std::move(step));
+  });
+  const auto& d = r.decision;
+  return {d.settings.motor_rpm, d.settings.alpha_holding_pct, d.settings.beta_holding_pct, d.coldest_c, d.coldest_sensor,
+          r.applied, r.failed, r.to_text()};
+}
 
 FirmwareOutcome Client::upgrade_firmware(const std::vector<std::uint8_t>& image, const UpgradeSettings& settings,
                                         const std::function<void(const SextantUpgrade&)>& progress) {

@@ -28,6 +28,7 @@
 
 #include "axon/fps/host/troubleshoot_types.hpp"
 #include "axon/fps/layout/focal_plane.hpp"
+#include "axon/fps/layout/layout_check.hpp"
 
 #include <cstdint>
 #include <functional>
@@ -214,6 +215,18 @@ struct FirmwareOutcome {
   std::string summary;  // one line per sextant, then one per robot that is not plainly ok
 };
 
+// What apply_cold_policy() decided from the PLC's temperatures and sent (docs/fps-plc.md).
+struct ColdOutcome {
+  std::uint32_t motor_rpm = 0;        // the speed every robot was given
+  double alpha_holding_pct = 0;       // holding currents
+  double beta_holding_pct = 0;
+  std::optional<double> coldest_c;    // the coldest valid reading (nullopt: none)
+  std::string coldest_sensor;
+  std::vector<std::uint16_t> applied;            // robots that took both settings
+  std::map<std::uint16_t, std::string> failed;   // robots that refused or did not answer, and why
+  std::string text;                   // the decision and its reasons, then the robots
+};
+
 class Client {
  public:
   explicit Client(ClientConfig config = {});
@@ -287,6 +300,15 @@ class Client {
   // The hall sensor and motor test of one robot, arm by arm, in open loop without collision
   // detection; closed loop with detection is restored afterwards (HallFinding::restored).
   host::HallTestReport hall_test(std::uint16_t id, const host::HallTestOptions& options = {});
+
+  // GET_ID on every bus of the layout at once, the answers compared with the layout: robots missing,
+  // on the wrong bus, unexpected or answering twice (fps/layout/layout_check.hpp). Needs
+  // open(plane) (HostErrc::invalid_argument).
+  LayoutCheck check_layout();
+  // The cold-temperature policy once (host/cold_control.hpp): the PLC's temperatures decide every
+  // robot's speed and holding currents, which are sent to all of them. Needs open(plane) with
+  // ClientConfig::plc_address (HostErrc::invalid_argument); a PLC that does not answer throws.
+  ColdOutcome apply_cold_policy();
 
   // Firmware of every robot of the layout, sextant by sextant through the PLC (host/plane_upgrade.hpp):
   // each sextant power-cycled into the bootloader, its robots sent the image at once, failures
