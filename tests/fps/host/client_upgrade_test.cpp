@@ -11,7 +11,25 @@
 namespace axon::fps::client_upgrade_test {
 namespace {
 
-ClientConfig quick(const std::string& plc) {
+sim::SimulatedPlaneOptions with_plc(bool plc) {
+  sim::SimulatedPlaneOptions so;
+  so.time_scale = 20;
+  so.plc = plc;
+  return so;
+}
+
+// A simulated benchtop plane (with or without its PLC) and a client open on it, robots discovered.
+struct Rig {
+  explicit Rig(bool plc) : plane("benchtop", with_plc(plc)), fps(quick(plc ? plane.plc_address() : "")) {
+    fps.open(plane.plane());
+    fps.discover();
+  }
+  static ClientConfig quick(const std::string& plc);
+  sim::SimulatedPlane plane;
+  Client fps;
+};
+
+ClientConfig Rig::quick(const std::string& plc) {
   ClientConfig c;
   c.poll_interval_s = 0.02;
   c.discover_window_s = 0.3;
@@ -21,12 +39,9 @@ ClientConfig quick(const std::string& plc) {
 }
 
 TEST(ClientUpgrade, EveryRobotRunsTheNewImageAndProgressIsReported) {
-  sim::SimulatedPlaneOptions so;
-  so.time_scale = 20;
-  sim::SimulatedPlane plane("benchtop", so);
-  Client fps(quick(plane.plc_address()));
-  fps.open(plane.plane());
-  ASSERT_EQ(fps.discover().size(), 6u);
+  Rig rig(true);
+  auto& fps = rig.fps;
+  ASSERT_EQ(fps.robots().size(), 6u);
   const auto image = sim::make_firmware_image({4, 2, 0}, 3000).value();
   std::vector<SextantUpgrade> seen;
   UpgradeSettings s;
@@ -51,13 +66,8 @@ TEST(ClientUpgrade, EveryRobotRunsTheNewImageAndProgressIsReported) {
 }
 
 TEST(ClientUpgrade, WithoutAPlcNothingIsSwitchedAndTheCallSaysWhy) {
-  sim::SimulatedPlaneOptions so;
-  so.time_scale = 20;
-  so.plc = false;
-  sim::SimulatedPlane plane("benchtop", so);
-  Client fps(quick(""));
-  fps.open(plane.plane());
-  fps.discover();
+  Rig rig(false);
+  auto& fps = rig.fps;
   const auto image = sim::make_firmware_image({4, 2, 0}, 3000).value();
   try {
     fps.upgrade_firmware(image);
@@ -73,15 +83,11 @@ TEST(ClientUpgrade, WithoutAPlcNothingIsSwitchedAndTheCallSaysWhy) {
 
 // The layout check and the cold policy of a plane with its PLC, from blocking calls.
 TEST(ClientPlc, TheLayoutCheckFindsEveryRobotAndTheColdPolicyReachesEveryRobot) {
-  sim::SimulatedPlaneOptions so;
-  so.time_scale = 20;
-  sim::SimulatedPlane plane("benchtop", so);
-  Client fps(quick(plane.plc_address()));
-  fps.open(plane.plane());
+  Rig rig(true);
+  auto& fps = rig.fps;
   const auto check = fps.check_layout();
   EXPECT_TRUE(check.ok()) << check.to_text();
   EXPECT_EQ(check.matched.size(), 6u) << check.to_text();
-  fps.discover();
   const auto cold = fps.apply_cold_policy();
   EXPECT_EQ(cold.applied.size(), 6u) << cold.text;
   EXPECT_TRUE(cold.failed.empty()) << cold.text;
@@ -91,15 +97,9 @@ TEST(ClientPlc, TheLayoutCheckFindsEveryRobotAndTheColdPolicyReachesEveryRobot) 
 }
 
 TEST(ClientPlc, TheColdPolicyWithoutAPlcIsRefused) {
-  sim::SimulatedPlaneOptions so;
-  so.time_scale = 20;
-  so.plc = false;
-  sim::SimulatedPlane plane("benchtop", so);
-  Client fps(quick(""));
-  fps.open(plane.plane());
-  fps.discover();
+  Rig rig(false);
   try {
-    fps.apply_cold_policy();
+    rig.fps.apply_cold_policy();
     FAIL() << "a cold policy ran without a PLC";
   } catch (const Exception& e) {
     EXPECT_EQ(e.code(), host::HostErrc::invalid_argument) << e.what();
