@@ -177,7 +177,9 @@ int run_plot(const PlanArgs& a) {
 }
 
 asio::awaitable<int> job_goto_all(const PlanArgs& a, host::Array& array) {
-  const auto [plane, model] = load(a);
+  const auto loaded = load(a);
+  const auto& plane = loaded.plane;  // named references, not a structured binding: clang 14 cannot
+  const auto& model = loaded.model;  // capture those in the lambda below
   const auto policy = a.reject ? plan::TargetPolicy::reject : plan::TargetPolicy::park;
   host::PlanAndMoveOptions o;
   o.planner = planner_options(a);

@@ -192,7 +192,11 @@ asio::awaitable<Result<double>> sampled_move(Positioner& p, Arm arm, double step
   }
   auto idle = co_await p.wait_until_idle(timeout);
   if (!idle) {
-    if (idle.error() != HostErrc::collision) co_await p.abort();  // never leave it moving unwatched
+    if (idle.error() != HostErrc::collision) {  // never leave it moving unwatched
+      if (auto aborted = co_await p.abort(); !aborted)
+        co_return Error(idle.error().code,
+                        idle.error().detail + "; TRAJECTORY_ABORT was not acknowledged: " + aborted.error().message());
+    }
     co_return idle.error();
   }
   co_return eta_s;
@@ -237,7 +241,8 @@ asio::awaitable<FrictionFinding> measure_arm(Array& array, const plan::Collision
     announced_s += point.eta_s;
     f.points.push_back(point);
   }
-  co_await p.set_speed(o.restore_speed_rpm, o.restore_speed_rpm);
+  if (auto restored = co_await p.set_speed(o.restore_speed_rpm, o.restore_speed_rpm); !restored && f.problem.empty())
+    f.problem = fmt::format("the speed was not set back to {} rpm: {}", o.restore_speed_rpm, restored.error().message());
   if (f.problem.empty()) f.fit = fit_friction(f.points);
   f.move_ratio = announced_s > 0 ? moved_s / announced_s : 0;
   if (!f.problem.empty()) f.advice = "not measured; after a collision, unlock and back the robot off first";
