@@ -87,6 +87,12 @@ TEST(C4gRobotFile, TheManualsTableLimitsAndTheFieldsAreCheckedOnLoad) {
   EXPECT_EQ(refused("arm1OpenAx: [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11]\n", "at most 10 values"), "");
   EXPECT_EQ(refused("period: 2\n", "no open axis"), "");
   EXPECT_EQ(refused("arm1OpenAx: [1]\narm1TxRate: [10]\nperiod: 11\n", "period = 11 ms"), "");
+  // Found by the 30-minute fuzz run: a number too large for its integer field was cast (undefined
+  // behaviour; UBSan stopped the fuzzer). Now every value must fit its field's type.
+  EXPECT_EQ(refused("arm1OpenAx: [999999999999999999999999999999999999999999999991, 2]\narm1TxRate: [10, 10]\n",
+                    "does not fit the field's type (a signed integer)"), "");
+  EXPECT_EQ(refused("arm1OpenAx: [1.5]\narm1TxRate: [10]\n", "1.5 does not fit"), "");
+  EXPECT_EQ(refused("arm1OpenAx: [1]\narm1TxRate: [1e300]\n", "does not fit the field's type (a 32-bit float)"), "");
   const auto missing = load_robot_file("/nonexistent/robot.yaml");
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().detail.find("cannot be opened"), std::string::npos);

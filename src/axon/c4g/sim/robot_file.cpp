@@ -6,6 +6,11 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <type_traits>
+
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -42,6 +47,27 @@ std::size_t listed_axes(const P::InitPacket& init) {
   return n;
 }
 
+// `x` as a packet field of type T: a whole number within T's range for the integer fields, a finite
+// number within float's range for the others; nullopt otherwise (a cast would be undefined).
+template <class T>
+std::optional<T> fits(double x) {
+  if (!std::isfinite(x)) return std::nullopt;
+  if constexpr (std::is_integral_v<T>) {
+    if (x != std::floor(x) || x < static_cast<double>(std::numeric_limits<T>::min()) ||
+        x > static_cast<double>(std::numeric_limits<T>::max()))
+      return std::nullopt;
+  } else if (std::abs(x) > static_cast<double>(std::numeric_limits<T>::max())) {
+    return std::nullopt;
+  }
+  return static_cast<T>(x);
+}
+
+template <class T>
+const char* type_name(const T&) {
+  if constexpr (std::is_integral_v<T>) return std::is_signed_v<T> ? "a signed integer" : "an unsigned integer";
+  return "a 32-bit float";
+}
+
 }  // namespace
 
 Result<P::InitPacket> init_from_yaml(std::string_view yaml, std::string where) {
@@ -59,11 +85,15 @@ Result<P::InitPacket> init_from_yaml(std::string_view yaml, std::string where) {
     AXON_TRY(node, root.child(key));
     if (it == known.end()) return node.error(CoreErrc::invalid_argument, "not a field of the initialization packet");
     AXON_TRY(values, values_of(node, it->second));
+    std::optional<Error> bad;
     P::for_each_field(init, [&](std::string_view name, int index, auto& v) {
-      if (name != key) return;
       const std::size_t i = index < 0 ? 0 : static_cast<std::size_t>(index);
-      if (i < values.size()) v = static_cast<std::decay_t<decltype(v)>>(values[i]);
+      if (name != key || bad || i >= values.size()) return;
+      auto value = fits<std::decay_t<decltype(v)>>(values[i]);
+      if (value) v = *value;
+      else bad = node.error(CoreErrc::invalid_argument, fmt::format("{:g} does not fit the field's type ({})", values[i], type_name(v)));
     });
+    if (bad) return *bad;
   }
   if (!root.has("nAxOpen")) init.open_axes = static_cast<std::int32_t>(listed_axes(init));
   return init;
