@@ -90,8 +90,10 @@ std::optional<FrictionFit> fit_friction(std::span<const FrictionPoint> points) {
 FrictionFinding judge_friction(FrictionFinding m, std::span<const FrictionRecord> history, const FrictionOptions& o) {
   if (!m.fit) {
     m.verdict = FrictionVerdict::failed;
-    if (m.problem.empty()) m.problem = "fewer than two speeds gave readings during the test moves";
-    if (m.advice.empty()) m.advice = "use a larger --step or lower speeds";
+    if (m.problem.empty()) {
+      m.problem = "fewer than two speeds gave readings during the test moves";
+      m.advice = "use a larger step or lower speeds";
+    }
     return m;
   }
   for (const auto& r : history)
@@ -245,7 +247,8 @@ asio::awaitable<FrictionFinding> measure_arm(Array& array, const plan::Collision
     f.problem = fmt::format("the speed was not set back to {} rpm: {}", o.restore_speed_rpm, restored.error().message());
   if (f.problem.empty()) f.fit = fit_friction(f.points);
   f.move_ratio = announced_s > 0 ? moved_s / announced_s : 0;
-  if (!f.problem.empty()) f.advice = "not measured; after a collision, unlock and back the robot off first";
+  if (!f.problem.empty() && array.locked())
+    f.advice = "not measured: the array locked; after a collision, unlock and back the robot off (backoff) first";
   co_return f;
 }
 
