@@ -107,10 +107,11 @@ Result<void> read_arm_faults(const core::ConfigNode& node, Scenario& s) {
       AXON_TRY(item.reject_unknown({"id", "arm", "fault"}));
       AXON_TRY(id, item.get_in<std::uint16_t>("id", 1, 2047));
       AXON_TRY(arm, arm_of(item));
-      AXON_TRY(fault, item.get<std::string>("fault"));
-      if (fault != "stuck" && fault != "dead")
-        return item.error(CoreErrc::config_bad_value, fmt::format("hall fault '{}': use stuck or dead", fault));
-      s.hall.push_back({id, arm, fault == "stuck" ? HallFault::stuck : HallFault::motor_dead});
+      AXON_TRY(name, item.get<std::string>("fault"));
+      const auto fault = hall_fault_from(name);
+      if (!fault || *fault == HallFault::none)
+        return item.error(CoreErrc::config_bad_value, fmt::format("hall fault '{}': use stuck or dead", name));
+      s.hall.push_back({id, arm, *fault});
     }
   }
   return ok();
@@ -283,16 +284,12 @@ Result<std::unique_ptr<FocalPlaneSimulator>> FocalPlaneSimulator::start(asio::an
   Impl& s = *impl;
   const auto& o = s.options;
   const auto& sc = o.scenario;
-  for (const auto* set : {&sc.datum_lost, &sc.uncalibrated, &sc.collided, &sc.bootloader, &sc.absent, &sc.collide_on_move}) {
-    for (auto id : *set) {
-      if (plane.find(id) == nullptr && !sc.extra.contains(id))
-        return Error(CoreErrc::invalid_argument, fmt::format("scenario: robot {} is not in layout '{}'", id, plane.name()));
-    }
-  }
-  std::vector<std::uint16_t> faulty;
-  for (const auto& f : sc.friction) faulty.push_back(f.id);
-  for (const auto& f : sc.hall) faulty.push_back(f.id);
-  for (auto id : faulty) {
+  std::vector<std::uint16_t> named;  // every robot the scenario names
+  for (const auto* set : {&sc.datum_lost, &sc.uncalibrated, &sc.collided, &sc.bootloader, &sc.absent, &sc.collide_on_move})
+    named.insert(named.end(), set->begin(), set->end());
+  for (const auto& f : sc.friction) named.push_back(f.id);
+  for (const auto& f : sc.hall) named.push_back(f.id);
+  for (auto id : named) {
     if (plane.find(id) == nullptr && !sc.extra.contains(id))
       return Error(CoreErrc::invalid_argument, fmt::format("scenario: robot {} is not in layout '{}'", id, plane.name()));
   }

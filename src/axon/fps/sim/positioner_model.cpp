@@ -41,6 +41,13 @@ std::string_view to_string(HallFault f) noexcept {
   return "?";
 }
 
+std::optional<HallFault> hall_fault_from(std::string_view name) noexcept {
+  if (name == "dead") return HallFault::motor_dead;
+  for (const HallFault f : {HallFault::none, HallFault::stuck, HallFault::motor_dead})
+    if (name == to_string(f)) return f;
+  return std::nullopt;
+}
+
 PositionerModel::PositionerModel(PositionerConfig config, SimTime now) : config_(std::move(config)), now_(now) {
   if (auto v = config_.validate(); !v) throw Exception(v.error());
   // The flash as the configuration describes it.

@@ -53,6 +53,8 @@ enum class HallFault : std::uint8_t {
   motor_dead,  // the arm does not turn (a loose motor cable, a failed h-bridge); the sensor is fine
 };
 std::string_view to_string(HallFault f) noexcept;
+// "none", "stuck", "motor_dead" or its short form "dead"; nullopt for anything else.
+std::optional<HallFault> hall_fault_from(std::string_view name) noexcept;
 
 enum class Activity : std::uint8_t {
   idle,

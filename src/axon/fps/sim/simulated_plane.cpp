@@ -121,11 +121,9 @@ void SimulatedPlane::set_friction_fault(std::uint16_t id, char arm, int level) {
 void SimulatedPlane::set_hall_fault(std::uint16_t id, char arm, const std::string& fault) {
   auto* impl = impl_.get();
   const Arm a = arm_of(arm);
-  HallFault f = HallFault::none;
-  if (fault == "stuck") f = HallFault::stuck;
-  else if (fault == "dead" || fault == "motor_dead") f = HallFault::motor_dead;
-  else if (fault != "none")
-    throw Exception(Error(CoreErrc::invalid_argument, fmt::format("hall fault '{}': use stuck, dead or none", fault)));
+  const auto parsed = hall_fault_from(fault);
+  if (!parsed) throw Exception(Error(CoreErrc::invalid_argument, fmt::format("hall fault '{}': use stuck, dead or none", fault)));
+  const HallFault f = *parsed;
   impl->loop.call([impl, id, a, f] { impl->sim->simulator().set_hall_fault(id, a, f).value(); });
 }
 
