@@ -2,12 +2,12 @@
 // `axon tell ACTOR COMMAND...`: send one command over the bus and print the replies as they come.
 // Parsing and library calls only: the actor is axon::actor::BusActor + FpsActor, the client
 // axon::actor::tell.
+#include "broker_options.hpp"
 #include "axon/actor/bus_actor.hpp"
 #include "axon/actor/fps_actor.hpp"
 #include "axon/actor/teller.hpp"
 #include "axon/fps/host/client.hpp"
 #include "axon/fps/sim/simulated_plane.hpp"
-#include "axon/net/endpoint.hpp"
 #include "commands.hpp"
 #include "layout_name.hpp"
 #include "run.hpp"
@@ -22,26 +22,6 @@
 namespace axon::app {
 namespace {
 
-// Where the broker is and which exchange: shared by `actor` and `tell`.
-struct BrokerOptions {
-  std::string broker = "127.0.0.1:5672";
-  std::string exchange{actor::kDefaultExchange};
-
-  [[nodiscard]] actor::LinkConfig link() const {
-    const auto ep = need(net::parse_endpoint(broker, 5672));
-    actor::LinkConfig c;
-    c.host = ep.host;
-    c.port = ep.port;
-    c.exchange = exchange;
-    return c;
-  }
-};
-
-void add_broker_options(CLI::App& cmd, BrokerOptions& o) {
-  cmd.add_option("--broker", o.broker, "the AMQP broker, HOST[:PORT] (default 127.0.0.1:5672)");
-  cmd.add_option("--exchange", o.exchange, "the topic exchange (default sdss_exchange, as clu's actors)");
-}
-
 struct ActorFpsOptions {
   BrokerOptions bus;
   std::string name = "fps";
@@ -52,7 +32,7 @@ struct ActorFpsOptions {
   std::uint64_t seed = 1;
   double status_period_s = 10.0;
   std::string friction_history;    // the friction verb's CSV history
-  std::string plc;                 // with --connect: the PLC at HOST[:PORT] (upgrade)
+  std::string plc;                 // real devices: the PLC at HOST[:PORT] (upgrade, power, sync)
   double duration_s = 0;
 };
 
@@ -85,6 +65,7 @@ int run_actor_fps(const ActorFpsOptions& o) {
       actor::FpsActorOptions fo;
       fo.status_period_s = o.status_period_s;
       fo.friction_history = o.friction_history;
+      fo.plc_address = cc.plc_address;
       actor::FpsActor fps_actor(bus.core(), client, fo);
       if (sim) add_simulator_verbs(bus.core(), *sim);
       bus.start();
@@ -163,7 +144,7 @@ void add_actor_commands(CLI::App& app, GlobalOptions& global) {
   f->add_option("--time-scale", fo->time_scale, "simulator: simulated seconds per second (default 10)");
   f->add_option("--seed", fo->seed, "simulator: seed (default 1)");
   f->add_option("--status-period", fo->status_period_s, "seconds between status broadcasts (default 10; 0: none)");
-  f->add_option("--plc", fo->plc, "with --connect: the PLC at HOST[:PORT], which upgrade needs (the simulator has its own)");
+  f->add_option("--plc", fo->plc, "with --connect or --bus: the PLC at HOST[:PORT] for upgrade, plc, power, gateway and sync (the simulator has its own)");
   f->add_option("--friction-history", fo->friction_history,
                  "CSV history the friction verb judges against and appends to (default: none, every arm a baseline)");
   f->add_option("--duration", fo->duration_s, "stop after this many seconds (default: until Ctrl-C)");

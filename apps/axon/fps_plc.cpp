@@ -5,6 +5,7 @@
 #include "axon/core/config.hpp"
 #include "axon/fps/plc/client.hpp"
 #include "axon/fps/plc/cold_policy.hpp"
+#include "axon/fps/plc/plc_json.hpp"
 #include "axon/net/endpoint.hpp"
 #include "run.hpp"
 
@@ -43,10 +44,6 @@ plc::PlcClient client(const PlcArgs& a) {
   return plc::PlcClient(need(net::parse_endpoint(a.host, kModbusPort)), map, o);
 }
 
-json reading_json(const plc::SensorReading& r) {
-  return json{{"name", r.name}, {"value", r.value ? json(*r.value) : json(nullptr)}, {"unit", r.unit}};
-}
-
 bool parse_on_off(const std::string& s) {
   if (s == "on") return true;
   if (s == "off") return false;
@@ -60,12 +57,7 @@ int status(const PlcArgs& a) {
     std::fputs(s.to_text().c_str(), stdout);
     return 0;
   }
-  json j{{"positioner_power", s.positioner_power}, {"gateway_power", s.gateway_power}, {"sync_line", s.sync_line}};
-  j["temperatures"] = json::array();
-  for (const auto& t : s.temperatures) j["temperatures"].push_back(reading_json(t));
-  j["humidity"] = reading_json(s.humidity);
-  j["pressure"] = reading_json(s.pressure);
-  j["coolant_flow"] = reading_json(s.coolant_flow);
+  const json j = plc::to_json(s);
   std::puts(j.dump(2).c_str());
   return 0;
 }

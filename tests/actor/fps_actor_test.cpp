@@ -219,5 +219,66 @@ TEST(FpsActorUpgrade, UpgradeReportsProgressAndEndsWithEveryRobotOnTheNewImage) 
   actor.reset();
 }
 
+// The PLC verbs on the embedded plane's PLC emulator, whose relays act on the simulated robots:
+// power off silences sextant 1's robots (status: none ready), on brings them back; the sync line
+// follows high/low/pulse; wrong arguments fail with the usage; without a PLC every PLC verb fails
+// saying how to give one.
+TEST(FpsActorPlc, PowerGatewayAndSyncActOnThePlcAndArgumentsAreChecked) {
+  fps::sim::SimulatedPlane plane{"benchtop", fps::sim::SimulatedPlaneOptions{20.0, 1, false, true}};
+  fps::Client client;
+  test::Replies out;
+  ActorCore core{"fps", out.sink()};
+  client.open(plane.plane());
+  FpsActorOptions o{0.0, 0.02, 0.2};
+  o.plc_address = plane.plc_address();
+  auto actor = std::make_unique<FpsActor>(core, client, o);
+  int n = 0;
+  auto run = [&](const std::string& text, ActorCore* to = nullptr) {
+    const auto id = fmt::format("c{}", n++);
+    (to ? *to : core).handle(command(text, id));
+    const auto r = out.final_of(id);
+    EXPECT_TRUE(r) << text;
+    return r ? *r : Message{};
+  };
+  auto r = run("plc");
+  ASSERT_EQ(code_of(r), ':') << r.body;
+  EXPECT_EQ(body_of(r)["plc"]["positioner_power"].size(), 6u) << r.body;
+  EXPECT_EQ(body_of(r)["plc"]["positioner_power"][0], true) << r.body;
+  r = run("power 1 off");
+  ASSERT_EQ(code_of(r), ':') << r.body;
+  EXPECT_EQ(body_of(r)["relay"]["name"], "positioner power 1");
+  EXPECT_EQ(body_of(r)["relay"]["on"], false);
+  r = run("status");
+  EXPECT_EQ(body_of(r)["ready"], 0) << r.body;
+  EXPECT_EQ(body_of(run("plc"))["plc"]["positioner_power"][0], false);
+  r = run("power 1 on");
+  ASSERT_EQ(code_of(r), ':') << r.body;
+  EXPECT_EQ(body_of(r)["relay"]["on"], true);
+  r = run("gateway 2 off");
+  EXPECT_EQ(code_of(r), ':') << r.body;
+  EXPECT_EQ(body_of(r)["relay"]["name"], "gateway power 2");
+  EXPECT_EQ(code_of(run("gateway 2 on")), ':');
+  r = run("sync high");
+  EXPECT_EQ(body_of(r)["relay"]["on"], true) << r.body;
+  r = run("sync low");
+  EXPECT_EQ(body_of(r)["relay"]["on"], false) << r.body;
+  r = run("sync pulse 0.05");
+  EXPECT_EQ(code_of(r), ':') << r.body;
+  EXPECT_EQ(body_of(r)["relay"]["on"], false) << r.body;  // low again after the pulse
+  for (const std::string bad : {"power 7 on", "power 1", "power one on", "gateway 1 maybe", "sync", "sync pulse -1",
+                                "sync pulse 60", "sync sideways", "plc now"}) {
+    r = run(bad);
+    EXPECT_EQ(code_of(r), 'f') << bad;
+    EXPECT_TRUE(body_of(r).contains("error")) << bad;
+  }
+  actor.reset();
+
+  ActorCore other{"fps", out.sink()};  // the first actor closed its core
+  FpsActor no_plc(other, client, FpsActorOptions{0.0, 0.02, 0.2});
+  r = run("power 1 off", &other);
+  EXPECT_EQ(code_of(r), 'f');
+  EXPECT_NE(body_of(r)["error"].get<std::string>().find("--plc"), std::string::npos) << r.body;
+}
+
 }  // namespace
 }  // namespace axon::actor

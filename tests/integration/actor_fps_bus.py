@@ -11,177 +11,33 @@ import json
 import os
 import shutil
 import signal
-import socket
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
-import uuid
 
 AXON = sys.argv[1]
-SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-RABBITMQ_SERVER = '/usr/lib/rabbitmq/bin/rabbitmq-server'
-EXCHANGE = 'axon_test_exchange'
 ACTOR = 'fps'
-FINAL = {':', 'f', '!'}
 
 try:
-    import jsonschema
-    import pika
+    import jsonschema  # noqa: F401 (amqp_support needs them; a clear skip without)
+    import pika  # noqa: F401
+    from amqp_support import EXCHANGE, Broker, broker_missing, free_port, validator
+    import amqp_support
 except ImportError as e:
     print('SKIP: python3-pika and python3-jsonschema are needed (%s)' % e)
     sys.exit(0)
 
-with open(os.path.join(SOURCE, 'docs', 'schema', 'fps.json')) as f:
-    SCHEMA = json.load(f)
-VALIDATOR = jsonschema.Draft7Validator(SCHEMA)
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(('127.0.0.1', 0))
-        return s.getsockname()[1]
-
-
-class Broker:
-    """A private rabbitmq-server on loopback."""
-
-    def __init__(self, tmp):
-        self.tmp = tmp
-        self.port, self.dist_port, self.epmd_port = free_port(), free_port(), free_port()
-        with open(os.path.join(tmp, 'enabled_plugins'), 'w') as f:
-            f.write('[].\n')
-        self.env = dict(os.environ, HOME=tmp, RABBITMQ_NODENAME='axon%d@localhost' % os.getpid(),
-                        RABBITMQ_NODE_IP_ADDRESS='127.0.0.1', RABBITMQ_NODE_PORT=str(self.port),
-                        RABBITMQ_DIST_PORT=str(self.dist_port), ERL_EPMD_PORT=str(self.epmd_port),
-                        ERL_EPMD_ADDRESS='127.0.0.1',
-                        RABBITMQ_MNESIA_BASE=os.path.join(tmp, 'mnesia'), RABBITMQ_LOG_BASE=os.path.join(tmp, 'log'),
-                        RABBITMQ_ENABLED_PLUGINS_FILE=os.path.join(tmp, 'enabled_plugins'),
-                        RABBITMQ_CONFIG_FILE=os.path.join(tmp, 'rabbitmq'),
-                        RABBITMQ_PID_FILE=os.path.join(tmp, 'rabbitmq.pid'),
-                        # Schedulers that sleep instead of spinning: the machine's other tests keep their CPU.
-                        RABBITMQ_SERVER_ADDITIONAL_ERL_ARGS='+sbwt none +sbwtdcpu none +sbwtdio none')
-        self.proc = None
-
-    def start(self, limit_s=120):
-        t0 = time.monotonic()
-        out = open(os.path.join(self.tmp, 'server.out'), 'a')
-        self.proc = subprocess.Popen([RABBITMQ_SERVER], env=self.env, stdout=out, stderr=subprocess.STDOUT,
-                                     start_new_session=True, cwd=self.tmp)
-        while time.monotonic() - t0 < limit_s:
-            if self.proc.poll() is not None:
-                return None
-            try:
-                pika.BlockingConnection(pika.ConnectionParameters('127.0.0.1', self.port, connection_attempts=1,
-                                                                  socket_timeout=1)).close()
-                return time.monotonic() - t0
-            except pika.exceptions.AMQPError:
-                time.sleep(0.2)
-        raise AssertionError('the broker did not answer within %d s (log in %s)' % (limit_s, self.tmp))
-
-    def stop(self):
-        if self.proc is None or self.proc.poll() is not None:
-            return
-        os.killpg(self.proc.pid, signal.SIGTERM)
-        try:
-            self.proc.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            os.killpg(self.proc.pid, signal.SIGKILL)
-            self.proc.wait()
-
-    def stop_epmd(self):
-        subprocess.run(['epmd', '-port', str(self.epmd_port), '-kill'], env=self.env, capture_output=True, timeout=10)
-
-
-class Commander:
-    """A client of the convention: commands to command.<actor>, replies on reply.<commander_id>,
-    broadcasts on reply.broadcast."""
-
-    def __init__(self, port):
-        self.commander = 'pytest.%s' % uuid.uuid4().hex[:8]
-        self.conn = pika.BlockingConnection(pika.ConnectionParameters('127.0.0.1', port))
-        self.ch = self.conn.channel()
-        self.ch.exchange_declare(EXCHANGE, exchange_type='topic', auto_delete=True)
-        self.queue = self.ch.queue_declare('', exclusive=True).method.queue
-        for key in ('reply.%s' % self.commander, 'reply.broadcast'):
-            self.ch.queue_bind(self.queue, EXCHANGE, routing_key=key)
-        self.replies = {}    # command id -> [(code, keywords)]
-        self.broadcasts = []  # (code, keywords)
-        self.checked = 0
-        self.ch.basic_consume(self.queue, lambda ch, method, props, body: self.take(props, body, method.routing_key),
-                              auto_ack=True)
-
-    def send(self, text=None, body=None):
-        command_id = uuid.uuid4().hex
-        body = json.dumps({'command_string': text}).encode() if body is None else body
-        props = pika.BasicProperties(headers={'commander_id': self.commander, 'command_id': command_id},
-                                     correlation_id=command_id, content_type='text/json', reply_to=self.queue)
-        self.ch.basic_publish(EXCHANGE, 'command.%s' % ACTOR, body, props)
-        self.replies[command_id] = []
-        return command_id
-
-    def take(self, props, body, key):
-        h = props.headers or {}
-        code = h.get('message_code')
-        assert code in ('>', ':', 'f', 'e', '!', 'i', 'w', 'd'), h
-        assert h.get('sender') == ACTOR, h
-        assert props.content_type == 'text/json', props.content_type
-        keywords = json.loads(body)
-        errors = sorted(VALIDATOR.iter_errors(keywords), key=str)
-        assert not errors, 'reply not valid against docs/schema/fps.json: %s\n%s' % (errors[0].message, body[:500])
-        self.checked += 1
-        if key == 'reply.broadcast':
-            self.broadcasts.append((code, keywords))
-            return
-        assert key == 'reply.%s' % self.commander, key
-        assert props.correlation_id == h.get('command_id'), (props.correlation_id, h)
-        self.replies.setdefault(h.get('command_id'), []).append((code, keywords))
-
-    def pump(self, until, timeout):
-        end = time.monotonic() + timeout
-        while not until() and time.monotonic() < end:
-            self.conn.process_data_events(time_limit=min(0.05, max(0.0, end - time.monotonic())))
-        return until()
-
-    def done(self, command_id):
-        r = self.replies.get(command_id, [])
-        return bool(r) and r[-1][0] in FINAL
-
-    def wait(self, command_id, timeout=30):
-        assert self.pump(lambda: self.done(command_id), timeout), ('no final reply', self.replies.get(command_id))
-        return self.replies[command_id]
-
-    def command(self, text=None, body=None, timeout=30):
-        return self.wait(self.send(text, body), timeout)
-
-    def close(self):
-        try:
-            self.conn.close()
-        except pika.exceptions.AMQPError:
-            pass
+VALIDATOR = validator(ACTOR)
 
 
 def wait_for_actor(port, timeout):
-    """Pings until the actor answers (its queue may not exist yet, or the broker just came back)."""
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        try:
-            c = Commander(port)
-        except pika.exceptions.AMQPError:
-            time.sleep(0.2)
-            continue
-        cid = c.send('ping')
-        if c.pump(lambda: c.done(cid), 1.0):
-            return c
-        c.close()
-    raise AssertionError('the actor did not answer ping within %d s' % timeout)
+    return amqp_support.wait_for_actor(port, timeout, ACTOR, VALIDATOR)
 
 
 def tell(port, *words, json_out=False, actor=ACTOR, timeout_s=20):
-    args = [AXON, 'tell', '--broker', '127.0.0.1:%d' % port, '--exchange', EXCHANGE, '--timeout', str(timeout_s)]
-    args += ['--json'] if json_out else []
-    return subprocess.run(args + [actor] + list(words), capture_output=True, text=True, timeout=60)
+    return amqp_support.tell(AXON, port, actor, *words, json_out=json_out, timeout_s=timeout_s)
 
 
 def check_commands(c, port, actor_proc):
@@ -275,6 +131,16 @@ def check_commands(c, port, actor_proc):
     assert r[-1][0] == ':' and r[-1][1]['upgrade_result']['ok'] is True, r
     assert {x['after'] for x in r[-1][1]['upgrade_result']['robots']} == {'04.02.00'}, r
     assert any('upgrade_progress' in kw and kw['upgrade_progress']['finished'] for code, kw in r if code == '>'), r
+    # The PLC of the embedded plane: relays and sensors, a sextant's power off and on, the sync line.
+    r = c.command('plc')
+    assert r[-1][0] == ':' and r[-1][1]['plc']['positioner_power'][0] is True, r
+    r = c.command('power 1 off')
+    assert r[-1][0] == ':' and r[-1][1]['relay'] == {'name': 'positioner power 1', 'on': False}, r
+    r = c.command('power 1 on')
+    assert r[-1][0] == ':' and r[-1][1]['relay']['on'] is True, r
+    r = c.command('sync pulse 0.1')
+    assert r[-1][0] == ':' and r[-1][1]['relay'] == {'name': 'sync line', 'on': False}, r
+    assert c.command('power 9 on')[-1][0] == 'f'
     assert any('robots' in kw for _, kw in c.broadcasts), 'no periodic status broadcast'
 
 
@@ -331,8 +197,8 @@ def round_trip_ms(c, text, n=100):
 
 
 def main():
-    if not os.path.exists(RABBITMQ_SERVER) or shutil.which('epmd') is None:
-        print('SKIP: rabbitmq-server is not installed (scripts/install-deps.sh installs it)')
+    if broker_missing():
+        print('SKIP: ' + broker_missing())
         return 0
     tmp = tempfile.mkdtemp(prefix='axon-actor-')
     broker = Broker(tmp)

@@ -2,6 +2,9 @@
 
 #include "axon/fps/host/troubleshoot_json.hpp"
 #include "axon/fps/layout/layout_check_json.hpp"
+#include "axon/fps/plc/client.hpp"
+#include "axon/fps/plc/plc_json.hpp"
+#include "axon/net/endpoint.hpp"
 
 #include "axon/core/error.hpp"
 #include "axon/fps/host/client.hpp"
@@ -100,6 +103,14 @@ json back_off_json(const fps::BackOffOutcome& out) {
   return {{"ok", out.ok}, {"contacts_before", out.contacts_before}, {"moves", moves}, {"contacts_after", out.contacts_after}};
 }
 
+// `SEXTANT on|off` of the power verbs.
+std::pair<int, bool> sextant_and_state(const std::vector<std::string>& args, std::string_view verb) {
+  const auto n = args.size() == 2 ? number(args[0]) : std::nullopt;
+  if (!n || (*n != 1 && *n != 2 && *n != 3 && *n != 4 && *n != 5 && *n != 6) || (args[1] != "on" && args[1] != "off"))
+    throw Exception(Error(CoreErrc::invalid_argument, fmt::format("{} takes SEXTANT (1..6) and on or off", verb)));
+  return {static_cast<int>(*n), args[1] == "on"};
+}
+
 }  // namespace
 
 struct FpsActor::Impl {
@@ -118,6 +129,9 @@ struct FpsActor::Impl {
   std::optional<Move> move;
   bool was_locked = false;
   std::string lock_reason;
+
+  std::mutex plc_mutex;  // one PLC call at a time (libmodbus contexts are not thread-safe)
+  std::unique_ptr<fps::plc::PlcClient> plc;
 
   std::mutex wake_mutex;
   std::condition_variable wake;
@@ -347,6 +361,59 @@ struct FpsActor::Impl {
               {"locked_by", client.lock_reason()}});
   }
 
+  // ---- the PLC: power and the sync line (docs/fps-plc.md) ----
+
+  // The PLC client, connected on first use; plc_mutex held.
+  fps::plc::PlcClient& plc_client() {
+    if (options.plc_address.empty())
+      throw Exception(Error(CoreErrc::invalid_argument, "no PLC: start the actor with --plc HOST[:PORT]"));
+    if (!plc) plc = std::make_unique<fps::plc::PlcClient>(value_or_throw(net::parse_endpoint(options.plc_address, 502)));
+    return *plc;
+  }
+
+  void plc_status(Command& c) {
+    if (!c.args().empty()) throw Exception(Error(CoreErrc::invalid_argument, "plc takes no argument"));
+    std::lock_guard lock(plc_mutex);
+    c.finish({{"plc", fps::plc::to_json(value_or_throw(plc_client().status()))}});
+  }
+
+  // Sets a relay and reads it back: `relay` {name, on}; 'f' when the PLC shows another state.
+  void set_relay(Command& c, const fps::plc::Relay& r, bool on) {
+    std::lock_guard lock(plc_mutex);
+    auto& p = plc_client();
+    value_or_throw(p.set_relay(r, on));
+    const bool now = value_or_throw(p.relay(r));
+    json kw{{"relay", {{"name", r.to_string()}, {"on", now}}}};
+    if (now == on) c.finish(std::move(kw));
+    else c.fail(fmt::format("{} reads {} after it was set {}", r.to_string(), now ? "on" : "off", on ? "on" : "off"), std::move(kw));
+  }
+
+  // power|gateway SEXTANT on|off. Off is taken at any time (cutting power stops the robots); on is
+  // refused while a command that drives the robots runs.
+  void power(Command& c, fps::plc::RelayKind kind) {
+    const auto [sextant, on] = sextant_and_state(c.args(), c.verb());
+    const auto busy = core.busy_with();
+    if (on && !busy.empty())
+      throw Exception(Error(CoreErrc::invalid_argument, fmt::format("{} on refused: {:?} is running", c.verb(), busy)));
+    set_relay(c, {kind, sextant}, on);
+  }
+
+  // sync pulse [HOLD_S] | high | low: the line that starts loaded trajectories on every robot.
+  void sync(Command& c) {
+    const auto& args = c.args();
+    const bool pulse = !args.empty() && args[0] == "pulse";
+    const auto hold = pulse && args.size() == 2 ? number(args[1]) : std::optional<double>(0.5);
+    const bool level = args.size() == 1 && (args[0] == "high" || args[0] == "low");
+    if (!(level || (pulse && args.size() <= 2 && hold && *hold > 0 && *hold <= 10)))
+      throw Exception(Error(CoreErrc::invalid_argument, "sync takes pulse [HOLD_S, 0..10], high or low"));
+    const fps::plc::Relay line{fps::plc::RelayKind::sync_line, 0};
+    if (level) return set_relay(c, line, args[0] == "high");
+    std::lock_guard lock(plc_mutex);
+    auto& p = plc_client();
+    value_or_throw(p.pulse_sync_line(std::chrono::duration_cast<core::Duration>(std::chrono::duration<double>(*hold))));
+    c.finish({{"relay", {{"name", line.to_string()}, {"on", value_or_throw(p.relay(line))}}}});
+  }
+
   // ---- the watcher's thread ----
 
   void check_lock() {
@@ -424,6 +491,12 @@ FpsActor::FpsActor(ActorCore& core, fps::Client& client, FpsActorOptions options
             [i](Command& c) { i->friction(c); }});
   core.add({"halltest", "halltest ID [alpha|beta] (hall sensor and motor test, 9.4.3)", true,
             [i](Command& c) { i->hall_test(c); }});
+  core.add({"plc", "plc (relays and sensors of the PLC)", false, [i](Command& c) { i->plc_status(c); }});
+  core.add({"power", "power SEXTANT on|off (the positioners' 24 V; off at any time)", false,
+            [i](Command& c) { i->power(c, fps::plc::RelayKind::positioner_power); }});
+  core.add({"gateway", "gateway SEXTANT on|off (the sextant's Ethernet-CAN gateway)", false,
+            [i](Command& c) { i->power(c, fps::plc::RelayKind::gateway_power); }});
+  core.add({"sync", "sync pulse [HOLD_S] | high | low (the sync line)", true, [i](Command& c) { i->sync(c); }});
   impl_->watcher = std::thread([i] { i->watch(); });
 }
 

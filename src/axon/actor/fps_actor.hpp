@@ -14,13 +14,17 @@
 //   upgrade FILE [XX.YY.ZZ]      firmware of every robot through the PLC (fps::Client::upgrade_firmware)
 //   friction [ID ...]            the friction trend (fps::Client::friction_survey, 9.4.2)
 //   halltest ID [alpha|beta]     the hall sensor and motor test (fps::Client::hall_test, 9.4.3)
+//   plc                          the PLC's relays and sensors (FpsActorOptions::plc_address)
+//   power|gateway SEXTANT on|off a sextant's positioner power or gateway power (off: at any time)
+//   sync pulse [HOLD_S]|high|low the sync line that starts loaded trajectories
 //
 // and writes unsolicited keywords to every listener: `locked`/`locked_by` and a `collision_alert`
 // when the array locks (checked every FpsActorOptions::watch_period_s, 20 ms by default, on a
 // thread of its own), the status every status_period_s, and `move_progress` to the commander of a
 // running move every progress_period_s.
 //
-// goto, plan, discover, check, cold, unlock, backoff, upgrade, friction and halltest are exclusive: a second one while one runs is refused. The client is called by
+// goto, plan, discover, check, cold, unlock, backoff, upgrade, friction, halltest and sync are exclusive:
+// a second one while one runs is refused (and power or gateway on while one runs). The client is called by
 // one command at a time; a status asked during a move answers from the status read before it
 // (keyword `stale`), with the move's progress. The collision safety stays the client's own
 // (fps::Client: any collision report locks the array and aborts every robot), bus or no bus.
@@ -46,6 +50,7 @@ struct FpsActorOptions {
   double watch_period_s = 0.02;    // how often the lock is checked
   double progress_period_s = 1.0;  // move_progress while a goto runs
   std::string friction_history{};  // friction's CSV history ("": none, every arm a baseline)
+  std::string plc_address{};       // the PLC at HOST[:PORT] for plc, power, gateway, sync ("": none)
 };
 
 class FpsActor {

@@ -1,0 +1,182 @@
+"""What the actor tests over a real broker share (not a test: the glob of tests/integration skips
+files named *_support.py): a private rabbitmq-server on loopback (own node name, ports, data
+directory and epmd, schedulers that sleep), and a commander written from the SDSS actor convention
+(docs/actor.md) with Debian's python3-pika, not from axon's code. Every reply a commander takes is
+checked against the actor's JSON schema (docs/schema/<actor>.json)."""
+import json
+import os
+import signal
+import socket
+import subprocess
+import time
+import uuid
+
+import pika
+
+SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+RABBITMQ_SERVER = '/usr/lib/rabbitmq/bin/rabbitmq-server'
+EXCHANGE = 'axon_test_exchange'
+FINAL = {':', 'f', '!'}
+
+
+def validator(actor):
+    """The JSON-schema validator of an actor's keywords (docs/schema/<actor>.json)."""
+    import jsonschema
+    with open(os.path.join(SOURCE, 'docs', 'schema', '%s.json' % actor)) as f:
+        return jsonschema.Draft7Validator(json.load(f))
+
+
+def broker_missing():
+    """Why no broker can run here, or None."""
+    import shutil
+    if not os.path.exists(RABBITMQ_SERVER) or shutil.which('epmd') is None:
+        return 'rabbitmq-server is not installed (scripts/install-deps.sh installs it)'
+    return None
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(('127.0.0.1', 0))
+        return s.getsockname()[1]
+
+
+class Broker:
+    """A private rabbitmq-server on loopback."""
+
+    def __init__(self, tmp):
+        self.tmp = tmp
+        self.port, self.dist_port, self.epmd_port = free_port(), free_port(), free_port()
+        with open(os.path.join(tmp, 'enabled_plugins'), 'w') as f:
+            f.write('[].\n')
+        self.env = dict(os.environ, HOME=tmp, RABBITMQ_NODENAME='axon%d@localhost' % os.getpid(),
+                        RABBITMQ_NODE_IP_ADDRESS='127.0.0.1', RABBITMQ_NODE_PORT=str(self.port),
+                        RABBITMQ_DIST_PORT=str(self.dist_port), ERL_EPMD_PORT=str(self.epmd_port),
+                        ERL_EPMD_ADDRESS='127.0.0.1',
+                        RABBITMQ_MNESIA_BASE=os.path.join(tmp, 'mnesia'), RABBITMQ_LOG_BASE=os.path.join(tmp, 'log'),
+                        RABBITMQ_ENABLED_PLUGINS_FILE=os.path.join(tmp, 'enabled_plugins'),
+                        RABBITMQ_CONFIG_FILE=os.path.join(tmp, 'rabbitmq'),
+                        RABBITMQ_PID_FILE=os.path.join(tmp, 'rabbitmq.pid'),
+                        # Schedulers that sleep instead of spinning: the machine's other tests keep their CPU.
+                        RABBITMQ_SERVER_ADDITIONAL_ERL_ARGS='+sbwt none +sbwtdcpu none +sbwtdio none')
+        self.proc = None
+
+    def start(self, limit_s=120):
+        t0 = time.monotonic()
+        out = open(os.path.join(self.tmp, 'server.out'), 'a')
+        self.proc = subprocess.Popen([RABBITMQ_SERVER], env=self.env, stdout=out, stderr=subprocess.STDOUT,
+                                     start_new_session=True, cwd=self.tmp)
+        while time.monotonic() - t0 < limit_s:
+            if self.proc.poll() is not None:
+                return None
+            try:
+                pika.BlockingConnection(pika.ConnectionParameters('127.0.0.1', self.port, connection_attempts=1,
+                                                                  socket_timeout=1)).close()
+                return time.monotonic() - t0
+            except pika.exceptions.AMQPError:
+                time.sleep(0.2)
+        raise AssertionError('the broker did not answer within %d s (log in %s)' % (limit_s, self.tmp))
+
+    def stop(self):
+        if self.proc is None or self.proc.poll() is not None:
+            return
+        os.killpg(self.proc.pid, signal.SIGTERM)
+        try:
+            self.proc.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            os.killpg(self.proc.pid, signal.SIGKILL)
+            self.proc.wait()
+
+    def stop_epmd(self):
+        subprocess.run(['epmd', '-port', str(self.epmd_port), '-kill'], env=self.env, capture_output=True, timeout=10)
+
+
+class Commander:
+    """A client of the convention: commands to command.<actor>, replies on reply.<commander_id>,
+    broadcasts on reply.broadcast."""
+
+    def __init__(self, port, actor, validator, exchange=EXCHANGE):
+        """validator: the actor's schema validator (validator(actor)), or None to take replies unchecked."""
+        self.actor, self.validator, self.exchange = actor, validator, exchange
+        self.commander = 'pytest.%s' % uuid.uuid4().hex[:8]
+        self.conn = pika.BlockingConnection(pika.ConnectionParameters('127.0.0.1', port))
+        self.ch = self.conn.channel()
+        self.ch.exchange_declare(self.exchange, exchange_type='topic', auto_delete=True)
+        self.queue = self.ch.queue_declare('', exclusive=True).method.queue
+        for key in ('reply.%s' % self.commander, 'reply.broadcast'):
+            self.ch.queue_bind(self.queue, self.exchange, routing_key=key)
+        self.replies = {}    # command id -> [(code, keywords)]
+        self.broadcasts = []  # (code, keywords)
+        self.checked = 0
+        self.ch.basic_consume(self.queue, lambda ch, method, props, body: self.take(props, body, method.routing_key),
+                              auto_ack=True)
+
+    def send(self, text=None, body=None):
+        command_id = uuid.uuid4().hex
+        body = json.dumps({'command_string': text}).encode() if body is None else body
+        props = pika.BasicProperties(headers={'commander_id': self.commander, 'command_id': command_id},
+                                     correlation_id=command_id, content_type='text/json', reply_to=self.queue)
+        self.ch.basic_publish(self.exchange, 'command.%s' % self.actor, body, props)
+        self.replies[command_id] = []
+        return command_id
+
+    def take(self, props, body, key):
+        h = props.headers or {}
+        code = h.get('message_code')
+        assert code in ('>', ':', 'f', 'e', '!', 'i', 'w', 'd'), h
+        assert h.get('sender') == self.actor, h
+        assert props.content_type == 'text/json', props.content_type
+        keywords = json.loads(body)
+        errors = sorted(self.validator.iter_errors(keywords), key=str) if self.validator else []
+        assert not errors, 'reply not valid against docs/schema/%s.json: %s\n%s' % (self.actor, errors[0].message, body[:500])
+        self.checked += 1
+        if key == 'reply.broadcast':
+            self.broadcasts.append((code, keywords))
+            return
+        assert key == 'reply.%s' % self.commander, key
+        assert props.correlation_id == h.get('command_id'), (props.correlation_id, h)
+        self.replies.setdefault(h.get('command_id'), []).append((code, keywords))
+
+    def pump(self, until, timeout):
+        end = time.monotonic() + timeout
+        while not until() and time.monotonic() < end:
+            self.conn.process_data_events(time_limit=min(0.05, max(0.0, end - time.monotonic())))
+        return until()
+
+    def done(self, command_id):
+        r = self.replies.get(command_id, [])
+        return bool(r) and r[-1][0] in FINAL
+
+    def wait(self, command_id, timeout=30):
+        assert self.pump(lambda: self.done(command_id), timeout), ('no final reply', self.replies.get(command_id))
+        return self.replies[command_id]
+
+    def command(self, text=None, body=None, timeout=30):
+        return self.wait(self.send(text, body), timeout)
+
+    def close(self):
+        try:
+            self.conn.close()
+        except pika.exceptions.AMQPError:
+            pass
+
+
+def wait_for_actor(port, timeout, actor, validator, exchange=EXCHANGE):
+    """Pings until the actor answers (its queue may not exist yet, or the broker just came back)."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        try:
+            c = Commander(port, actor, validator, exchange)
+        except pika.exceptions.AMQPError:
+            time.sleep(0.2)
+            continue
+        cid = c.send('ping')
+        if c.pump(lambda: c.done(cid), 1.0):
+            return c
+        c.close()
+    raise AssertionError('the actor did not answer ping within %d s' % timeout)
+
+
+def tell(axon, port, actor, *words, json_out=False, timeout_s=20, exchange=EXCHANGE):
+    args = [axon, 'tell', '--broker', '127.0.0.1:%d' % port, '--exchange', exchange, '--timeout', str(timeout_s)]
+    args += ['--json'] if json_out else []
+    return subprocess.run(args + [actor] + list(words), capture_output=True, text=True, timeout=60)
