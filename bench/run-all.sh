@@ -13,6 +13,12 @@ for src in "$here"/*.cpp; do
   out=$("$exe" 2>&1 | tee /dev/stderr)
   summary+=("$(grep '^BENCH ' <<<"$out" | tail -n 1)")
 done
+# The actor over a real broker (needs rabbitmq-server and python3-pika).
+if [ -x /usr/lib/rabbitmq/bin/rabbitmq-server ]; then
+  echo "== actor_roundtrip"
+  out=$(/usr/bin/python3 "$here/actor_roundtrip.py" "$build" 2>&1 | tee /dev/stderr)
+  summary+=("$(grep "^BENCH " <<<"$out" | tail -n 1)")
+fi
 # The Python front end's cost (needs the Python module: AXON_PYTHON=ON, the default with pybind11).
 if [ -d "$build/python/axon" ]; then
   echo "== python_front_end"
