@@ -41,15 +41,20 @@ def free_port():
 
 
 class Broker:
-    """A private rabbitmq-server on loopback."""
+    """A private rabbitmq-server on loopback, or on `host` inside the network namespace `netns`."""
 
-    def __init__(self, tmp):
-        self.tmp = tmp
+    def __init__(self, tmp, host='127.0.0.1', netns=None):
+        self.tmp, self.host = tmp, host
+        self.prefix = ['ip', 'netns', 'exec', netns] if netns else []
         self.port, self.dist_port, self.epmd_port = free_port(), free_port(), free_port()
         with open(os.path.join(tmp, 'enabled_plugins'), 'w') as f:
             f.write('[].\n')
+        # The broker lets the user `guest` in from loopback only; on another address (a network
+        # namespace's) the test's clients come from other hosts.
+        with open(os.path.join(tmp, 'rabbitmq.conf'), 'w') as f:
+            f.write('' if host.startswith('127.') else 'loopback_users.guest = false\n')
         self.env = dict(os.environ, HOME=tmp, RABBITMQ_NODENAME='axon%d@localhost' % os.getpid(),
-                        RABBITMQ_NODE_IP_ADDRESS='127.0.0.1', RABBITMQ_NODE_PORT=str(self.port),
+                        RABBITMQ_NODE_IP_ADDRESS=host, RABBITMQ_NODE_PORT=str(self.port),
                         RABBITMQ_DIST_PORT=str(self.dist_port), ERL_EPMD_PORT=str(self.epmd_port),
                         ERL_EPMD_ADDRESS='127.0.0.1',
                         RABBITMQ_MNESIA_BASE=os.path.join(tmp, 'mnesia'), RABBITMQ_LOG_BASE=os.path.join(tmp, 'log'),
@@ -63,13 +68,13 @@ class Broker:
     def start(self, limit_s=120):
         t0 = time.monotonic()
         out = open(os.path.join(self.tmp, 'server.out'), 'a')
-        self.proc = subprocess.Popen([RABBITMQ_SERVER], env=self.env, stdout=out, stderr=subprocess.STDOUT,
+        self.proc = subprocess.Popen(self.prefix + [RABBITMQ_SERVER], env=self.env, stdout=out, stderr=subprocess.STDOUT,
                                      start_new_session=True, cwd=self.tmp)
         while time.monotonic() - t0 < limit_s:
             if self.proc.poll() is not None:
                 return None
             try:
-                pika.BlockingConnection(pika.ConnectionParameters('127.0.0.1', self.port, connection_attempts=1,
+                pika.BlockingConnection(pika.ConnectionParameters(self.host, self.port, connection_attempts=1,
                                                                   socket_timeout=1)).close()
                 return time.monotonic() - t0
             except pika.exceptions.AMQPError:
@@ -87,18 +92,18 @@ class Broker:
             self.proc.wait()
 
     def stop_epmd(self):
-        subprocess.run(['epmd', '-port', str(self.epmd_port), '-kill'], env=self.env, capture_output=True, timeout=10)
+        subprocess.run(self.prefix + ['epmd', '-port', str(self.epmd_port), '-kill'], env=self.env, capture_output=True, timeout=10)
 
 
 class Commander:
     """A client of the convention: commands to command.<actor>, replies on reply.<commander_id>,
     broadcasts on reply.broadcast."""
 
-    def __init__(self, port, actor, validator, exchange=EXCHANGE):
+    def __init__(self, port, actor, validator, exchange=EXCHANGE, host='127.0.0.1'):
         """validator: the actor's schema validator (validator(actor)), or None to take replies unchecked."""
         self.actor, self.validator, self.exchange = actor, validator, exchange
         self.commander = 'pytest.%s' % uuid.uuid4().hex[:8]
-        self.conn = pika.BlockingConnection(pika.ConnectionParameters('127.0.0.1', port))
+        self.conn = pika.BlockingConnection(pika.ConnectionParameters(host, port))
         self.ch = self.conn.channel()
         self.ch.exchange_declare(self.exchange, exchange_type='topic', auto_delete=True)
         self.queue = self.ch.queue_declare('', exclusive=True).method.queue
@@ -160,12 +165,12 @@ class Commander:
             pass
 
 
-def wait_for_actor(port, timeout, actor, validator, exchange=EXCHANGE):
+def wait_for_actor(port, timeout, actor, validator, exchange=EXCHANGE, host='127.0.0.1'):
     """Pings until the actor answers (its queue may not exist yet, or the broker just came back)."""
     end = time.monotonic() + timeout
     while time.monotonic() < end:
         try:
-            c = Commander(port, actor, validator, exchange)
+            c = Commander(port, actor, validator, exchange, host)
         except pika.exceptions.AMQPError:
             time.sleep(0.2)
             continue
@@ -176,7 +181,7 @@ def wait_for_actor(port, timeout, actor, validator, exchange=EXCHANGE):
     raise AssertionError('the actor did not answer ping within %d s' % timeout)
 
 
-def tell(axon, port, actor, *words, json_out=False, timeout_s=20, exchange=EXCHANGE):
-    args = [axon, 'tell', '--broker', '127.0.0.1:%d' % port, '--exchange', exchange, '--timeout', str(timeout_s)]
+def tell(axon, port, actor, *words, json_out=False, timeout_s=20, exchange=EXCHANGE, host='127.0.0.1', netns=None):
+    args = (['ip', 'netns', 'exec', netns] if netns else []) + [axon, 'tell', '--broker', '%s:%d' % (host, port), '--exchange', exchange, '--timeout', str(timeout_s)]
     args += ['--json'] if json_out else []
     return subprocess.run(args + [actor] + list(words), capture_output=True, text=True, timeout=60)
