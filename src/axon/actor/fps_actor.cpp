@@ -1,5 +1,6 @@
 #include "axon/actor/fps_actor.hpp"
 
+#include "axon/fps/host/client_json.hpp"
 #include "axon/fps/host/troubleshoot_json.hpp"
 #include "axon/fps/layout/layout_check_json.hpp"
 #include "axon/fps/plc/client.hpp"
@@ -30,26 +31,6 @@ using Clock = std::chrono::steady_clock;
 using json = nlohmann::json;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-json robot_json(const fps::RobotStatus& r) {
-  json j{{"id", r.id}, {"bus", r.bus}, {"state", r.state}, {"ready", r.ready}, {"firmware", r.firmware}};
-  j["alpha"] = r.position ? json(r.position->alpha) : json(nullptr);
-  j["beta"] = r.position ? json(r.position->beta) : json(nullptr);
-  if (!r.error.empty()) j["error"] = r.error;
-  return j;
-}
-
-json move_json(const fps::MoveOutcome& out) {
-  json robots = json::array();
-  for (const auto& r : out.robots) {
-    json j{{"id", r.id}, {"ok", r.ok}, {"state", r.state}};
-    j["alpha"] = r.reached ? json(r.reached->alpha) : json(nullptr);
-    j["beta"] = r.reached ? json(r.reached->beta) : json(nullptr);
-    if (!r.detail.empty()) j["detail"] = r.detail;
-    robots.push_back(std::move(j));
-  }
-  return json{{"completed", out.completed}, {"robots", std::move(robots)}};
-}
 
 std::optional<double> number(const std::string& s) {
   double v = 0;
@@ -88,19 +69,6 @@ std::map<std::uint16_t, fps::Angles> parse_targets(const std::vector<std::string
     targets[robot_id(args[i], known, "goto")] = {*alpha, *beta};
   }
   return targets;
-}
-
-json back_off_json(const fps::BackOffOutcome& out) {
-  json moves = json::array();
-  for (const auto& m : out.moves)
-    moves.push_back({{"id", m.id},
-                     {"moved", m.moved},
-                     {"arm", m.arm == 'a' ? "alpha" : m.arm == 'b' ? "beta" : ""},
-                     {"step_deg", m.step_deg},
-                     {"clearance_before_mm", m.clearance_before_mm},
-                     {"clearance_after_mm", m.clearance_after_mm},
-                     {"problem", m.problem}});
-  return {{"ok", out.ok}, {"contacts_before", out.contacts_before}, {"moves", moves}, {"contacts_after", out.contacts_after}};
 }
 
 // `SEXTANT on|off` of the power verbs.
@@ -142,7 +110,7 @@ struct FpsActor::Impl {
 
   void remember(const std::vector<fps::RobotStatus>& rows) {
     json robots = json::array();
-    for (const auto& r : rows) robots.push_back(robot_json(r));
+    for (const auto& r : rows) robots.push_back(fps::to_json(r));
     std::lock_guard lock(state);
     last_robots = std::move(robots);
   }
@@ -195,7 +163,7 @@ struct FpsActor::Impl {
     const auto tracking = start_move(c, targets);
     const auto out = client.goto_absolute(targets);
     remember(client.status());
-    json kw{{"move_result", move_json(out)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
+    json kw{{"move_result", fps::to_json(out)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
     if (out.completed) c.finish(std::move(kw));
     else c.fail(out.summary.empty() ? "not every robot reached its target" : out.summary, std::move(kw));
   }
@@ -230,11 +198,8 @@ struct FpsActor::Impl {
     const auto tracking = start_move(c, targets);
     const auto out = file ? client.plan_and_move(args[0]) : client.plan_and_move(targets);
     remember(client.status());
-    const auto& p = out.plan;
-    json kw{{"plan_result", {{"verified", p.verified}, {"robots", p.robots}, {"not_reached", p.not_reached},
-                             {"move_s", p.move_s}, {"plan_s", p.plan_s}, {"min_clearance_mm", p.min_clearance_mm},
-                             {"notes", p.notes}, {"outside_safe_zone", p.outside_safe_zone}, {"moved", out.moved}}},
-            {"move_result", move_json(out.move)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
+    json kw{{"plan_result", fps::plan_result_json(out)}, {"move_result", fps::to_json(out.move)},
+            {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
     if (!out.moved || out.move.completed) c.finish(std::move(kw));
     else c.fail(out.move.summary.empty() ? "not every robot reached its target" : out.move.summary, std::move(kw));
   }
@@ -264,12 +229,7 @@ struct FpsActor::Impl {
   void cold(Command& c) {
     std::lock_guard lock(device);
     const auto r = client.apply_cold_policy();
-    json failed = json::object();
-    for (const auto& [id, why] : r.failed) failed[std::to_string(id)] = why;
-    json kw{{"cold", {{"motor_rpm", r.motor_rpm}, {"alpha_holding_pct", r.alpha_holding_pct},
-                      {"beta_holding_pct", r.beta_holding_pct},
-                      {"coldest_c", r.coldest_c ? json(*r.coldest_c) : json(nullptr)}, {"coldest_sensor", r.coldest_sensor},
-                      {"applied", r.applied}, {"failed", failed}, {"text", r.text}}}};
+    json kw{{"cold", fps::to_json(r)}};
     if (r.failed.empty()) c.finish(std::move(kw));
     else c.fail(r.text, std::move(kw));
   }
@@ -296,7 +256,7 @@ struct FpsActor::Impl {
     for (const auto& a : c.args()) ids.push_back(robot_id(a, client.robots(), "backoff"));
     const auto out = client.back_off(ids);
     remember(client.status());
-    json kw{{"back_off", back_off_json(out)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
+    json kw{{"back_off", fps::to_json(out)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
     if (out.ok) c.finish(std::move(kw));
     else c.fail(out.summary, std::move(kw));
   }
@@ -338,17 +298,10 @@ struct FpsActor::Impl {
     if (args.size() == 2) s.expected_version = args[1];
     std::lock_guard lock(device);
     const auto out = client.upgrade_firmware(image, s, [&c](const fps::SextantUpgrade& p) {
-      c.write(MessageCode::running, {{"upgrade_progress", {{"sextant", p.sextant}, {"robots", p.robots}, {"done", p.done},
-                                                           {"failed", p.failed}, {"bytes", p.bytes}, {"seconds", p.seconds},
-                                                           {"finished", p.finished}, {"text", p.text}}}});
+      c.write(MessageCode::running, {{"upgrade_progress", fps::to_json(p)}});
     });
     remember(client.status());
-    json robots = json::array();
-    for (const auto& r : out.robots)
-      robots.push_back({{"id", r.id}, {"sextant", r.sextant}, {"outcome", r.outcome}, {"attempts", r.attempts},
-                        {"half_written", r.half_written}, {"before", r.before}, {"after", r.after}, {"reason", r.reason}});
-    json kw{{"upgrade_result", {{"ok", out.ok}, {"robots", robots}}}, {"locked", client.locked()},
-            {"locked_by", client.lock_reason()}};
+    json kw{{"upgrade_result", fps::to_json(out)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
     if (out.ok) c.finish(std::move(kw));
     else c.fail(out.summary, std::move(kw));
   }
