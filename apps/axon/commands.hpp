@@ -30,5 +30,7 @@ void add_blmc_commands(CLI::App& app, GlobalOptions& global);
 void add_fps_plane_commands(CLI::App& app, GlobalOptions& global);
 // `actor fps` and `tell` (apps/axon/actor.cpp).
 void add_actor_commands(CLI::App& app, GlobalOptions& global);
+// `actor blmc`, registered by add_actor_commands under `actor` (apps/axon/actor_blmc.cpp).
+void add_actor_blmc_command(CLI::App& actor_group, GlobalOptions& global);
 
 }  // namespace axon::app

@@ -188,6 +188,9 @@ TEST_F(BlmcActorOnSim, BrokerLossSetsTheIdleActionAndWarnsOnReconnection) {
   const auto lost = body_of(*warning)["broker_lost"];
   EXPECT_EQ(lost["idle_set"], true);
   EXPECT_EQ(lost["action_before"]["motors"][0]["current_a"], 0.3);
+  const auto faults = done("errors")["faults"];
+  ASSERT_FALSE(faults.empty());
+  EXPECT_EQ(faults.back()["source"], "broker");
 }
 
 // A board error during control: the loop's safety stop (zero current, motors off) reaches every

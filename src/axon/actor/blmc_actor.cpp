@@ -181,7 +181,7 @@ struct BlmcActor::Impl {
   };
   struct FaultSeen {
     Clock::time_point at;
-    std::string source;  // safety_stop, board
+    std::string source;  // safety_stop, board, broker
     std::string text;
   };
   static constexpr std::size_t kFaultHistory = 32;
@@ -614,6 +614,8 @@ struct BlmcActor::Impl {
         broker_down = false;
         broker_back_at = Clock::now();
         broker_announce = true;
+        record_fault("broker", fmt::format("the broker connection was lost for {:.1f} s{}", bk::seconds(broker_back_at - broker_lost_at),
+                                           action_at_loss.is_null() ? "" : ": the idle action was set (zero current)"));
       }
     } catch (const std::exception& e) {
       spdlog::error("blmc actor: broker state: {}", e.what());
