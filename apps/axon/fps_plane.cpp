@@ -3,6 +3,7 @@
 // broadcast or by the sync line, firmware upgrade, the cold policy and correction iterations after
 // a measurement of the fibres.
 #include "commands.hpp"
+#include "axon/fps/plan/arm_name.hpp"
 #include "axon/fps/host/back_off.hpp"
 #include "axon/fps/host/focal_plane_array.hpp"
 #include "axon/fps/host/cold_control.hpp"
@@ -359,7 +360,7 @@ asio::awaitable<int> plane_back_off(host::FocalPlaneArray& fpa, const PlaneArgs&
   if (a.json) {
     nlohmann::json moves = nlohmann::json::array();
     for (const auto& s : rep.steps)
-      moves.push_back({{"id", s.id}, {"moved", s.moved}, {"arm", s.plan.arm == 'a' ? "alpha" : s.plan.arm == 'b' ? "beta" : ""},
+      moves.push_back({{"id", s.id}, {"moved", s.moved}, {"arm", fps::arm_name(s.plan.arm)},
                        {"step_deg", s.plan.step_deg}, {"from", {s.plan.from.alpha_deg, s.plan.from.beta_deg}},
                        {"to", {s.plan.to.alpha_deg, s.plan.to.beta_deg}}, {"clearance_before_mm", s.plan.clearance_before_mm},
                        {"clearance_after_mm", s.plan.clearance_after_mm}, {"problem", s.problem}});

@@ -2,6 +2,7 @@
 // (fps::sim::SimulatedPlane). Every blocking call releases the GIL and answers Ctrl-C by
 // interrupting the client (every robot stopped, the array locked), then raising KeyboardInterrupt.
 #include "bindings.hpp"
+#include "axon/fps/plan/arm_name.hpp"
 
 #include "axon/fps/host/client.hpp"
 #include "axon/fps/sim/firmware_marker.hpp"
@@ -113,7 +114,7 @@ void bind_outcomes(py::module_& m) {
       .def_readonly("id", &fps::BackOffMove::id)
       .def_readonly("moved", &fps::BackOffMove::moved)
       .def_property_readonly("arm", [](const fps::BackOffMove& b) {
-        return std::string(b.arm == 'a' ? "alpha" : b.arm == 'b' ? "beta" : "");
+        return std::string(fps::arm_name(b.arm));
       })
       .def_readonly("step_deg", &fps::BackOffMove::step_deg)
       .def_property_readonly("start", [](const fps::BackOffMove& b) { return std::pair{b.from.alpha, b.from.beta}; })
@@ -141,11 +142,9 @@ fps::PlanSettings plan_settings(double speed_deg_s, double buffer_mm, std::uint6
   return {speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial, refuse_outside_safe_zone};
 }
 
-const char* arm_name(char a) { return a == 'a' ? "alpha" : "beta"; }
-
 char arm_letter(const std::string& arm) {
-  if (arm == "alpha" || arm == "a") return 'a';
-  if (arm == "beta" || arm == "b") return 'b';
+  if (const auto a = fps::arm_from_name(arm)) return *a;
+  if (arm == "a" || arm == "b") return arm[0];
   throw Exception(Error(CoreErrc::invalid_argument, fmt::format("arm '{}': use 'alpha' or 'beta'", arm)));
 }
 
@@ -165,7 +164,7 @@ void bind_troubleshoot(py::module_& m) {
       .def("at", &FrictionFit::at, py::arg("rpm"), "The fitted current (percent) at a motor speed.");
   py::class_<FrictionFinding>(m, "FrictionFinding", "One arm's friction trend.")
       .def_readonly("id", &FrictionFinding::id)
-      .def_property_readonly("arm", [](const FrictionFinding& f) { return arm_name(f.arm); })
+      .def_property_readonly("arm", [](const FrictionFinding& f) { return std::string(fps::arm_name(f.arm)); })
       .def_property_readonly("verdict", [](const FrictionFinding& f) { return to_string(f.verdict); },
                              "ok, increased, baseline (the first record) or failed")
       .def_readonly("points", &FrictionFinding::points)
@@ -185,7 +184,7 @@ void bind_troubleshoot(py::module_& m) {
       .def("__bool__", &FrictionReport::ok);
   py::class_<HallFinding>(m, "HallFinding", "One arm's hall sensor and motor test.")
       .def_readonly("id", &HallFinding::id)
-      .def_property_readonly("arm", [](const HallFinding& f) { return arm_name(f.arm); })
+      .def_property_readonly("arm", [](const HallFinding& f) { return std::string(fps::arm_name(f.arm)); })
       .def_property_readonly("verdict", [](const HallFinding& f) { return to_string(f.verdict); },
                              "ok, no_hall_change, inaccurate or failed")
       .def_readonly("step_deg", &HallFinding::step_deg)

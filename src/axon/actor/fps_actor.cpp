@@ -1,4 +1,5 @@
 #include "axon/actor/fps_actor.hpp"
+#include "axon/fps/plan/arm_name.hpp"
 
 #include "axon/fps/host/client_json.hpp"
 #include "axon/fps/host/troubleshoot_json.hpp"
@@ -273,12 +274,13 @@ struct FpsActor::Impl {
 
   void hall_test(Command& c) {
     const auto& args = c.args();
-    if (args.empty() || args.size() > 2 || (args.size() == 2 && args[1] != "alpha" && args[1] != "beta"))
+    const auto arm = args.size() == 2 ? fps::arm_from_name(args[1]) : std::nullopt;
+    if (args.empty() || args.size() > 2 || (args.size() == 2 && !arm))
       throw Exception(Error(CoreErrc::invalid_argument, "halltest takes ID [alpha|beta]"));
     std::lock_guard lock(device);
     fps::host::HallTestOptions o;
-    o.alpha = args.size() == 1 || args[1] == "alpha";
-    o.beta = args.size() == 1 || args[1] == "beta";
+    o.alpha = !arm || *arm == 'a';
+    o.beta = !arm || *arm == 'b';
     const auto report = client.hall_test(robot_id(args[0], client.robots(), "halltest"), o);
     json kw{{"hall_test", fps::host::to_json(report)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
     if (report.ok()) c.finish(std::move(kw));

@@ -1,4 +1,5 @@
 #include "axon/fps/host/back_off.hpp"
+#include "axon/fps/plan/arm_name.hpp"
 
 #include "axon/fps/plan/distance.hpp"
 #include "axon/fps/plan/problems.hpp"
@@ -108,7 +109,7 @@ std::string BackOffReport::summary() const {
     if (s.moved)
       out += fmt::format("robot {}: {} {:+.1f} deg, alpha {:.2f} beta {:.2f} -> alpha {:.2f} beta {:.2f}, nearest body {:.3f} -> "
                          "{:.3f} mm\n",
-                         s.id, s.plan.arm == 'a' ? "alpha" : "beta", s.plan.step_deg, s.plan.from.alpha_deg,
+                         s.id, arm_name(s.plan.arm), s.plan.step_deg, s.plan.from.alpha_deg,
                          s.plan.from.beta_deg, s.plan.to.alpha_deg, s.plan.to.beta_deg, s.plan.clearance_before_mm,
                          s.plan.clearance_after_mm);
     else

@@ -1,4 +1,5 @@
 #include "axon/fps/host/client_json.hpp"
+#include "axon/fps/plan/arm_name.hpp"
 
 namespace axon::fps {
 
@@ -42,7 +43,7 @@ json to_json(const BackOffOutcome& out) {
   for (const auto& m : out.moves)
     moves.push_back({{"id", m.id},
                      {"moved", m.moved},
-                     {"arm", m.arm == 'a' ? "alpha" : m.arm == 'b' ? "beta" : ""},
+                     {"arm", arm_name(m.arm)},
                      {"step_deg", m.step_deg},
                      {"clearance_before_mm", m.clearance_before_mm},
                      {"clearance_after_mm", m.clearance_after_mm},

@@ -1,4 +1,5 @@
 #include "axon/fps/host/troubleshoot.hpp"
+#include "axon/fps/plan/arm_name.hpp"
 
 #include "axon/fps/host/concurrent.hpp"
 #include "axon/fps/host/datum_check.hpp"
@@ -24,7 +25,6 @@ using protocol::CommandId;
 namespace {
 
 char arm_letter(Arm a) noexcept { return a == Arm::alpha ? 'a' : 'b'; }
-const char* arm_word(char a) noexcept { return a == 'a' ? "alpha" : "beta"; }
 
 std::string now_utc() {
   return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", std::chrono::floor<std::chrono::seconds>(std::chrono::system_clock::now()));
@@ -139,7 +139,7 @@ std::vector<FrictionRecord> FrictionReport::records() const {
 std::string FrictionReport::summary() const {
   std::string s;
   for (const auto& f : arms) {
-    s += fmt::format("robot {} {}: {}", f.id, arm_word(f.arm), to_string(f.verdict));
+    s += fmt::format("robot {} {}: {}", f.id, arm_name(f.arm), to_string(f.verdict));
     if (f.fit)
       s += fmt::format(", stiction {:.1f} % + {:.2f} %/krpm (rms {:.2f} %)", f.fit->stiction_percent,
                        f.fit->viscous_percent_per_krpm, f.fit->rms_percent);
@@ -334,7 +334,7 @@ bool HallTestReport::ok() const noexcept {
 std::string HallTestReport::summary() const {
   std::string s;
   for (const auto& f : arms) {
-    s += fmt::format("robot {} {}: {}", f.id, arm_word(f.arm), to_string(f.verdict));
+    s += fmt::format("robot {} {}: {}", f.id, arm_name(f.arm), to_string(f.verdict));
     if (f.verdict != HallVerdict::failed)
       s += fmt::format(" (open-loop move {:+.1f} deg: position {:.3f} -> {:.3f}, hall {:.3f} -> {:.3f}, hall off by {:.3f} deg)",
                        f.step_deg, f.position_before_deg, f.position_after_deg, f.hall_before_deg, f.hall_after_deg,
@@ -473,8 +473,9 @@ Result<std::vector<FrictionRecord>> load_friction_history(const std::string& pat
     } catch (const std::exception&) {
       return bad("not a number");
     }
-    if (cells[2] != "alpha" && cells[2] != "beta") return bad("arm must be alpha or beta");
-    r.arm = cells[2] == "alpha" ? 'a' : 'b';
+    const auto arm = arm_from_name(cells[2]);
+    if (!arm) return bad("arm must be alpha or beta");
+    r.arm = *arm;
     if (r.time_utc.size() != 20 || r.time_utc.back() != 'Z') return bad("time_utc must look like 2026-12-02T03:04:05Z");
     out.push_back(std::move(r));
   }
@@ -487,7 +488,7 @@ Result<void> append_friction_history(const std::string& path, const std::vector<
   if (!out) return Error(CoreErrc::invalid_argument, fmt::format("cannot write {}", path));
   if (fresh) out << kHeader << "\n";
   for (const auto& r : records)
-    out << fmt::format("{},{},{},{:.3f},{:.4f},{:.3f},{:.4f}\n", r.time_utc, r.id, arm_word(r.arm), r.fit.stiction_percent,
+    out << fmt::format("{},{},{},{:.3f},{:.4f},{:.3f},{:.4f}\n", r.time_utc, r.id, arm_name(r.arm), r.fit.stiction_percent,
                        r.fit.viscous_percent_per_krpm, r.fit.rms_percent, r.move_ratio);
   out.flush();
   if (!out) return Error(CoreErrc::invalid_argument, fmt::format("cannot write {}", path));

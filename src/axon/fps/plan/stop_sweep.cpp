@@ -1,4 +1,5 @@
 #include "axon/fps/plan/stop_sweep.hpp"
+#include "axon/fps/plan/arm_name.hpp"
 
 #include <fmt/format.h>
 
@@ -117,7 +118,7 @@ StopSweep check_arm_sweep(const CollisionModel& model, std::size_t i, std::span<
   const bool inside = arm == 'a' ? to_deg >= l.alpha_min_deg && to_deg <= l.alpha_max_deg
                                  : to_deg >= l.beta_min_deg && to_deg <= l.beta_max_deg;
   if (!inside) {
-    out.in_the_way.insert(out.in_the_way.begin(), fmt::format("angle limit ({} {:.1f} deg)", arm == 'a' ? "alpha" : "beta", to_deg));
+    out.in_the_way.insert(out.in_the_way.begin(), fmt::format("angle limit ({} {:.1f} deg)", arm_name(arm), to_deg));
     out.clear = false;
   }
   return out;
