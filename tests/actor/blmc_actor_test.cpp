@@ -222,6 +222,20 @@ TEST_F(BlmcActorOnSim, ABoardFaultIsASafetyStopThatEveryListenerHearsWithItsText
   done("currents 0.1 0");
 }
 
+// home finds each motor's index under its own loop; it needs the motors enabled and no loop running.
+TEST_F(BlmcActorOnSim, HomeFindsBothIndexMarksWhenNoLoopRuns) {
+  EXPECT_NE(failure("home").find("not enabled"), std::string::npos);
+  enable_and_start();
+  EXPECT_NE(failure("home").find("the control loop runs"), std::string::npos);
+  done("stop");
+  EXPECT_NE(failure("home 0").find("not 0"), std::string::npos);
+  const auto kw = done("home 1");
+  EXPECT_EQ(kw["homing"]["all_found"], true) << kw;
+  EXPECT_EQ(kw["homing"]["motors"][1]["state"], "found");
+  EXPECT_TRUE(kw["homing"]["motors"][0]["index_rev"].is_number());
+  EXPECT_EQ(kw["stopped"]["end"], "requested");
+}
+
 TEST_F(BlmcActorOnSim, DisableDuringTheLoopStopsItAndTurnsTheMotorsOff) {
   enable_and_start();
   done("currents 0.2 0.2");

@@ -1,7 +1,7 @@
 """`axon actor blmc` on a real RabbitMQ broker, driven by the independent python3-pika commander of
 amqp_support.py (written from the SDSS actor convention, not from axon's code), with its simulated
 board in the actor's process: status, a current refused while no loop runs, malformed and
-non-JSON commands, enable, start (and a second start refused), currents, current, pd, stop, a board
+non-JSON commands, enable, home, start (and a second start refused), currents, current, pd, stop, a board
 fault whose safety stop a second listener hears with its text, errors and recover, `axon tell blmc`
 (human and --json), then the broker stopped and started again while the loop runs: the actor has set
 the idle action (zero current), says so in errors, and answers again. Every reply is checked
@@ -65,6 +65,8 @@ def check_refusals(c):
 def check_session(c):
     kw = done(c, 'enable')
     assert kw['board']['enabled'] is True and all(m['ready'] for m in kw['board']['motors']), kw['board']
+    kw = done(c, 'home 1')
+    assert kw['homing']['all_found'] is True, kw
     kw = done(c, 'start --max-current 1.5')
     assert kw['loop']['running'] is True and kw['limits']['max_current_a'] == 1.5, kw
     assert 'already runs' in failed(c, 'start')

@@ -142,6 +142,17 @@ json limits_json(const blmc::ControlSettings& s, const blmc::FrontEndOptions& fe
               {"recv_timeout_ms", recv_timeout_ms}};
 }
 
+json homing_json(const blmc::HomingReport& r) {
+  json motors = json::array();
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto& m = r.motors[k];
+    const bool found = m.state == blmc::host::MotorHoming::State::found;
+    motors.push_back({{"motor", k + 1}, {"state", blmc::host::to_string(m.state)}, {"start_rev", m.start_rev},
+                      {"index_rev", found ? json(m.index_rev) : json(nullptr)}});
+  }
+  return json{{"all_found", r.all_found}, {"motors", std::move(motors)}};
+}
+
 json counters_json(const CoreCounters& c) {
   return json{{"received", c.received}, {"accepted", c.accepted}, {"not_json", c.not_json}, {"malformed", c.malformed},
               {"unknown", c.unknown},   {"refused", c.refused},   {"failed", c.failed},
@@ -359,7 +370,7 @@ struct BlmcActor::Impl {
   // Never refused: an enable or recover waiting for the board ends now, then the motors go off.
   void disable(Command& c) {
     const auto busy = core.busy_with();  // (interrupting a running loop would read as its safety stop)
-    if (busy == "enable" || busy == "recover") board.interrupt();
+    if (busy == "enable" || busy == "recover" || busy == "home") board.interrupt();
     std::lock_guard lock(device);
     board.clear_interrupt();
     const auto report = stop_loop_locked();
@@ -383,6 +394,33 @@ struct BlmcActor::Impl {
     json kw = assemble(true);
     kw["text"] = "the board recovered: enabled and ready";
     c.finish(std::move(kw));
+  }
+
+  // home [SPEED_REV_S]: each motor turns slowly until its encoder index (MotorBoard::home, under
+  // the same safety limits); refused while the loop runs.
+  void home(Command& c) {
+    const auto& args = c.args();
+    if (args.size() > 1) bk::bad_argument("home takes [SPEED_REV_S] (the sign gives the direction; default 0.5)");
+    blmc::host::HomingOptions h;
+    if (args.size() == 1) h.speed_rev_s = bk::argument(args[0], "home", "motor rev/s");
+    if (h.speed_rev_s == 0 || std::abs(h.speed_rev_s) > 5) bk::bad_argument("home: the speed must be in [-5, 5] rev/s and not 0");
+    std::lock_guard lock(device);
+    reap_locked();
+    {
+      std::lock_guard s(state);
+      if (running()) bk::bad_argument("home: the control loop runs (stop it first)");
+    }
+    if (!board.enabled()) bk::bad_argument("home: the motors are not enabled (enable first)");
+    const auto t0 = Clock::now();
+    const auto r = board.home(h, options.control);
+    json kw{{"homing", bk::homing_json(r)}, {"stopped", bk::run_report_json(r.control, bk::seconds(Clock::now() - t0))}};
+    if (r.control.fault) {
+      std::lock_guard s(state);
+      record_fault("safety_stop", r.control.fault_text);
+    }
+    publish(read_board_locked());
+    if (r.all_found && !r.control.fault) return c.finish(std::move(kw));
+    c.fail(r.control.fault ? r.control.fault_text : "not every motor found its index", std::move(kw));
   }
 
   // ---- the loop ----
@@ -649,6 +687,8 @@ BlmcActor::BlmcActor(ActorCore& core, blmc::MotorBoard& board, BlmcActorOptions 
   core.add({"pd", "pd P1 P2 [KP KD] (positions in motor rev; gains A/rev, A/(rev/s))", false, [i](Command& c) { i->pd(c); }});
   core.add({"idle", "idle (zero current on both motors; the loop runs on)", false, [i](Command& c) { i->idle(c); }});
   core.add({"errors", "errors (the board's error code, the faults seen)", false, [i](Command& c) { i->errors(c); }});
+  core.add({"home", "home [SPEED_REV_S] (finds each motor's encoder index; no loop may run)", true,
+            [i](Command& c) { i->home(c); }});
   core.add({"recover", "recover (after a board error: the board's recovery, enabled and ready)", true,
             [i](Command& c) { i->recover(c); }});
   {

@@ -13,6 +13,7 @@
 //   current MOTOR A              one motor's current (1 or 2); the other keeps its action
 //   pd P1 P2 [KP KD]             PD to positions P1, P2 (motor rev), gains A/rev and A/(rev/s)
 //   idle                         the idle action (zero current on both motors), the loop runs on
+//   home [SPEED_REV_S]           homing on the encoder index (MotorBoard::home), no loop running
 //   errors                       the board's error code, the faults seen since start-up
 //   recover                      the board's recovery after an error (MotorBoard::recover)
 //
@@ -35,8 +36,9 @@
 // (current clamp, velocity limit, stale data, board errors end the loop with zero current and the
 // motors off), and the board's receive timeout stops it when the host stops sending.
 //
-// enable, start, stop and recover are exclusive (a second one while one runs is refused). disable is
-// never refused: it interrupts an enable or recover in progress and turns the motors off. Setting
+// enable, start, stop, home and recover are exclusive (a second one while one runs is refused).
+// disable is never refused: it interrupts an enable, home or recover in progress and turns the
+// motors off. Setting
 // an action is refused ('f') while no loop runs.
 //
 // The board must be open and outlive the actor. The destructor closes the core (later commands are
