@@ -1,10 +1,14 @@
 // `axon sim blmc`: simulated motor driver boards, one per bus (can0, can1 ...), served over
 // socketcand until Ctrl-C or --duration: the library's SimulatedBoard (blmc/sim/simulated_board.hpp)
-// and a wait.
+// and a wait. --http serves the boards' truth (currents, positions, velocities, status) on the blmc
+// page (docs/dashboard.md), sampled from the simulator's loop at 50 Hz on this thread.
 #include "axon/blmc/sim/board_config.hpp"
 #include "axon/blmc/sim/fault_plan.hpp"
 #include "axon/blmc/sim/simulated_board.hpp"
 #include "axon/core/config.hpp"
+#include "axon/net/endpoint.hpp"
+#include "axon/web/blmc_view.hpp"
+#include "axon/web/server.hpp"
 #include "checks.hpp"
 #include "commands.hpp"
 #include "run.hpp"
@@ -15,6 +19,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 namespace axon::app {
 namespace {
@@ -28,7 +33,70 @@ struct SimBlmcOptions {
   std::string fault_plan;
   double duration_s = 0;
   bool realtime = true;
+  std::string http;  // HOST:PORT of the boards' live page (empty: none)
 };
+
+// ---- --http: the boards' page -------------------------------------------------------------------
+
+constexpr auto kSamplePeriod = std::chrono::milliseconds(20);  // 50 Hz, the page's scope rate
+constexpr unsigned kSamplesPerPublish = 5;                     // 10 updates a second
+
+// What the simulator knows of board i, as a host's measurements would carry it.
+blmc::host::Measurements sampled(const bsim::SimulatedBoardReport& r) {
+  blmc::host::Measurements m;
+  const auto now = core::steady_now();
+  auto stamp = [now](auto& field, auto value) {
+    field.value = value;
+    field.at = now;
+    field.count = 1;
+  };
+  stamp(m.status_byte, r.status_byte);
+  stamp(m.current, blmc::protocol::MotorPair{r.current_a[0], r.current_a[1]});
+  stamp(m.position, blmc::protocol::MotorPair{r.position_rev[0], r.position_rev[1]});
+  stamp(m.velocity, blmc::protocol::MotorPair{r.velocity_krpm[0], r.velocity_krpm[1]});
+  return m;
+}
+
+struct BoardsPage {
+  std::unique_ptr<web::Server> server;
+  std::shared_ptr<web::Source> source;
+  std::unique_ptr<web::BlmcView> view;
+};
+
+BoardsPage open_boards_page(const std::string& address, unsigned boards) {
+  const auto ep = need(net::parse_endpoint(address));
+  web::ServerOptions so;
+  so.address = ep.host;
+  so.port = ep.port;
+  BoardsPage page;
+  web::BlmcViewOptions vo;
+  for (unsigned i = 0; i < boards; ++i) vo.boards.push_back({fmt::format("can{}", i), std::nullopt});
+  vo.sample_hz = 1000.0 / static_cast<double>(kSamplePeriod.count());
+  vo.command = "sim";
+  page.view = std::make_unique<web::BlmcView>(std::move(vo));
+  page.server = std::make_unique<web::Server>(so);
+  page.source = std::make_shared<web::Source>("blmc", fmt::format("blmc: {} simulated board{}", boards, boards == 1 ? "" : "s"), "blmc");
+  page.source->set_info(page.view->info_json());
+  page.view->publish(*page.source, 1);
+  page.server->add(page.source);
+  return page;
+}
+
+// Samples every board until *stop (the simulator, view and source outlive it until then);
+// publishes every kSamplesPerPublish samples.
+asio::awaitable<void> feed_boards_page(const bsim::SimulatedBoard& sim, web::BlmcView& view, web::Source& source,
+                                       std::shared_ptr<const bool> stop) {
+  asio::steady_timer timer(co_await asio::this_coro::executor);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (unsigned tick = 1; !*stop; ++tick) {
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (unsigned i = 0; i < sim.boards(); ++i) view.add_measurements(i, t, sampled(sim.report(i)));
+    if (tick % kSamplesPerPublish == 0) view.publish(source);
+    timer.expires_after(kSamplePeriod);
+    boost::system::error_code ec;
+    co_await timer.async_wait(asio::redirect_error(asio::use_awaitable, ec));
+  }
+}
 
 void log_end(const bsim::SimulatedBoard& sim) {
   for (unsigned i = 0; i < sim.boards(); ++i) {
@@ -56,7 +124,16 @@ int run_sim_blmc(const SimBlmcOptions& o) {
     std::vector<std::string> channels;
     for (unsigned i = 0; i < o.boards; ++i) channels.push_back(fmt::format("can{}", i));
     spdlog::info("sim: {} blmc board{} on {} (Ctrl-C to stop)", o.boards, o.boards == 1 ? "" : "s", fmt::join(channels, ", "));
+    std::optional<BoardsPage> page;
+    auto stop_feeding = std::make_shared<bool>(false);
+    if (!o.http.empty()) {
+      page = open_boards_page(o.http, o.boards);
+      std::printf("listening http %s:%u\n", page->server->address().c_str(), unsigned{page->server->port()});
+      std::fflush(stdout);
+      asio::co_spawn(io, feed_boards_page(sim, *page->view, *page->source, stop_feeding), asio::detached);
+    }
     co_await wait_for_stop(io, o.duration_s, set_on_signal);
+    *stop_feeding = true;
     sim.stop();
     log_end(sim);
     co_return 0;
@@ -74,6 +151,8 @@ void add_sim_blmc_command(CLI::App& sim_cmd, GlobalOptions& global) {
   b->add_option("--fault-plan", o->fault_plan, "fault plan YAML (docs/blmc-simulator.md)");
   b->add_option("--duration", o->duration_s, "stop after this many seconds (default: until Ctrl-C)")->check(non_negative());
   b->add_flag("!--no-realtime", o->realtime, "do not ask for SCHED_FIFO 70 for the boards' 1 kHz loop");
+  b->add_option("--http", o->http, "serve the boards' live page (the simulator's truth), /api/state and /metrics on "
+                                   "HOST:PORT (port 0: any; docs/dashboard.md)");
   b->callback([o, &global] { global.exit_code = run_sim_blmc(*o); });
 }
 

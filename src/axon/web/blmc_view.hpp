@@ -67,7 +67,7 @@ class BlmcView {
   // the jitter histogram's buckets, the sample rate.
   [[nodiscard]] std::string info_json() const;
   // {t_s, command, running, loop: {...} or null, boards: [{name, status, error, tripped, fault,
-  //  limits, samples: {t, i1, i2, p1, p2, v1, v2}}]} (A, motor rev, rev/s).
+  //  limits, samples: {t, i1, i2, p1, p2, v1, v2}}]} (A, motor rev, krpm).
   [[nodiscard]] std::string state_json() const;
   // Prometheus text (metrics_text.hpp): axon_blmc_* (docs/dashboard.md).
   [[nodiscard]] std::string metrics() const;

@@ -110,6 +110,8 @@ SimulatedBoardReport SimulatedBoard::report(unsigned board) const {
     r.status_byte = b.status_byte();
     r.motors = {b.motor_state(0), b.motor_state(1)};
     r.position_rev = {b.motor(0).position_rev(), b.motor(1).position_rev()};
+    r.velocity_krpm = {b.motor(0).velocity_krpm(), b.motor(1).velocity_krpm()};
+    r.current_a = {b.motor(0).current_a(), b.motor(1).current_a()};
     r.stats = b.stats();
     r.bus_load = i->registry->find(i->channels[board])->load(std::chrono::steady_clock::now());
     return r;

@@ -48,7 +48,9 @@ struct SimulatedBoardReport {
   protocol::Status status{};
   std::uint8_t status_byte = 0;        // the status as sent (shows an undocumented error code 6)
   std::array<MotorState, 2> motors{};  // enabled, ready, the last IqRef ...
-  std::array<double, 2> position_rev{};
+  std::array<double, 2> position_rev{};   // as the board reports it (wrapping at the counter's rollover)
+  std::array<double, 2> velocity_krpm{};  // the shafts' velocity
+  std::array<double, 2> current_a{};      // the motors' quadrature current
   BoardStats stats{};
   double bus_load = 0;  // 0..1 over the last second (bus_load option)
 };
