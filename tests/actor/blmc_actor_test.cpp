@@ -245,6 +245,21 @@ TEST_F(BlmcActorOnSim, DisableDuringTheLoopStopsItAndTurnsTheMotorsOff) {
   EXPECT_TRUE(eventually([&] { return board_off(); }));
 }
 
+// disable is the one command that is never refused: sent while an enable waits for the alignment,
+// it interrupts that wait and the motors end off.
+TEST_F(BlmcActorOnSim, DisableIsNeverRefusedAndInterruptsAnEnableInProgress) {
+  core.handle(command("enable", "e"));
+  const auto d = run("disable");
+  EXPECT_EQ(code_of(d), ':') << d.body;
+  const auto e = out.final_of("e");
+  ASSERT_TRUE(e);  // done or interrupted, depending on how far it got: either way it ended
+  if (code_of(*e) == 'f') {
+    EXPECT_NE(body_of(*e)["error"].get<std::string>().find("stopped on request"), std::string::npos) << e->body;
+  }
+  EXPECT_TRUE(eventually([&] { return board_off(); }));
+  EXPECT_EQ(done("status")["board"]["enabled"], false);
+}
+
 TEST_F(BlmcActorOnSim, TheDestructorStopsTheLoopAndDisablesTheMotors) {
   enable_and_start();
   done("currents 0.2 -0.2");

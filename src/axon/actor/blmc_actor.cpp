@@ -297,11 +297,36 @@ struct BlmcActor::Impl {
       last_run = report;
       if (r.end != blmc::ControlEnd::requested || !requested) {
         record_fault("safety_stop", report["text"].get<std::string>());
-        alert = json{{"safety_stop", report}, {"text", fmt::format("the control loop stopped by itself: {}", report["text"].get<std::string>())}};
+        const auto why = report["text"].get<std::string>();
+        alert = json{{"safety_stop", report},
+                     {"text", fmt::format("the control loop stopped by itself: {}", why.empty() ? report["end"].get<std::string>() : why)}};
       }
     }
     if (alert) core.broadcast(MessageCode::error, *alert);
     return report;
+  }
+
+  // MotorBoard::stop_control, whose failure (the loop did not stop, its thread failed) also ends the
+  // actor's run: the next start begins afresh, and every listener hears of it.
+  json collect_run_locked(bool requested) {
+    std::optional<blmc::ControlReport> report;
+    std::string failure;
+    try {
+      report = board.stop_control();
+    } catch (const std::exception& e) {
+      failure = e.what();
+    }
+    if (report) return finish_run_locked(*report, requested);
+    {
+      std::lock_guard s(state);
+      front_end.reset();
+      action = Action{};
+      action.by = "loop failure";
+      in_force = options.control;
+      record_fault("safety_stop", failure);
+    }
+    core.broadcast(MessageCode::error, {{"text", fmt::format("the control loop ended badly: {}", failure)}, {"loop", {{"running", false}}}});
+    bk::bad_argument(fmt::format("the control loop ended badly: {}", failure));
   }
 
   // A loop that ended by itself (a safety stop) is collected here, by whoever looks first.
@@ -311,7 +336,7 @@ struct BlmcActor::Impl {
       if (!running()) return;
     }
     if (board.control_running()) return;
-    finish_run_locked(board.stop_control(), false);
+    collect_run_locked(false);
   }
 
   std::optional<json> stop_loop_locked() {
@@ -320,7 +345,7 @@ struct BlmcActor::Impl {
       if (!running()) return std::nullopt;
     }
     const bool by_itself = !board.control_running();
-    return finish_run_locked(board.stop_control(), !by_itself);
+    return collect_run_locked(!by_itself);
   }
 
   void publish(const std::vector<std::pair<MessageCode, json>>& messages) {
