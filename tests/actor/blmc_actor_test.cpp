@@ -283,4 +283,35 @@ TEST_F(BlmcActorOnSim, BroadcastsTheStatusEveryPeriod) {
   EXPECT_TRUE(body_of(*status).contains("board"));
 }
 
+// Outside the loop the board's status frames (once a second) are the sign that it is there: when
+// they stop (the simulated board's transmitter stalls for a while) every listener is warned, and
+// told again when they resume.
+TEST(BlmcActorStaleData, StatusFramesThatStopAreStaleDataUntilTheyResume) {
+  auto so = sim_options();
+  blmc::sim::BoardFaultPlan plan;
+  plan.stalls.push_back({std::chrono::seconds(1), std::chrono::seconds(5), blmc::sim::LinkDirection::tx});
+  so.faults.push_back(plan);
+  blmc::sim::SimulatedBoard sim(so);
+  blmc::MotorBoard board(sim.bus_spec(), board_options());
+  test::Replies out;
+  ActorCore core{"blmc", out.sink()};
+  auto o = actor_options();
+  o.status_stale_s = 2.0;
+  BlmcActor actor(core, board, o);
+  const auto stale_data = [&](bool stale) {
+    return out.wait_for([&](const Message& m) {
+      const auto kw = body_of(m);
+      return m.routing_key == kBroadcastKey && kw.contains("stale_data") && kw["stale_data"]["stale"] == stale;
+    });
+  };
+  const auto gone = stale_data(true);
+  ASSERT_TRUE(gone);
+  EXPECT_EQ(code_of(*gone), 'w');
+  EXPECT_EQ(body_of(*gone)["stale_data"]["quantity"], "status");
+  EXPECT_GT(body_of(*gone)["stale_data"]["age_s"].get<double>(), 2.0);
+  const auto back = stale_data(false);
+  ASSERT_TRUE(back);
+  EXPECT_EQ(code_of(*back), 'i');
+}
+
 }  // namespace axon::actor::blmc_actor_test
