@@ -230,6 +230,56 @@ void bind_upgrade(py::module_& m) {
       .def("__bool__", [](const fps::FirmwareOutcome& o) { return o.ok; });
 }
 
+// The layout check and the cold policy: what check_layout() and apply_cold_policy() return.
+void bind_checks(py::module_& m) {
+  using fps::BusRef;
+  using fps::LayoutCheck;
+  auto buses = [](const std::vector<BusRef>& b) {
+    std::vector<std::string> out;
+    for (const auto& r : b) out.push_back(r.to_string());
+    return out;
+  };
+  auto misplaced = [buses](const std::vector<fps::Misplaced>& v) {
+    std::map<std::uint16_t, std::vector<std::string>> out;
+    for (const auto& x : v) out[x.id] = buses(x.found);
+    return out;
+  };
+  py::class_<LayoutCheck>(m, "LayoutCheck", "GET_ID on every bus against the layout; buses as 'gw2/3' (gateway/channel).")
+      .def_readonly("matched", &LayoutCheck::matched, "robots that answered on their own bus only")
+      .def_readonly("missing", &LayoutCheck::missing, "robots of the layout nobody heard")
+      .def_property_readonly("wrong_bus", [buses](const LayoutCheck& c) {
+        std::map<std::uint16_t, std::pair<std::string, std::vector<std::string>>> out;
+        for (const auto& w : c.wrong_bus) out[w.id] = {w.expected.to_string(), buses(w.found)};
+        return out;
+      }, "{id: (expected bus, [buses it answered on])}")
+      .def_property_readonly("unexpected", [misplaced](const LayoutCheck& c) { return misplaced(c.unexpected); },
+                             "{id: [buses]}: robots that answered but are not in the layout")
+      .def_property_readonly("duplicated", [misplaced](const LayoutCheck& c) { return misplaced(c.duplicated); },
+                             "{id: [buses]}: one id answering on several buses")
+      .def_readonly("offline_answered", &LayoutCheck::offline_answered)
+      .def_readonly("offline_silent", &LayoutCheck::offline_silent)
+      .def_readonly("not_checked", &LayoutCheck::not_checked)
+      .def_property_readonly("failed_buses", [](const LayoutCheck& c) {
+        std::map<std::string, std::string> out;
+        for (const auto& [bus, why] : c.failed_buses) out[bus.to_string()] = why;
+        return out;
+      })
+      .def_property_readonly("ok", &LayoutCheck::ok)
+      .def("__bool__", &LayoutCheck::ok)
+      .def("__str__", &LayoutCheck::to_text);
+  py::class_<fps::ColdOutcome>(m, "ColdOutcome", "What the cold policy decided from the PLC's temperatures and sent.")
+      .def_readonly("motor_rpm", &fps::ColdOutcome::motor_rpm)
+      .def_readonly("alpha_holding_pct", &fps::ColdOutcome::alpha_holding_pct)
+      .def_readonly("beta_holding_pct", &fps::ColdOutcome::beta_holding_pct)
+      .def_readonly("coldest_c", &fps::ColdOutcome::coldest_c, "degrees Celsius; None when no sensor read")
+      .def_readonly("coldest_sensor", &fps::ColdOutcome::coldest_sensor)
+      .def_readonly("applied", &fps::ColdOutcome::applied, "robots that took both settings")
+      .def_readonly("failed", &fps::ColdOutcome::failed, "{id: why} for the robots that did not")
+      .def_readonly("text", &fps::ColdOutcome::text)
+      .def("__bool__", [](const fps::ColdOutcome& o) { return o.failed.empty(); })
+      .def("__str__", [](const fps::ColdOutcome& o) { return o.text; });
+}
+
 void bind_client_upgrade(py::class_<Client>& c) {
   c.def("upgrade_firmware", [](Client& c, const py::bytes& image, const std::string& expected_version,
                                const std::vector<int>& sextants, unsigned retries, double power_off_s,
@@ -258,6 +308,11 @@ void bind_client_upgrade(py::class_<Client>& c) {
        "Firmware of every robot, sextant by sextant through the PLC (Client(plc_address=...), open(layout)): "
        "image as bytes; progress(SextantUpgrade) about once a second per sextant and at its end. Returns an "
        "FirmwareOutcome; raise the call timeout first for a whole plane.");
+  c.def("check_layout", [](Client& c) { return blocking(c, [&c] { return c.check_layout(); }); },
+        "GET_ID on every bus of the layout (open(layout) first), the answers against it: LayoutCheck.")
+      .def("apply_cold_policy", [](Client& c) { return blocking(c, [&c] { return c.apply_cold_policy(); }); },
+           "The cold-temperature policy once: the PLC's temperatures (Client(plc_address=...)) decide every "
+           "robot's speed and holding currents, sent to all of them: ColdOutcome.");
 }
 
 void bind_client_troubleshoot(py::class_<Client>& c) {
@@ -435,6 +490,7 @@ void bind_fps_client(py::module_& m) {
   bind_outcomes(m);
   bind_troubleshoot(m);
   bind_upgrade(m);
+  bind_checks(m);
   bind_client(m);
   bind_plane(m);
 }

@@ -146,3 +146,23 @@ def test_upgrade_firmware_reports_progress_and_every_robot_runs_the_new_image():
             assert {r.firmware for r in fps.status()} == {"04.02.00"}
             with pytest.raises(axon.Error):
                 fps.upgrade_firmware(image, expected_version="four")
+
+
+def test_check_layout_and_the_cold_policy_through_the_plc():
+    with axon.fps.SimulatedPlane("benchtop", time_scale=20.0) as plane:
+        with axon.fps.Client(discover_window_s=0.3, plc_address=plane.plc_address) as fps:
+            fps.open(plane.layout)
+            fps.discover()
+            check = fps.check_layout()
+            assert check and check.ok, str(check)
+            assert sorted(check.matched) == sorted(r.id for r in plane.layout.robots)
+            assert check.missing == [] and check.wrong_bus == {} and check.unexpected == {}
+            cold = fps.apply_cold_policy()
+            assert cold, str(cold)
+            assert sorted(cold.applied) == sorted(check.matched) and cold.failed == {}
+            assert cold.motor_rpm > 0 and cold.coldest_c is not None, str(cold)
+    with axon.fps.SimulatedPlane("benchtop") as plane:
+        with axon.fps.Client() as fps:  # no PLC given: a clear error, nothing sent
+            fps.open(plane.layout)
+            with pytest.raises(axon.Error, match="needs the PLC"):
+                fps.apply_cold_policy()
