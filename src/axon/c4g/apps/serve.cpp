@@ -255,7 +255,18 @@ ServeReport ServeSession::report(std::string reason) const {
   r.server_summary = s.summary();
   r.csv_path = options_.csv;
   r.moni = options_.moni;
-  auto& st = r.stats;
+  r.stats = serve_stats(s);
+  if (const auto* csv = recorder_->csv.get()) {
+    r.stats.csv = true;
+    r.stats.csv_rows = csv->rows();
+    r.stats.csv_rotations = csv->rotations();
+    r.stats.csv_write_errors = csv->write_errors();
+  }
+  return r;
+}
+
+ServeStats serve_stats(const host::Server& s) {
+  ServeStats st;
   const auto& c = s.counters();
   if (const auto peer = s.peer()) st.controller = peer->to_string();
   st.sessions = c.sessions.load();
@@ -274,19 +285,13 @@ ServeReport ServeSession::report(std::string reason) const {
   st.currents_clamped = s.safety().counters().currents_clamped.load();
   st.controller_errors = s.controller_errors().names();
   st.timing = timing_of(s);
-  if (const auto* csv = recorder_->csv.get()) {
-    st.csv = true;
-    st.csv_rows = csv->rows();
-    st.csv_rotations = csv->rotations();
-    st.csv_write_errors = csv->write_errors();
-  }
   if (const auto* pcap = s.recorder()) {
     st.pcap = true;
     st.pcap_written = pcap->written();
     st.pcap_rotations = pcap->rotations();
     st.pcap_write_failures = pcap->write_failures();
   }
-  return r;
+  return st;
 }
 
 }  // namespace axon::c4g::apps

@@ -80,6 +80,10 @@ struct ServeStats {
   std::uint64_t pcap_written = 0, pcap_rotations = 0, pcap_write_failures = 0;
 };
 
+// The server's counters and timing figures as they stand (any thread): what ServeReport::stats holds
+// at the end of a run, for a server that runs on (the CSV figures are the session's, left unset).
+ServeStats serve_stats(const host::Server& server);
+
 struct ServeReport {
   std::string app;             // the app's name
   std::string reason;          // why run() ended: "application finished", "duration reached", "signal", ...
