@@ -101,9 +101,8 @@ int run_actor_blmc(const ActorBlmcOptions& o) {
         std::fprintf(stderr, "actor %s: board on %s%s, commands on %s (exchange %s)\n", o.name.c_str(), spec.c_str(),
                      sim ? " (simulated)" : "", o.bus.broker.c_str(), o.bus.exchange.c_str());
         co_await wait_for_stop(io, o.duration_s, hook);
-        bus.core().close();  // the simulator's verb too: nothing runs once the board goes
         relay.set(nullptr);
-      }  // the actor stops the loop and disables the motors
+      }  // the actor ends a wait in progress, closes the core, stops the loop and disables the motors
       const auto c = bus.core().counters();
       std::fprintf(stderr, "actor %s: motors disabled; %llu commands, %llu refused, %llu not understood\n", o.name.c_str(),
                    static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.refused + c.busy),

@@ -270,6 +270,16 @@ TEST_F(BlmcActorOnSim, TheDestructorStopsTheLoopAndDisablesTheMotors) {
   EXPECT_EQ(code_of(r), 'f');
 }
 
+// The actor going away (a stop signal) while an enable waits for the alignment: the wait ends, the
+// enable gets its final reply, the motors end off.
+TEST_F(BlmcActorOnSim, TheDestructorEndsAnEnableInProgressAndLeavesTheMotorsOff) {
+  core.handle(command("enable", "e"));
+  actor.reset();
+  const auto e = out.final_of("e");
+  ASSERT_TRUE(e);
+  EXPECT_TRUE(eventually([&] { return board_off(); }));
+}
+
 TEST_F(BlmcActorOnSim, BroadcastsTheStatusEveryPeriod) {
   actor.reset();
   auto o = actor_options();

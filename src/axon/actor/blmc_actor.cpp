@@ -386,16 +386,21 @@ struct BlmcActor::Impl {
       std::lock_guard s(state);
       if (running()) bk::bad_argument("enable: the control loop runs, the motors are enabled");
     }
-    board.clear_interrupt();
     board.enable();
     publish(read_board_locked());
     c.finish(assemble(true));
   }
 
   // Never refused: an enable or recover waiting for the board ends now, then the motors go off.
-  void disable(Command& c) {
-    const auto busy = core.busy_with();  // (interrupting a running loop would read as its safety stop)
+  // Ends the wait of an enable, home or recover in progress (not a running loop's: that would read
+  // as its safety stop).
+  void interrupt_waits() {
+    const auto busy = core.busy_with();
     if (busy == "enable" || busy == "recover" || busy == "home") board.interrupt();
+  }
+
+  void disable(Command& c) {
+    interrupt_waits();
     std::lock_guard lock(device);
     board.clear_interrupt();
     const auto report = stop_loop_locked();
@@ -413,7 +418,6 @@ struct BlmcActor::Impl {
       std::lock_guard s(state);
       if (running()) bk::bad_argument("recover: the control loop runs (stop it first)");
     }
-    board.clear_interrupt();
     board.recover();
     publish(read_board_locked());
     json kw = assemble(true);
@@ -724,6 +728,11 @@ BlmcActor::BlmcActor(ActorCore& core, blmc::MotorBoard& board, BlmcActorOptions 
 }
 
 BlmcActor::~BlmcActor() {
+  try {
+    impl_->interrupt_waits();  // a stop signal does not wait for an alignment to finish
+  } catch (const std::exception& e) {
+    spdlog::error("blmc actor: {}", e.what());
+  }
   impl_->core.close();  // no command reaches the board after this
   {
     std::lock_guard lock(impl_->wake_mutex);

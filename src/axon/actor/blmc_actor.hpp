@@ -38,12 +38,11 @@
 //
 // enable, start, stop, home and recover are exclusive (a second one while one runs is refused).
 // disable is never refused: it interrupts an enable, home or recover in progress and turns the
-// motors off. Setting
-// an action is refused ('f') while no loop runs.
+// motors off. Setting an action is refused ('f') while no loop runs.
 //
-// The board must be open and outlive the actor. The destructor closes the core (later commands are
-// refused), waits for the running ones, stops the watcher, stops the loop and disables the motors;
-// it never throws.
+// The board must be open and outlive the actor. The destructor interrupts an enable, home or
+// recover in progress, closes the core (later commands are refused), waits for the running ones,
+// stops the watcher, stops the loop and disables the motors; it never throws.
 #pragma once
 
 #include "axon/actor/actor_core.hpp"
