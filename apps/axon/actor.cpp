@@ -150,6 +150,7 @@ void add_actor_commands(CLI::App& app, GlobalOptions& global) {
   f->add_option("--duration", fo->duration_s, "stop after this many seconds (default: until Ctrl-C)");
   f->callback([fo, &global] { global.exit_code = run_actor_fps(*fo); });
   add_actor_blmc_command(*group, global);
+  add_actor_c4g_command(*group, global);
 
   auto ta = std::make_shared<TellArgs>();
   auto* t = app.add_subcommand("tell", "send a command to an actor over the bus; print the replies (exit 0 on ':')");

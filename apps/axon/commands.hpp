@@ -32,5 +32,7 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions& global);
 void add_actor_commands(CLI::App& app, GlobalOptions& global);
 // `actor blmc`, registered by add_actor_commands under `actor` (apps/axon/actor_blmc.cpp).
 void add_actor_blmc_command(CLI::App& actor_group, GlobalOptions& global);
+// `actor c4g`, registered by add_actor_commands under `actor` (apps/axon/actor_c4g.cpp).
+void add_actor_c4g_command(CLI::App& actor_group, GlobalOptions& global);
 
 }  // namespace axon::app
