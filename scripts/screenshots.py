@@ -1,0 +1,122 @@
+#!/usr/bin/env python3
+"""Takes the screenshots of the live pages that docs/dashboard.md shows, from the real programs in a
+headless Chromium (Debian's chromium, chromium-driver, python3-selenium), so they are re-taken by
+running this, not by hand:
+
+  dashboard-fps.png   `axon sim fps --layout default --http`: 500 robots while `axon fps plane move`
+                      turns every one of them, robot 42's details open
+  dashboard-blmc.png  `axon blmc ... --http pd` against `axon sim blmc`: the scopes of a PD sine
+  dashboard-c4g.png   `axon c4g serve --http` against `axon sim c4g`, when this axon has that option
+
+usage: /usr/bin/python3 scripts/screenshots.py [--axon build/release/axon] [--out docs/images]
+Prints one line per file written; exits 1 when a page did not come up.
+"""
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
+sys.path.insert(0, os.path.join(ROOT, 'tests', 'integration', 'helpers'))
+from browser import page, start_chromium, wait_until  # noqa: E402
+
+
+def parse():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument('--axon', default=os.path.join(ROOT, 'build', 'release', 'axon'))
+    p.add_argument('--out', default=os.path.join(ROOT, 'docs', 'images'))
+    return p.parse_args()
+
+
+class Programs:
+    """The programs a screenshot needs, ended (SIGTERM, then SIGKILL) on the way out."""
+
+    def __init__(self, tmp):
+        self.tmp, self.procs = tmp, []
+
+    def start(self, name, args, until):
+        """Starts `args`, logging to TMP/NAME.log; returns the stdout lines up to one starting with `until`."""
+        log = open(os.path.join(self.tmp, name + '.err'), 'w')
+        p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=log, text=True)
+        self.procs.append(p)
+        lines = []
+        for line in p.stdout:
+            lines.append(line.rstrip('\n'))
+            if line.startswith(until):
+                return lines
+        raise AssertionError('%s ended before printing %r; its log: %s' % (name, until, log.name))
+
+    def stop(self):
+        for p in reversed(self.procs):
+            if p.poll() is None:
+                p.terminate()
+                try:
+                    p.wait(timeout=20)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+                    p.wait()
+        self.procs = []
+
+
+def http_of(lines):
+    return 'http://' + next(l.split()[2] for l in lines if l.startswith('listening http '))
+
+
+def shoot_fps(axon, driver, progs, out):
+    lines = progs.start('sim-fps', [axon, 'sim', 'fps', '--layout', 'default', '--folded', '--http', '127.0.0.1:0',
+                                    '--write-layout', os.path.join(progs.tmp, 'live.yaml')], 'ready')
+    driver.get(http_of(lines) + '/fps.html')
+    wait_until('500 robots drawn', lambda: page(driver, 'window.axonFps && window.axonFps.drawn.robots') == 500)
+    move = subprocess.Popen([axon, 'fps', 'plane', '--layout', os.path.join(progs.tmp, 'live.yaml'), 'move', '--alpha',
+                             '60', '--beta', '150', '--duration', '8'], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    progs.procs.append(move)
+    wait_until('robots moving on the page', lambda: page(
+        driver, "window.axonFps.state.robots.filter((r) => r.a > 15 && r.a < 45).length") > 100, seconds=60)
+    driver.execute_script('window.axonFps.selected = 42')  # the details panel follows at the next update
+    wait_until("robot 42's details", lambda: page(driver, "document.getElementById('details').dataset.robot") == '42')
+    path = os.path.join(out, 'dashboard-fps.png')
+    driver.save_screenshot(path)
+    return path
+
+
+def shoot_blmc(axon, driver, progs, out):
+    board = os.path.join(progs.tmp, 'board.yaml')
+    with open(board, 'w') as f:
+        f.write('alignment_s: 0.2\n')
+    sim = progs.start('sim-blmc', [axon, 'sim', 'blmc', '--socketcand', '127.0.0.1:0', '--config', board, '--no-realtime'],
+                      'listening socketcand ')
+    port = sim[-1].rsplit(':', 1)[1]
+    lines = progs.start('blmc', [axon, 'blmc', '--socketcand', '127.0.0.1:%s/can0' % port, '--no-realtime', '--stale-ms',
+                                 '1000', '--recv-timeout-ms', '0', '--http', '127.0.0.1:0', '--http-linger', '30', 'pd',
+                                 '--amplitude', '0.5', '--frequency', '0.5', '--duration', '20'], 'listening http ')
+    driver.get(http_of(lines) + '/blmc.html')
+    wait_until('scopes with 6 s of samples', lambda: (page(
+        driver, "window.axonBlmc && window.axonBlmc.state && window.axonBlmc.state.boards[0].samples.n") or 0) >= 300,
+        seconds=60)
+    path = os.path.join(out, 'dashboard-blmc.png')
+    driver.save_screenshot(path)
+    return path
+
+
+def main():
+    a = parse()
+    os.makedirs(a.out, exist_ok=True)
+    tmp = tempfile.mkdtemp(prefix='axon-screenshots-')
+    progs = Programs(tmp)
+    driver = start_chromium()
+    try:
+        for shoot in (shoot_fps, shoot_blmc):
+            print(shoot(a.axon, driver, progs, a.out), flush=True)
+            progs.stop()
+        return 0
+    finally:
+        driver.quit()
+        progs.stop()
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == '__main__':
+    sys.exit(main())
