@@ -111,6 +111,7 @@ class Commander:
             self.ch.queue_bind(self.queue, self.exchange, routing_key=key)
         self.replies = {}    # command id -> [(code, keywords)]
         self.broadcasts = []  # (code, keywords)
+        self.others = []      # (sender, code, keywords): broadcasts of the other actors on the exchange
         self.checked = 0
         self.ch.basic_consume(self.queue, lambda ch, method, props, body: self.take(props, body, method.routing_key),
                               auto_ack=True)
@@ -128,9 +129,12 @@ class Commander:
         h = props.headers or {}
         code = h.get('message_code')
         assert code in ('>', ':', 'f', 'e', '!', 'i', 'w', 'd'), h
-        assert h.get('sender') == self.actor, h
         assert props.content_type == 'text/json', props.content_type
         keywords = json.loads(body)
+        if key == 'reply.broadcast' and h.get('sender') != self.actor:
+            self.others.append((h.get('sender'), code, keywords))  # another actor on the exchange
+            return
+        assert h.get('sender') == self.actor, h
         errors = sorted(self.validator.iter_errors(keywords), key=str) if self.validator else []
         assert not errors, 'reply not valid against docs/schema/%s.json: %s\n%s' % (self.actor, errors[0].message, body[:500])
         self.checked += 1
