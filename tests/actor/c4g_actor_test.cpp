@@ -214,6 +214,37 @@ TEST_F(C4gActorOnSimulator, StatsGivesTheCountersAndTheTimingFigures) {
   EXPECT_GT(s["reply_latency"]["count"].get<std::uint64_t>(), 0u);
 }
 
+// Takes 0.7 ms of every cycle: over the server's 400 us budget and its 500 us deadline.
+class SlowApp final : public c4g::apps::App {
+ public:
+  [[nodiscard]] std::string_view name() const noexcept override { return "slow"; }
+
+ protected:
+  void step(const c4g::host::CycleContext&, c4g::host::ReplyBuilder&) override {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(700);
+    while (std::chrono::steady_clock::now() < until) {
+    }
+  }
+};
+
+TEST_F(C4gActorOnSimulator, LateCyclesAreBroadcastAtMostOnceASecond) {
+  ASSERT_TRUE(wait_for_mode("4"));
+  ASSERT_TRUE(apps.install(std::make_unique<SlowApp>()));  // no built-in app is this slow
+  const auto late = broadcast_with("late", [](const auto& l) { return l["new_controller_late"] > 0; });
+  ASSERT_TRUE(late);
+  EXPECT_EQ(code_of(*late), 'w');
+  EXPECT_GT(body_of(*late)["late"]["new_missed_deadlines"].get<std::uint64_t>(), 0u);
+  auto count = [this] {
+    std::lock_guard lock(out.mutex);
+    return std::count_if(out.messages.begin(), out.messages.end(), [](const Message& m) {
+      return m.routing_key == "reply.broadcast" && body_of(m).contains("late");
+    });
+  };
+  const auto before = count();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  EXPECT_LE(count() - before, 2);  // at most one a second, though every cycle is late
+}
+
 // A program that goes on after a drive off ended its open phase (the default one would then fail
 // its next GO OPEN and stop sending, and a reset takes effect only at the next packet).
 struct C4gActorAfterDriveOff : C4gActorOnSimulator {
