@@ -335,6 +335,11 @@ void bind_server(py::module_& m) {
         if (!s.session) throw Exception(Error(CoreErrc::closed, "c4g: the server was closed"));
         return s.session->status_line();
       }, "A status line: app, server state, cycle times.")
+      .def_property_readonly("stats", [](Session& s) {
+        if (!s.session) throw Exception(Error(CoreErrc::closed, "c4g: the server was closed"));
+        return apps::serve_stats(s.session->server());
+      }, "The server's counters and timing figures as they stand (ServeStats), while it runs: read them from "
+         "run()'s until callable or another thread; the report has the final ones.")
       .def_property_readonly("report", [](const Session& s) { return s.report; }, "The ServeReport once run() ended (also after Ctrl-C), else None.")
       .def("run", &run, py::arg("until") = py::none(),
            "Blocks (GIL released) until the app is done or failed, the controller ends the exchange, duration_s passed, "

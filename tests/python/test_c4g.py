@@ -157,6 +157,25 @@ def test_a_condition_ends_the_run_cleanly():
     assert 0.0 < seen.joints_deg(1)[0] < 1.0  # stopped early, along the path
 
 
+def test_live_stats_count_up_while_the_server_runs():
+    app = axon.c4g.Monitor()
+    seen = []
+
+    def sample():  # run()'s condition, between polls, off the cycle thread
+        seen.append(server.stats.cyclic_packets)
+        return False
+    with axon.c4g.Server(app) as server, \
+            axon.c4g.SimulatedController(server, program="steps:\n  - drive_on\n  - delay: 0.5\n  - exit_open\n",
+                                         reply_window="period") as controller:
+        assert server.stats.packets == 0  # bound, nothing came yet
+        report = server.run(until=sample)
+        controller.wait(timeout_s=30)
+    live = [n for n in seen if n > 0]
+    assert len(set(live)) >= 3, seen  # counting up during the run, not only at its end
+    assert live == sorted(live) and live[-1] <= report.stats.cyclic_packets, (live[-5:], report.stats)
+    assert report.stats.cyclic_packets > 100
+
+
 def test_a_condition_that_raises_ends_the_run_and_raises():
     with axon.c4g.Server(axon.c4g.Monitor()) as server:
         with pytest.raises(ZeroDivisionError):
