@@ -172,6 +172,20 @@ TEST_F(C4gActorOnSimulator, ASecondStartIsRefusedAndStopLeavesTheOpenModeCleanly
   EXPECT_EQ(run("stop")["text"], "no application in force: the monitor answers");
 }
 
+TEST_F(C4gActorOnSimulator, AnAppThatHoldsNoModeIsStoppedAtOnce) {
+  ASSERT_TRUE(wait_for_mode("4"));  // the program's phase, not the apps'
+  for (const std::string app : {"echo", "monitor", "correct --amplitude 0.2"}) {  // correct waits for mode 7
+    run("start " + app);
+    auto stopped = run("stop");
+    ASSERT_TRUE(stopped.contains("app_ended")) << stopped;
+    EXPECT_EQ(stopped["app_ended"]["name"], app.substr(0, app.find(' ')));
+    EXPECT_EQ(stopped["app_ended"]["left_cleanly"], true);
+    EXPECT_EQ(stopped["app_ended"]["drive_off"], false);
+    EXPECT_LT(stopped["app_ended"]["in_force_s"].get<double>(), 1.5);  // not the stop timeout (2 s here)
+  }
+  EXPECT_EQ(run("status")["axes"][0]["label"], "4");
+}
+
 TEST_F(C4gActorOnSimulator, AnAppThatRefusesIsReportedWithItsErrorAndTakenOut) {
   ASSERT_TRUE(wait_for_mode("4"));
   run("start stream --file " + trajectory("far.csv", 30));  // absolute: 30 deg away from the robot

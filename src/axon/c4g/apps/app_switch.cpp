@@ -1,5 +1,6 @@
 #include "axon/c4g/apps/app_switch.hpp"
 
+#include "axon/c4g/apps/echo.hpp"
 #include "axon/c4g/apps/open_mode.hpp"
 #include "axon/c4g/protocol/packet.hpp"
 
@@ -20,9 +21,12 @@ std::chrono::steady_clock::duration after(double s) {
   return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(s));
 }
 
-// An open-mode app that is waiting for its mode (or done with it) holds no open mode of its own:
-// the arm's mode, if open, is the program's, which the monitor answers as before.
+// Apps that hold no open mode of their own: the monitor and the echo (whose reply in 0' is the
+// server's safe reply too) never leave a mode, and an open-mode app waiting for its mode (or done
+// with it) has none; the arm's mode, if open, is then the program's, which the monitor answers as
+// before. Taking them out needs no wait.
 bool holds_no_mode(const App& app) {
+  if (dynamic_cast<const MonitorApp*>(&app) != nullptr || dynamic_cast<const EchoApp*>(&app) != nullptr) return true;
   const auto* o = dynamic_cast<const OpenModeApp*>(&app);
   return o != nullptr && (o->phase() == Phase::waiting || o->phase() == Phase::done);
 }

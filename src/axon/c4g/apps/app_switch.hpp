@@ -19,9 +19,10 @@
 // The stop is ServeSession's graceful stop, as a state machine that poll() advances (so a thread
 // that watches the switch and a thread that waits for a stop may share the work): the app is asked
 // to leave its open modes (App::request_stop); once the controller shows every axis in mode 0 (or
-// went silent, ended the exchange, or obeyed a drive off) the monitor takes over; after
+// went silent, or obeyed a drive off) the monitor takes over; after
 // stop_timeout_s without that the server is asked for drive off (505), and drive_off_wait_s later
-// the app is taken out whatever the controller shows. An app that finishes on its own is taken out
+// the app is taken out whatever the controller shows. The monitor, the echo and an open-mode app
+// still waiting for its mode hold no mode and go at once. An app that finishes on its own is taken out
 // at once (it already left its mode); one that refuses is stopped the same way, with drive off at
 // once when the robot depends on it every cycle (App::drive_off_on_error, as ServeSession does).
 //
