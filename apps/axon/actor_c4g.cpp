@@ -13,6 +13,7 @@
 #include "run.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <cstdio>
 #include <memory>
@@ -31,6 +32,8 @@ struct ActorC4gOptions {
   std::string scenario;    // the simulator's robot program (empty: the built-in one below)
   bool lenient_timing = false;
   std::vector<std::string> stroke_ends;
+  int rt_priority = 0;     // SCHED_FIFO for the cycle thread (and mlockall); 0: a normal thread
+  std::vector<int> cpus;
   double stop_timeout_s = 5.0;
   double status_period_s = 10.0;
   double duration_s = 0;
@@ -58,6 +61,9 @@ c4g::host::ServerOptions c4g_server_options(const ActorC4gOptions& o) {
   so.listen = need(net::parse_endpoint(o.listen, c4g::host::kManualPort));
   if (!o.controller.empty() && o.controller != "any") so.controller = need(net::parse_endpoint(o.controller, 0));
   for (const auto& spec : o.stroke_ends) need(c4g::host::parse_stroke_end(spec, 1, so.safety));
+  so.cycle.realtime.fifo_priority = o.rt_priority;
+  so.cycle.realtime.lock_memory = o.rt_priority > 0;
+  so.cycle.realtime.cpus = o.cpus;
   return so;
 }
 
@@ -68,6 +74,13 @@ std::unique_ptr<c4g::sim::SimulatedController> start_simulator(const ActorC4gOpt
   if (o.scenario.empty()) co.scenario_yaml = actor_program();
   else co.scenario_file = o.scenario;
   if (o.lenient_timing) co.reply_window = c4g::sim::ReplyWindow::period;
+  // The simulated controller's warnings and errors (a communication error, a failed program step)
+  // go to stderr as they happen, as `axon sim c4g` prints them.
+  co.on_event = [](const c4g::sim::Event& e) {
+    if (e.level == c4g::sim::EventLevel::info) return;
+    std::fprintf(stderr, "simulated controller %8.3f s %s %s: %s\n", e.time_s, std::string(c4g::sim::to_string(e.level)).c_str(),
+                 e.name.c_str(), e.text.c_str());
+  };
   return std::make_unique<c4g::sim::SimulatedController>(c4g::sim::SimulatedController::start(co));
 }
 
@@ -76,6 +89,8 @@ int run_actor_c4g(const ActorC4gOptions& o) {
     c4g::apps::AppSwitch apps({o.stop_timeout_s, 1.0});
     auto started = c4g::host::Server::start(apps, c4g_server_options(o));
     auto server = need(std::move(started));
+    for (const auto& step : server->realtime_report().steps)
+      if (!step.granted) spdlog::warn("actor c4g: {} refused: {}", step.name, step.reason);
     auto sim = o.controller.empty() ? start_simulator(o, *server) : nullptr;
     actor::BusActor bus({o.name, o.bus.link()});
     {
@@ -120,6 +135,9 @@ void add_actor_c4g_command(CLI::App& actor_group, GlobalOptions& global) {
   c->add_option("--scenario", o->scenario, "simulator: the robot program FILE (default: open phases in modes 4 and 7, again and again)");
   c->add_flag("--lenient-timing", o->lenient_timing, "simulator: accept a reply up to a whole period late (loaded machines)");
   c->add_option("--stroke-end", o->stroke_ends, "Safety: a joint's stroke ends, [ARM.]AXIS=MIN:MAX [deg]; repeatable");
+  c->add_option("--rt-priority", o->rt_priority, "SCHED_FIFO priority of the server's cycle thread (and mlockall)")
+      ->check(CLI::Range(0, 99));
+  c->add_option("--cpu", o->cpus, "pin the cycle thread to this CPU (repeatable)");
   c->add_option("--stop-timeout", o->stop_timeout_s, "seconds an app may take to leave its open modes before drive off (default 5)")
       ->check(CLI::NonNegativeNumber);
   c->add_option("--status-period", o->status_period_s, "seconds between status broadcasts (default 10; 0: none)")
