@@ -94,7 +94,7 @@ def status_rate_during_move(c, window):
     target = 60.0 if statistics.median(alpha) < 180 else -60.0
     target += statistics.median(alpha)
     move = c.send('goto all %.1f 180' % target)
-    assert c.pump(lambda: any(code == '>' for code, _ in c.replies[move]), 30), c.replies[move]
+    assert c.pump(lambda: any('move_started' in kw for _, kw in c.replies[move]), 30), c.replies[move]
     t0, answered, stale, in_flight, sizes = time.perf_counter(), 0, 0, [], []
     while not c.done(move):
         while len(in_flight) < window:

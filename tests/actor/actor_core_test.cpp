@@ -56,6 +56,36 @@ TEST(ActorCore, UnknownAndMalformedCommandsFailWithAReasonAndAreCounted) {
   EXPECT_EQ(core.counters().malformed, 1u);
 }
 
+// As clu's actors: an accepted command answers '>' (no keywords) first, then its keywords, then one
+// final reply; get_schema gives the schema the actor was given, as a string, and fails without one.
+TEST(ActorCore, ACommandAnswersRunningFirstAndGetSchemaGivesTheSchemaText) {
+  test::Replies out;
+  ActorCore core("test", out.sink());
+  core.add({"work", "work", false, [](Command& c) {
+              c.write(MessageCode::info, {{"text", "half way"}});
+              c.finish({{"text", "done"}});
+            }});
+  core.handle(command("work", "w"));
+  ASSERT_TRUE(out.final_of("w"));
+  core.wait_idle();
+  const auto replies = out.of("w");
+  ASSERT_EQ(replies.size(), 3u);
+  EXPECT_EQ(code_of(replies[0]), '>');
+  EXPECT_EQ(replies[0].body, "{}");
+  EXPECT_EQ(code_of(replies[1]), 'i');
+  EXPECT_EQ(code_of(replies[2]), ':');
+  core.handle(command("get_schema", "none"));
+  const auto none = out.final_of("none");
+  ASSERT_TRUE(none);
+  EXPECT_EQ(code_of(*none), 'f');
+  core.set_schema(R"({"type": "object"})");
+  core.handle(command("get_schema", "s"));
+  const auto schema = out.final_of("s");
+  ASSERT_TRUE(schema);
+  EXPECT_EQ(code_of(*schema), ':');
+  EXPECT_EQ(body_of(*schema)["schema"], R"({"type": "object"})");
+}
+
 TEST(ActorCore, ASecondExclusiveCommandIsRefusedWhileTheFirstRunsNotQueued) {
   test::Replies out;
   ActorCore core("test", out.sink());
@@ -126,7 +156,9 @@ TEST(ActorCore, NothingFollowsAFinalReply) {
   core.handle(command("twice", "3"));
   ASSERT_TRUE(out.final_of("3"));
   core.wait_idle();
-  EXPECT_EQ(out.of("3").size(), 1u);
+  const auto replies = out.of("3");
+  ASSERT_EQ(replies.size(), 2u);  // '>' as it starts, then the one final reply
+  EXPECT_EQ(code_of(replies.back()), ':');
 }
 
 TEST(ActorCore, ACommandWithoutIdsGetsOneAndItsRepliesAreBroadcast) {

@@ -299,7 +299,8 @@ TEST_F(BlmcActorOnSim, BroadcastsTheStatusEveryPeriod) {
 TEST(BlmcActorStaleData, StatusFramesThatStopAreStaleDataUntilTheyResume) {
   auto so = sim_options();
   blmc::sim::BoardFaultPlan plan;
-  plan.stalls.push_back({std::chrono::seconds(1), std::chrono::seconds(5), blmc::sim::LinkDirection::tx});
+  // From 2.5 s: the board has sent its first status frames (one a second) however loaded the machine.
+  plan.stalls.push_back({std::chrono::milliseconds(2500), std::chrono::seconds(5), blmc::sim::LinkDirection::tx});
   so.faults.push_back(plan);
   blmc::sim::SimulatedBoard sim(so);
   blmc::MotorBoard board(sim.bus_spec(), board_options());

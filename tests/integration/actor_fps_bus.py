@@ -48,7 +48,8 @@ def check_commands(c, port, actor_proc):
     ids = [r['id'] for r in robots]
 
     move = c.command('goto %d 30 170' % ids[0])
-    assert move[0][0] == '>' and 'move_started' in move[0][1], move[0]
+    assert move[0] == ('>', {}), move[0]  # the convention: '>' first, then the command's keywords
+    assert move[1][0] == '>' and 'move_started' in move[1][1], move[1]
     assert move[-1][0] == ':', move[-1]
     reached = move[-1][1]['move_result']['robots'][0]
     assert abs(reached['alpha'] - 30) < 0.2 and abs(reached['beta'] - 170) < 0.2, reached
@@ -56,6 +57,8 @@ def check_commands(c, port, actor_proc):
     for body, reason in ((b'status, please', 'not JSON'), (b'{"command": "status"}', 'command_string')):
         r = c.command(body=body)
         assert r[-1][0] == 'f' and reason in r[-1][1]['error'], r
+    r = c.command('get_schema')  # clu's built-in: the keyword schema as JSON text, the one shipped in docs/
+    assert r[-1][0] == ':' and json.loads(r[-1][1]['schema']) == VALIDATOR.schema, r[-1][1].keys()
     r = c.command('fly 3')
     assert r[-1][0] == 'f' and 'unknown command' in r[-1][1]['error'], r
     r = c.command('goto %d ninety 170' % ids[0])
@@ -63,7 +66,7 @@ def check_commands(c, port, actor_proc):
 
     # A long move, then a second one while it runs: refused at once with a reason, not queued.
     first = c.send('goto all 300 150')
-    assert c.pump(lambda: any(code == '>' for code, _ in c.replies[first]), 10), c.replies[first]
+    assert c.pump(lambda: any('move_started' in kw for _, kw in c.replies[first]), 10), c.replies[first]
     second = c.command('goto %d 10 170' % ids[1])
     assert second[-1][0] == 'f' and 'is running' in second[-1][1]['error'], second
     during = c.command('status')
@@ -75,7 +78,7 @@ def check_commands(c, port, actor_proc):
     r = c.command('stop')
     assert r[-1][0] == ':' and r[-1][1]['stopped']['while_moving'] is False, r
     moving = c.send('goto %d 30 170' % ids[0])
-    assert c.pump(lambda: any(code == '>' for code, _ in c.replies[moving]), 10), c.replies[moving]
+    assert c.pump(lambda: any('move_started' in kw for _, kw in c.replies[moving]), 10), c.replies[moving]
     r = c.command('abort')
     assert r[-1][0] == ':' and r[-1][1]['stopped']['while_moving'] is True, r
     assert c.wait(moving)[-1][0] == 'f', c.replies[moving][-1]

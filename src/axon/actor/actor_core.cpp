@@ -67,6 +67,11 @@ void ActorCore::add(Verb verb) {
   verbs_.push_back(std::move(verb));
 }
 
+void ActorCore::set_schema(std::string schema) {
+  std::lock_guard lock(mutex_);
+  schema_ = std::move(schema);
+}
+
 void ActorCore::add_builtins() {
   verbs_.push_back(Verb{"ping", "ping", false, [](Command& c) { c.finish({{"text", "Pong."}}); }});
   verbs_.push_back(Verb{"version", "version", false, [](Command& c) { c.finish({{"version", "axon 0.1.0"}}); }});
@@ -78,6 +83,15 @@ void ActorCore::add_builtins() {
                           }
                           std::sort(lines.begin(), lines.end());
                           c.finish({{"help", lines}});
+                        }});
+  verbs_.push_back(Verb{"get_schema", "get_schema (the keyword schema, as JSON text)", false, [this](Command& c) {
+                          std::string schema;
+                          {
+                            std::lock_guard lock(mutex_);
+                            schema = schema_;
+                          }
+                          if (schema.empty()) return c.fail("this actor has no keyword schema");
+                          c.finish({{"schema", schema}});
                         }});
 }
 
@@ -172,6 +186,7 @@ void ActorCore::start(const Command::Id& who, CommandLine line, const Verb& verb
   try {
     running->thread = std::thread([command, run = verb.run, done = &running->finished] {
       try {
+        command->write(MessageCode::running, Keywords::object());
         run(*command);
         if (!command->done()) command->finish();
       } catch (const std::exception& e) {

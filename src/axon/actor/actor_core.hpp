@@ -8,6 +8,11 @@
 // over `max_body_bytes` is refused unparsed, a command beyond `max_running` running at once is
 // refused as busy, and refusals are logged on the first and every 100th (all are counted).
 //
+// As clu's actors do, an accepted command's first reply is `>` (running, no keywords), then what its
+// handler writes, then exactly one final reply; `get_schema` answers with the actor's keyword schema
+// as a JSON string (keyword `schema`). An unknown verb gets one `f` that points to `help` (clu adds a
+// `w` with the whole help first; one reply keeps a flood of unknown verbs from being amplified).
+//
 // Replies leave through the `publish` function given to the constructor, from the thread that
 // writes them (the caller of handle() for refusals, a command's thread otherwise): it must be
 // thread-safe (AmqpLink::publish is). Handlers must not throw past their command: what they throw
@@ -103,8 +108,10 @@ class ActorCore {
   ActorCore& operator=(const ActorCore&) = delete;
 
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
-  // Adds a verb (before the first command). `help`, `ping` and `version` are built in.
+  // Adds a verb (before the first command). `help`, `ping`, `version` and `get_schema` are built in.
   void add(Verb verb);
+  // The keyword schema (JSON text) `get_schema` answers with, as keyword `schema` (a string).
+  void set_schema(std::string schema);
   // One incoming command message. Returns once the command is refused or started.
   void handle(const Message& message);
   // An unsolicited reply to every listener (routing key reply.broadcast).
@@ -129,6 +136,7 @@ class ActorCore {
   std::function<void(Message)> publish_;
   ActorLimits limits_;
   std::vector<Verb> verbs_;
+  std::string schema_;
   mutable std::mutex mutex_;
   CoreCounters counters_;
   std::string exclusive_running_;

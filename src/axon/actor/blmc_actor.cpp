@@ -1,4 +1,5 @@
 #include "axon/actor/blmc_actor.hpp"
+#include "axon/actor/schemas.hpp"
 
 #include "axon/blmc/host/error.hpp"
 #include "axon/core/error.hpp"
@@ -704,6 +705,7 @@ struct BlmcActor::Impl {
 BlmcActor::BlmcActor(ActorCore& core, blmc::MotorBoard& board, BlmcActorOptions options)
     : impl_(std::make_unique<Impl>(core, board, std::move(options))) {
   auto* i = impl_.get();
+  core.set_schema(std::string(schemas::blmc));
   core.add({"status", "status", false, [i](Command& c) { i->status(c); }});
   core.add({"enable", "enable (the motors on, aligned and ready)", true, [i](Command& c) { i->enable(c); }});
   core.add({"disable", "disable (stops the loop, zero current, motors off; never refused)", false,

@@ -1,4 +1,5 @@
 #include "axon/actor/c4g_actor.hpp"
+#include "axon/actor/schemas.hpp"
 
 #include "axon/c4g/apps/app_factory.hpp"
 #include "axon/c4g/apps/app_switch.hpp"
@@ -555,6 +556,7 @@ struct C4gActor::Impl {
 C4gActor::C4gActor(ActorCore& core, c4g::apps::AppSwitch& apps, c4g::host::Server& server, C4gActorOptions options)
     : impl_(std::make_unique<Impl>(core, apps, server, options)) {
   auto* i = impl_.get();
+  core.set_schema(std::string(schemas::c4g));
   core.add({"status", "status", false, [i](Command& c) { i->status(c); }});
   core.add({"stats", "stats (counters and timing of the server)", false, [i](Command& c) { i->stats(c); }});
   core.add({"start", "start APP [OPTION ...] (monitor, echo, stream, correct, pid, handover, contribute; options as axon c4g serve)",

@@ -1,4 +1,5 @@
 #include "axon/actor/fps_actor.hpp"
+#include "axon/actor/schemas.hpp"
 #include "axon/fps/plan/arm_name.hpp"
 
 #include "axon/fps/host/client_json.hpp"
@@ -429,6 +430,7 @@ FpsActor::FpsActor(ActorCore& core, fps::Client& client, FpsActorOptions options
     : impl_(std::make_unique<Impl>(core, client, options)) {
   impl_->remember(client.discover());
   auto* i = impl_.get();
+  core.set_schema(std::string(schemas::fps));
   core.add({"status", "status", false, [i](Command& c) { i->status(c); }});
   core.add({"goto", "goto ID ALPHA BETA [ID ALPHA BETA ...] (ID: a robot or all)", true, [i](Command& c) { i->go(c); }});
   core.add({"plan", "plan ID ALPHA BETA [...] | plan FILE (collision-free, the others fold)", true,
