@@ -3,6 +3,8 @@
 //   init-info  prints an initialization packet from a 1200-byte file or from a capture
 // The ready line `listening c4g HOST:PORT`, events and status lines go to stdout; logs to stderr.
 // With --json, stdout carries one JSON document and nothing else: the lines go to stderr.
+// --http HOST:PORT serves the live page and /metrics (docs/dashboard.md): a web::C4gView fed on
+// run()'s thread from the session's hooks, never on the cycle thread.
 // What runs lives in the library (src/axon/c4g/apps: app_factory.hpp, serve.hpp); here are the
 // arguments, the freezing controls (signals, --freeze-at/--freeze-for) and the printing.
 #include "axon/c4g/apps/app_factory.hpp"
@@ -13,6 +15,8 @@
 #include "axon/c4g/protocol/axis_map.hpp"
 #include "axon/c4g/protocol/init_packet.hpp"
 #include "axon/net/endpoint.hpp"
+#include "axon/web/c4g_view.hpp"
+#include "axon/web/server.hpp"
 #include "checks.hpp"
 #include "commands.hpp"
 #include "rotation_options.hpp"
@@ -29,6 +33,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <thread>
 
 namespace axon::app {
 namespace {
@@ -61,6 +66,8 @@ struct ServeArgs {
   bool json = false;
   double freeze_at_s = 0;  // active freezing
   double freeze_for_s = 0;
+  std::string http;          // HOST:PORT of the live page (empty: none)
+  double http_linger_s = 0;  // keep serving the final state this long after the run
 };
 
 struct InitInfoArgs {
@@ -130,6 +137,57 @@ apps::ServeOptions serve_options(const ServeArgs& o) {
   return s;
 }
 
+// ---- --http: the live page ----------------------------------------------------------------------
+
+// The server's page on a web server of its own thread. The view is fed and published from the
+// session's hooks on run()'s thread: the app's events as run() drains them, the server's counters
+// read at each publish.
+struct C4gWebPage {
+  std::unique_ptr<web::Server> server;
+  std::shared_ptr<web::Source> source;
+  std::unique_ptr<web::C4gView> view;
+  std::chrono::steady_clock::time_point next{};
+
+  [[nodiscard]] std::string where() const { return fmt::format("{}:{}", server->address(), server->port()); }
+  // About 10 times a second (run() polls every 20 ms); the metrics once a second.
+  void tick() {
+    const auto now = std::chrono::steady_clock::now();
+    if (now < next) return;
+    next = now + std::chrono::milliseconds(100);
+    view->publish(*source, 10);
+  }
+  void publish_all() { view->publish(*source, 1); }
+};
+
+std::unique_ptr<C4gWebPage> open_c4g_page(const ServeArgs& o, const apps::App& app, apps::ServeSession& session) {
+  const auto ep = need(net::parse_endpoint(o.http));
+  web::ServerOptions so;
+  so.address = ep.host;
+  so.port = ep.port;
+  auto page = std::make_unique<C4gWebPage>();
+  web::C4gViewOptions vo;
+  vo.command = fmt::format("serve --app {}", o.app.app);
+  vo.soft_switch = {o.switch_t1_ms * 1e-3, o.switch_t2_ms * 1e-3, o.switch_t3_ms * 1e-3};
+  page->view = std::make_unique<web::C4gView>(app, session.server(), std::move(vo));
+  page->server = std::make_unique<web::Server>(so);
+  page->source = std::make_shared<web::Source>(
+      "c4g", fmt::format("c4g: {} on {}", o.app.app, session.local_address()), "c4g");
+  page->source->set_info(page->view->info_json());
+  page->publish_all();
+  page->server->add(page->source);
+  return page;
+}
+
+// --http-linger: the page goes on showing how the run ended until the time is up or a stop signal,
+// which is then the normal end. A run a signal ended does not linger: the user asked to stop.
+void linger_c4g_page(C4gWebPage& page, double seconds_left, const StopSignals& signals) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds_left);
+  while (std::chrono::steady_clock::now() < until && signals.count() == 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    page.publish_all();
+  }
+}
+
 int run_serve(const ServeArgs& o) {
   std::FILE* out = o.json ? stderr : stdout;  // stdout carries the JSON report alone
   auto say = [out](const std::string& line) {
@@ -141,18 +199,22 @@ int run_serve(const ServeArgs& o) {
   FreezeSignals freeze_signals;
   apps::ServeSession session(*app, serve_options(o));
   session.start();
+  auto page = o.http.empty() ? nullptr : open_c4g_page(o, *app, session);
   say("listening c4g " + session.local_address());
+  if (page) say("listening http " + page->where());
   apps::FreezeSchedule freeze(session.server(), {o.freeze_at_s, o.freeze_for_s}, say);
   apps::ServeSession::Hooks hooks;
   hooks.on_session = [&](const std::string& peer) { std::fprintf(out, "session: controller %s\n", peer.c_str()); };
   hooks.on_event = [&](const apps::Event& e, const std::string& text) {
     std::fprintf(out, "event cycle %llu: %s\n", static_cast<unsigned long long>(e.cycle), text.c_str());
+    if (page) page->view->add_event(e, text);
   };
   hooks.on_status = say;
   hooks.on_poll = [&] {
     if (const int sig = freeze_signal().exchange(0); sig == 1) freeze.request("SIGUSR1");
     else if (sig == 2) freeze.release("SIGUSR2");
     freeze.poll();
+    if (page) page->tick();
     std::fflush(out);
   };
   hooks.on_stopping = [&] { freeze.stopping(); };
@@ -161,6 +223,10 @@ int run_serve(const ServeArgs& o) {
   if (o.json) std::printf("%s\n", report.json().c_str());
   else std::printf("%s", report.text().c_str());
   std::fflush(stdout);
+  if (page) {
+    page->publish_all();
+    if (o.http_linger_s > 0) linger_c4g_page(*page, o.http_linger_s, signals);
+  }
   return report.exit_code();
 }
 
@@ -269,6 +335,8 @@ void add_serve(CLI::App* c4g, GlobalOptions& global) {
   s->add_option("--stop-timeout", o->stop_timeout_s, "seconds to wait for mode 0 when stopping before drive off (default 5)")->check(non_negative());
   s->add_flag("--json", o->json, "print the final report as one JSON document on stdout (the other lines go to stderr)");
   s->add_option("--freeze-at", o->freeze_at_s, "active freezing (500) from this many seconds after start (also: SIGUSR1 freezes, SIGUSR2 releases)")->check(non_negative());
+  s->add_option("--http", o->http, "serve the live page and /metrics on HOST:PORT (docs/dashboard.md; 127.0.0.1 keeps it on this machine, port 0: any)");
+  s->add_option("--http-linger", o->http_linger_s, "with --http: keep serving the final state this many seconds after the run (a stop signal ends it; default 0)")->check(non_negative());
   s->add_option("--freeze-for", o->freeze_for_s, "release an active freezing this many seconds after the controller shows 500 (0: on SIGUSR2)")->check(non_negative());
   s->callback([o, &global] { global.exit_code = run_serve(*o); });
 }

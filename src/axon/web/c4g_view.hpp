@@ -40,7 +40,7 @@ namespace axon::web {
 struct C4gViewOptions {
   std::string command;                      // what the process runs, shown on the page ("serve --app stream")
   c4g::protocol::SwitchTimes soft_switch{};  // the controller's T1, T2, T3 (START of modes 1 and 2)
-  std::size_t event_log = 30;               // the last events kept, in words, for the page
+  std::size_t event_log = 60;               // the last events kept, in words, for the page (10 per axis of a six-axis arm)
 };
 
 class C4gView {
