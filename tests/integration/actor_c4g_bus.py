@@ -48,12 +48,11 @@ def wait_for_modes(c, label, timeout=30):
 
 
 def changed(broadcasts, frm, to):
-    """Some mode_changes broadcast moves every axis from `frm` to `to`."""
-    for _, kw in broadcasts:
-        moves = [m for m in kw.get('mode_changes', []) if m['from_label'] == frm and m['to_label'] == to]
-        if len(moves) == 6:
-            return True
-    return False
+    """The mode_changes broadcasts so far move every axis from `frm` to `to` (the six changes of one
+    packet may come in two broadcasts: the actor's watcher drains while they are queued)."""
+    moves = {m['axis'] for _, kw in broadcasts for m in kw.get('mode_changes', [])
+             if m['from_label'] == frm and m['to_label'] == to}
+    return len(moves) == 6
 
 
 def check_commands(c, listener, port):
