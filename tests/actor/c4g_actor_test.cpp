@@ -282,6 +282,20 @@ struct C4gActorAfterDriveOff : C4gActorOnSimulator {
   C4gActorAfterDriveOff() { program = "steps:\n  - drive_on\n  - go_open: {type: A, mode: 4, arms: [1]}\n  - wait_for_pc\n  - run\n"; }
 };
 
+// A program that stays in mode 0 with the drives on: what active freezing needs.
+struct C4gActorInMode0 : C4gActorOnSimulator {
+  C4gActorInMode0() { program = "steps:\n  - drive_on\n  - run\n"; }
+};
+
+TEST_F(C4gActorInMode0, FreezeAndReleaseTheExchange) {
+  ASSERT_TRUE(wait_for_mode("0"));
+  EXPECT_EQ(run("status")["server"]["freeze"], "off");
+  EXPECT_EQ(run("freeze")["server"]["freeze"], "frozen");
+  EXPECT_EQ(run("status")["axes"][0]["label"], "500");
+  EXPECT_EQ(run("release")["server"]["freeze"], "off");
+  EXPECT_TRUE(wait_for_mode("0"));
+}
+
 TEST_F(C4gActorAfterDriveOff, DriveOffIsObeyedBroadcastAndResetClearsIt) {
   ASSERT_TRUE(wait_for_mode("4"));
   auto off = run("driveoff");

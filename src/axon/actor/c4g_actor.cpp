@@ -209,6 +209,17 @@ std::string_view fault_id(host::FaultReason r) {
   return "none";
 }
 
+std::string_view freeze_id(host::FreezeState f) {
+  switch (f) {
+    case host::FreezeState::off: return "off";
+    case host::FreezeState::pending: return "pending";
+    case host::FreezeState::entering: return "entering";
+    case host::FreezeState::frozen: return "frozen";
+    case host::FreezeState::leaving: return "leaving";
+  }
+  return "off";
+}
+
 Keywords server_json(const host::Server& s) {
   const auto st = apps::serve_stats(s);
   const auto period = s.period_ns();
@@ -218,7 +229,8 @@ Keywords server_json(const host::Server& s) {
                   {"controller", st.controller.empty() ? Keywords(nullptr) : Keywords(st.controller)},
                   {"sessions", st.sessions},
                   {"cycles", st.cyclic_packets},
-                  {"period_ms", period > 0 ? Keywords(static_cast<double>(period) * 1e-6) : Keywords(nullptr)}};
+                  {"period_ms", period > 0 ? Keywords(static_cast<double>(period) * 1e-6) : Keywords(nullptr)},
+                  {"freeze", std::string(freeze_id(s.freeze_state()))}};
 }
 
 Keywords safety_json(const host::Server& s) {
@@ -411,6 +423,33 @@ struct C4gActor::Impl {
            std::move(kw));
   }
 
+  // Active freezing (500): from the next packet with every axis in mode 0 the controller stops
+  // checking the replies, until release.
+  void freeze(Command& c) {
+    no_arguments(c);
+    server.request_freeze();
+    const bool frozen = server.wait_frozen(std::chrono::duration_cast<std::chrono::nanoseconds>(
+        std::chrono::duration<double>(options.drive_off_wait_s)));
+    Keywords kw{{"server", c4g_kw::server_json(server)}};
+    if (frozen) return c.finish(std::move(kw));
+    c.fail(fmt::format("the controller has not shown 500 within {} s (it freezes once every axis is in mode 0); the "
+                       "request stands until release",
+                       options.drive_off_wait_s),
+           std::move(kw));
+  }
+
+  void release(Command& c) {
+    no_arguments(c);
+    server.release_freeze();
+    const auto until = c4g_kw::SteadyClock::now() + c4g_kw::c4g_after(options.drive_off_wait_s);
+    while (server.freeze_state() != c4g::host::FreezeState::off && c4g_kw::SteadyClock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    Keywords kw{{"server", c4g_kw::server_json(server)}};
+    if (server.freeze_state() == c4g::host::FreezeState::off) return c.finish(std::move(kw));
+    c.fail(fmt::format("the controller has not left the freezing within {} s (exit from open goes on)", options.drive_off_wait_s),
+           std::move(kw));
+  }
+
   void reset(Command& c) {
     no_arguments(c);
     auto& safety = server.safety();
@@ -565,6 +604,8 @@ C4gActor::C4gActor(ActorCore& core, c4g::apps::AppSwitch& apps, c4g::host::Serve
             [i](Command& c) { i->stop(c); }});
   core.add({"driveoff", "driveoff (505 now, until the controller shows it)", true, [i](Command& c) { i->drive_off(c); }});
   core.add({"reset", "reset (clears a latched safety fault once obeyed)", true, [i](Command& c) { i->reset(c); }});
+  core.add({"freeze", "freeze (active freezing, 500, once every axis is in mode 0)", true, [i](Command& c) { i->freeze(c); }});
+  core.add({"release", "release (ends the active freezing)", true, [i](Command& c) { i->release(c); }});
   impl_->watcher = std::thread([i] { i->watch(); });
 }
 

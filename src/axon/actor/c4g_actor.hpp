@@ -14,6 +14,7 @@
 //                               cycles, wake-up and reply latency
 //   driveoff                    asks the controller for drive off now (505)
 //   reset                       clears a latched safety fault once the controller obeyed it
+//   freeze | release            active freezing (500) from the next packet in mode 0 / its end
 //
 // and writes unsolicited keywords to every listener from a thread of its own (watch_period_s):
 // mode changes, drives on and off, the app's milestones, its end (finished, stopped, refused with
@@ -24,7 +25,7 @@
 // switch's and the server's atomics and drains the apps' event queues; JSON and the bus stay on
 // the actor's threads. The broker coming and going changes nothing for the controller.
 //
-// start, stop, driveoff and reset are exclusive: one at a time, a second is refused. The switch and
+// start, stop, driveoff, reset, freeze and release are exclusive: one at a time, a second is refused. The switch and
 // the server must outlive the actor; the server must run the switch. The destructor closes the core
 // (later commands are refused), stops the watcher and then the app in force cleanly (as `stop`);
 // it never throws.
