@@ -221,14 +221,14 @@ std::string_view freeze_id(host::FreezeState f) {
 }
 
 Keywords server_json(const host::Server& s) {
-  const auto st = apps::serve_stats(s);
   const auto period = s.period_ns();
+  const auto peer = s.peer();
   return Keywords{{"address", s.local_address().to_string()},
                   {"state", std::string(state_id(s.state()))},
                   {"state_text", std::string(host::to_string(s.state()))},
-                  {"controller", st.controller.empty() ? Keywords(nullptr) : Keywords(st.controller)},
-                  {"sessions", st.sessions},
-                  {"cycles", st.cyclic_packets},
+                  {"controller", peer ? Keywords(peer->to_string()) : Keywords(nullptr)},
+                  {"sessions", s.counters().sessions.load(std::memory_order_relaxed)},
+                  {"cycles", s.counters().cyclic_packets.load(std::memory_order_relaxed)},
                   {"period_ms", period > 0 ? Keywords(static_cast<double>(period) * 1e-6) : Keywords(nullptr)},
                   {"freeze", std::string(freeze_id(s.freeze_state()))}};
 }
