@@ -6,7 +6,8 @@ running this, not by hand:
   dashboard-fps.png   `axon sim fps --layout default --http`: 500 robots while `axon fps plane move`
                       turns every one of them, robot 42's details open
   dashboard-blmc.png  `axon blmc ... --http pd` against `axon sim blmc`: the scopes of a PD sine
-  dashboard-c4g.png   `axon c4g serve --http` against `axon sim c4g`, when this axon has that option
+  dashboard-c4g.png   `axon c4g serve --app stream --mode 4 --http` answering `axon sim c4g`: arm 1 in
+                      mode 4 while the stream plays, the timing histograms
 
 usage: /usr/bin/python3 scripts/screenshots.py [--axon build/release/axon] [--out docs/images]
 Prints one line per file written; exits 1 when a page did not come up.
@@ -101,6 +102,42 @@ def shoot_blmc(axon, driver, progs, out):
     return path
 
 
+# The c4g screenshot's robot program and trajectory: drives on, mode 4 on arm 1 for the 6 s trajectory.
+C4G_PROGRAM = """name: screenshot, mode 4
+steps:
+  - drive_on
+  - delay: 1.0
+  - go_open: {type: A, mode: 4, arms: [1]}
+  - wait_for_pc: {timeout: 30}
+  - exit_open
+"""
+C4G_TRAJECTORY = "# units: deg\nt,j1,j2,j3,j4,j5,j6\n0,0,0,0,0,0,0\n3,10,-5,4,0,6,0\n6,0,0,0,0,0,0\n"
+
+
+def shoot_c4g(axon, driver, progs, out):
+    traj, program = os.path.join(progs.tmp, 'traj.csv'), os.path.join(progs.tmp, 'program.yaml')
+    with open(traj, 'w') as f:
+        f.write(C4G_TRAJECTORY)
+    with open(program, 'w') as f:
+        f.write(C4G_PROGRAM)
+    lines = progs.start('c4g-serve', [axon, 'c4g', 'serve', '--listen', '127.0.0.1:0', '--app', 'stream', '--file', traj,
+                                      '--mode', '4', '--relative', '--status-interval', '0', '--rt-priority', '10',
+                                      '--http', '127.0.0.1:0', '--http-linger', '30'], 'listening http ')
+    port = next(l for l in lines if l.startswith('listening c4g ')).rsplit(':', 1)[1]
+    driver.get(http_of(lines) + '/c4g.html')
+    wait_until('the page connected', lambda: page(driver, "document.getElementById('conn').className") == 'live')
+    # The lenient reply window of one period: a loaded machine must not end the program early.
+    sim = subprocess.Popen([axon, 'sim', 'c4g', '--robot', 'six-axis', '--server', '127.0.0.1:' + port, '--scenario', program,
+                            '--lenient-timing'], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    progs.procs.append(sim)
+    wait_until('arm 1 in mode 4 for 2 s', lambda: page(
+        driver, "(window.axonC4g.state?.axes || []).filter((a) => a.mode === 4 && a.in_mode_s > 2).length") == 6,
+        seconds=60)
+    path = os.path.join(out, 'dashboard-c4g.png')
+    driver.save_screenshot(path)
+    return path
+
+
 def main():
     a = parse()
     os.makedirs(a.out, exist_ok=True)
@@ -108,7 +145,7 @@ def main():
     progs = Programs(tmp)
     driver = start_chromium()
     try:
-        for shoot in (shoot_fps, shoot_blmc):
+        for shoot in (shoot_fps, shoot_blmc, shoot_c4g):
             print(shoot(a.axon, driver, progs, a.out), flush=True)
             progs.stop()
         return 0
