@@ -8,7 +8,7 @@ each answered before the next) with one of the built-in applications.
             seen = controller.wait()
     print(report.stats, seen.joints_deg(1))
 
-The application (Monitor, Echo, Stream, Correct, Pid) is built whole before the server starts,
+The application (Monitor, Echo, Stream, Correct, Pid, Contribute, Handover) is built whole before the server starts,
 its trajectory copied into C++: Python never runs inside the cycle. Angles are degrees on the
 link side, times seconds; motor-side figures are in motor turns.
 """
@@ -16,10 +16,12 @@ link side, times seconds; motor-side figures are in motor turns.
 from ._axon.c4g import (
     App,
     ControllerEvent,
+    Contribute,
     ControllerStats,
     Correct,
     Echo,
     Error,
+    Handover,
     Monitor,
     OpenModeApp,
     Pid,

@@ -7,6 +7,8 @@
 // CLI's Ctrl-C does (the application leaves its open modes, drive off if the controller does not
 // come back to mode 0 in time), then raises KeyboardInterrupt.
 #include "bindings.hpp"
+#include "axon/c4g/apps/contribute.hpp"
+#include "axon/c4g/apps/handover.hpp"
 
 #include "axon/c4g/apps/app_factory.hpp"
 #include "axon/c4g/apps/correct.hpp"
@@ -110,7 +112,7 @@ void bind_apps(py::module_& m) {
 
   py::class_<apps::StreamApp, OpenModeApp, std::shared_ptr<apps::StreamApp>>(m, "Stream", "Mode 4 or 5: a joint trajectory played on one arm.")
       .def(py::init([](const py::object& positions_deg, std::optional<double> dt_s, int mode, std::size_t arm, bool relative,
-                       double start_tolerance_deg, double max_motor_speed, double stop_ramp_s) {
+                       double start_tolerance_deg, double max_motor_speed, double stop_ramp_s, bool rearm) {
              auto c = config("stream");
              c.per_cycle = !dt_s;
              c.trajectory = trajectory_of(positions_deg, "positions_deg", dt_s.value_or(1.0));
@@ -120,23 +122,33 @@ void bind_apps(py::module_& m) {
              c.start_tolerance_deg = start_tolerance_deg;
              c.max_motor_speed = max_motor_speed;
              c.ramp_s = finite_seconds(stop_ramp_s, "stop_ramp_s");
+             c.rearm = rearm;
              return make<apps::StreamApp>(c);
            }),
            py::arg("positions_deg"), py::kw_only(), py::arg("dt_s") = py::none(), py::arg("mode") = 4, py::arg("arm") = 1,
            py::arg("relative") = false, py::arg("start_tolerance_deg") = 0.5, py::arg("max_motor_speed") = 100.0,
-           py::arg("stop_ramp_s") = 0.3,
+           py::arg("stop_ramp_s") = 0.3, py::arg("rearm") = false,
            "positions_deg: (rows, axes) array of joint angles (link side, degrees), one column per axis of the arm. "
            "dt_s=None: one row per controller cycle; else rows dt_s apart, sampled each cycle by linear interpolation. "
            "relative: rows are offsets from where the arm stands (the first row must be 0); else the first row must "
            "match the arm within start_tolerance_deg. max_motor_speed: motor turns/s between two cycles. The table is "
-           "copied: later changes to the array do not reach the app.")
+           "copied: later changes to the array do not reach the app. rearm: play it again at every open phase (the "
+           "program's next GO OPEN), not once.")
       .def_property_readonly("rows", &apps::StreamApp::table_rows, "Cycles the trajectory takes (known once the controller's initialization packet came).")
       .def_property_readonly("progress", &apps::StreamApp::progress, "Rows played so far.");
 
   py::class_<apps::CorrectApp, OpenModeApp, std::shared_ptr<apps::CorrectApp>>(m, "Correct", "Mode 7: a sine correction added to the robot program's path.")
       .def(py::init([](const py::object& amplitude_deg, const py::object& frequency_hz, double open_time_s, double ramp_s,
-                       std::size_t arm, const py::object& max_correction_deg, const py::object& max_step_deg) {
+                       std::size_t arm, const py::object& max_correction_deg, const py::object& max_step_deg,
+                       const std::string& file, const std::string& feed, const std::string& feed_from, std::size_t feed_axes,
+                       double feed_timeout_ms, bool rearm) {
              auto c = config("correct");
+             c.file = file;
+             c.feed = feed;
+             c.feed_from = feed_from;
+             c.feed_axes = feed_axes;
+             c.feed_timeout_ms = feed_timeout_ms;
+             c.rearm = rearm;
              c.amplitude = per_axis(amplitude_deg);
              c.frequency_hz = per_axis(frequency_hz);
              c.open_time_s = finite_seconds(open_time_s, "open_time_s");
@@ -148,9 +160,14 @@ void bind_apps(py::module_& m) {
            }),
            py::kw_only(), py::arg("amplitude_deg") = py::none(), py::arg("frequency_hz") = py::none(), py::arg("open_time_s") = 0.0,
            py::arg("ramp_s") = 0.5, py::arg("arm") = 1, py::arg("max_correction_deg") = py::none(), py::arg("max_step_deg") = py::none(),
-           "amplitude_deg, frequency_hz: one value for every axis or one per axis (link side). open_time_s=0: until the "
-           "session stops. Corrections beyond max_correction_deg (default 5) or steps beyond max_step_deg per cycle "
-           "(default 0.1) are refused.")
+           py::arg("file") = "", py::arg("feed") = "", py::arg("feed_from") = "", py::arg("feed_axes") = 6,
+           py::arg("feed_timeout_ms") = 100.0, py::arg("rearm") = false,
+           "The correction, from one source: a sine (amplitude_deg, frequency_hz: one value for every axis or one per "
+           "axis, link side), a table of correction values (file: CSV, docs/c4g-cli.md), or a live feed of a sensor "
+           "over UDP (feed: HOST:PORT to listen on; feed_from: only that sender; feed_axes values a datagram; a feed "
+           "silent for feed_timeout_ms holds the last correction and is reported). open_time_s=0: until the session "
+           "stops. Corrections beyond max_correction_deg (default 5) or steps beyond max_step_deg per cycle (default "
+           "0.1) are refused. rearm: serve every open phase, not only the first.")
       .def("applied_turns", &apps::CorrectApp::applied, py::arg("axis_index"), "The sum of the increments sent on the arm's axis (0-based), motor turns.");
 
   py::class_<apps::PidApp, OpenModeApp, std::shared_ptr<apps::PidApp>>(m, "Pid", "Modes 1 and 2: the PC closes the arm's loops and sends currents.")
@@ -175,6 +192,56 @@ void bind_apps(py::module_& m) {
            py::arg("ramp_s") = 0.5, py::arg("arm") = 1, py::arg("dynamic_model") = true, py::arg("reduce_in_pc") = false,
            "Gains per axis or one for all: kp [1/s], kv [A per turn/s], ki [1/s] (defaults 20, 0.5, 10). Mode 1 holds the "
            "arm, or swings it by amplitude_deg at frequency_hz; open_time_s=0: until the session stops.");
+
+  py::class_<apps::ContributeApp, OpenModeApp, std::shared_ptr<apps::ContributeApp>>(
+      m, "Contribute", "Modes 8 and 9: a sine added to the controller's own velocity (8) or current (9) references.")
+      .def(py::init([](int mode, const py::object& amplitude, const py::object& frequency_hz, double open_time_s, double ramp_s,
+                       std::size_t arm, double max_motor_speed) {
+             auto c = config("contribute");
+             c.mode = mode;
+             c.amplitude = per_axis(amplitude);
+             c.frequency_hz = per_axis(frequency_hz);
+             c.open_time_s = finite_seconds(open_time_s, "open_time_s");
+             c.ramp_s = finite_seconds(ramp_s, "ramp_s");
+             c.arm = arm;
+             c.max_motor_speed = max_motor_speed;
+             return make<apps::ContributeApp>(c);
+           }),
+           py::kw_only(), py::arg("mode") = 9, py::arg("amplitude") = py::none(), py::arg("frequency_hz") = py::none(),
+           py::arg("open_time_s") = 0.0, py::arg("ramp_s") = 0.5, py::arg("arm") = 1, py::arg("max_motor_speed") = 100.0,
+           "amplitude: per axis or one for all, motor side: turns/s in mode 8, amperes in mode 9 (the server's Safety "
+           "saturates currents to the initialization packet's limits); a mode 8 amplitude above max_motor_speed is "
+           "refused. open_time_s=0: until the session stops.")
+      .def("last", &apps::ContributeApp::last, py::arg("axis_index"), "The contribution sent last on the arm's axis (0-based), in the mode's unit.")
+      .def("peak", &apps::ContributeApp::peak, py::arg("axis_index"), "The largest contribution sent on that axis so far.");
+
+  py::class_<apps::HandoverApp, App, std::shared_ptr<apps::HandoverApp>>(
+      m, "Handover", "The manual's hand-over: a trajectory (or a hold) in modes 4/5, a correction in mode 7, as the program asks.")
+      .def(py::init([](const py::object& positions_deg, std::optional<double> dt_s, bool relative, double start_tolerance_deg,
+                       const py::object& amplitude_deg, const py::object& frequency_hz, const std::string& correct_file,
+                       double hold_s, double ramp_s, std::size_t arm) {
+             auto c = config("handover");
+             if (!positions_deg.is_none()) {
+               c.per_cycle = !dt_s;
+               c.trajectory = trajectory_of(positions_deg, "positions_deg", dt_s.value_or(1.0));
+             }
+             c.relative = relative;
+             c.start_tolerance_deg = start_tolerance_deg;
+             c.amplitude = per_axis(amplitude_deg);
+             c.frequency_hz = per_axis(frequency_hz);
+             c.correct_file = correct_file;
+             c.open_time_s = finite_seconds(hold_s, "hold_s");
+             c.ramp_s = finite_seconds(ramp_s, "ramp_s");
+             c.arm = arm;
+             return make<apps::HandoverApp>(c);
+           }),
+           py::arg("positions_deg") = py::none(), py::kw_only(), py::arg("dt_s") = py::none(), py::arg("relative") = false,
+           py::arg("start_tolerance_deg") = 0.5, py::arg("amplitude_deg") = py::none(), py::arg("frequency_hz") = py::none(),
+           py::arg("correct_file") = "", py::arg("hold_s") = 0.5, py::arg("ramp_s") = 0.5, py::arg("arm") = 1,
+           "Serves whichever open mode the program enters, phase after phase: modes 4/5 play positions_deg (as Stream; "
+           "none: hold the arm for hold_s), mode 7 adds the correction (a sine of amplitude_deg at frequency_hz, or the "
+           "values of correct_file; none: a zero correction for hold_s). Each phase ends with exit from open.")
+      .def_property_readonly("phases", &apps::HandoverApp::phases, "Open phases entered so far.");
 }
 
 void bind_report(py::module_& m) {

@@ -213,3 +213,42 @@ def test_the_docs_quick_start_runs(source_dir):
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, env=env)
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+HANDOVER = open(os.path.join(os.path.dirname(__file__), "..", "..", "data", "c4g", "handover.yaml")).read()
+
+
+def test_handover_plays_the_trajectory_in_mode_4_then_corrects_in_mode_7():
+    positions = raised_cosine(0.4, 0.002, [5.0, -3.0, 2.0, 0, 4.0, 0])
+    positions = np.vstack([positions, positions[::-1]])  # there and back: relative, from 0 to 0
+    app = axon.c4g.Handover(positions, relative=True, amplitude_deg=0.5, frequency_hz=2.0, hold_s=0.3, ramp_s=0.1)
+    report, seen = serve(app, HANDOVER)
+    assert report.reason == "controller ended the exchange (504)", report.text()
+    assert_every_cycle_answered(report, seen)
+    assert app.phases == 2 and app.error is None, report.text()
+
+
+def test_contribute_adds_a_current_sine_in_mode_9():
+    app = axon.c4g.Contribute(mode=9, amplitude=0.2, frequency_hz=2.0, open_time_s=0.5, ramp_s=0.1)
+    report, seen = serve(app, SHORT.replace("mode: 4", "mode: 9"))
+    assert_answered_until_the_server_closed(report, seen)
+    assert app.error is None and report.finished, report.text()
+    assert 0.05 < max(app.peak(j) for j in range(6)) <= 0.2 + 1e-9
+    with pytest.raises(axon.Error):
+        axon.c4g.Contribute(mode=7)
+
+
+def test_a_correction_from_a_table_and_a_rearmed_stream_are_built():
+    import tempfile
+    with tempfile.NamedTemporaryFile("w", suffix=".csv", delete=False) as f:
+        f.write("# units: deg\nt,j1,j2,j3,j4,j5,j6\n0,0,0,0,0,0,0\n0.2,0.1,0,0,0,0,0\n0.4,0,0,0,0,0,0\n")
+    try:
+        app = axon.c4g.Correct(file=f.name)
+        report, seen = serve(app, SHORT.replace("mode: 4", "mode: 7"))
+        assert_answered_until_the_server_closed(report, seen)
+        assert app.error is None and app.runs == 1, report.text()  # the table played in the open phase
+    finally:
+        os.unlink(f.name)
+    assert axon.c4g.Stream(raised_cosine(0.2, 0.002, [1.0, 0, 0, 0, 0, 0]), rearm=True) is not None
+    with pytest.raises(axon.Error):
+        axon.c4g.Correct(file="/nonexistent/corrections.csv")
