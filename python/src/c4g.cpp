@@ -328,7 +328,9 @@ struct Session {
 
 std::unique_ptr<Session> open_session(const std::shared_ptr<App>& app, const std::string& listen, const std::string& controller,
                                       double duration_s, bool until_controller_ends, double stop_timeout_s, int rt_priority,
-                                      bool verify_reply_fields, const std::string& csv, int moni) {
+                                      bool verify_reply_fields, const std::string& csv, int moni, std::size_t samples) {
+  if (samples > 0 && !csv.empty())
+    invalid("samples and csv both take the recorded cycles: give one (the CSV has every cycle too)");
   apps::ServeOptions o;
   o.server.listen = net::parse_endpoint(listen, host::kManualPort).value();
   if (!controller.empty()) o.server.controller = net::parse_endpoint(controller, 0).value();
@@ -342,6 +344,7 @@ std::unique_ptr<Session> open_session(const std::shared_ptr<App>& app, const std
   o.moni = moni;
   auto s = std::make_unique<Session>();
   s->app = app;
+  if (samples > 0) s->app->record_samples(samples);
   py::gil_scoped_release release;
   s->session = std::make_unique<apps::ServeSession>(*s->app, o);
   s->session->start();
@@ -384,6 +387,51 @@ apps::ServeReport run(Session& s, const py::object& until) {
   return *done;
 }
 
+// Server.samples(): what the cycle thread recorded since the last call, as numpy arrays.
+py::dict drain_samples(Session& s) {
+  if (!s.app) throw Exception(Error(CoreErrc::closed, "c4g: the server was closed"));
+  std::vector<apps::Sample> got;
+  {
+    py::gil_scoped_release release;
+    s.app->drain_samples([&got](const apps::Sample& x) { got.push_back(x); });
+  }
+  std::size_t axes = 0;
+  for (const auto& x : got) axes = std::max(axes, std::min(x.request.count, protocol::kMaxAxes));
+  const auto n = static_cast<py::ssize_t>(got.size()), k = static_cast<py::ssize_t>(axes);
+  py::array_t<std::uint64_t> cycle(n);
+  py::array_t<std::int64_t> wall(n);
+  py::array_t<std::int32_t> mode({n, k});
+  py::array_t<float> request({n, k, py::ssize_t{5}}), reply({n, k, py::ssize_t{5}});
+  auto c = cycle.mutable_unchecked<1>();
+  auto w = wall.mutable_unchecked<1>();
+  auto md = mode.mutable_unchecked<2>();
+  auto rq = request.mutable_unchecked<3>();
+  auto rp = reply.mutable_unchecked<3>();
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const auto& x = got[static_cast<std::size_t>(i)];
+    c(i) = x.cycle;
+    w(i) = x.wall_ns;
+    for (py::ssize_t j = 0; j < k; ++j) {
+      const auto& a = x.request.axes[static_cast<std::size_t>(j)];
+      const auto& b = x.reply.axes[static_cast<std::size_t>(j)];
+      md(i, j) = a.mode;
+      const float qa[5] = {a.d1, a.d2, a.d3, a.d4, a.d5}, qb[5] = {b.d1, b.d2, b.d3, b.d4, b.d5};
+      for (py::ssize_t f = 0; f < 5; ++f) {
+        rq(i, j, f) = qa[f];
+        rp(i, j, f) = qb[f];
+      }
+    }
+  }
+  py::dict d;
+  d["cycle"] = cycle;
+  d["wall_ns"] = wall;
+  d["mode"] = mode;
+  d["request"] = request;
+  d["reply"] = reply;
+  d["dropped"] = s.app->samples_dropped();
+  return d;
+}
+
 void bind_server(py::module_& m) {
   py::class_<Session>(m, "Server",
                       "Answers one robot controller with an application, from the first packet on. Construction binds and "
@@ -391,10 +439,12 @@ void bind_server(py::module_& m) {
       .def(py::init(&open_session), py::arg("app"), py::kw_only(), py::arg("listen") = "127.0.0.1:0", py::arg("controller") = "",
            py::arg("duration_s") = 0.0, py::arg("until_controller_ends") = false, py::arg("stop_timeout_s") = 5.0,
            py::arg("rt_priority") = 0, py::arg("verify_reply_fields") = false, py::arg("csv") = "", py::arg("moni") = 0,
+           py::arg("samples") = 0,
            "listen: HOST[:PORT] (a host alone: port 1000; port 0: any free one). controller: only this HOST[:PORT] may "
            "start the session. duration_s: run() ends after this long (0: when the app is done). until_controller_ends: "
            "once the app is done, answer the robot program to its end (504). rt_priority: SCHED_FIFO 1..99 for the cycle "
-           "thread (0: none). csv/moni: record every cycle (docs/c4g-cli.md).")
+           "thread (0: none). csv/moni: record every cycle (docs/c4g-cli.md). samples: keep up to this many cycles "
+           "for samples() (0: none).")
       .def_property_readonly("address", [](const Session& s) { return s.address; }, "HOST:PORT the server answers on.")
       .def_property_readonly("port", [](const Session& s) { return s.port; })
       .def_property_readonly("app", [](const Session& s) { return s.app; })
@@ -407,6 +457,12 @@ void bind_server(py::module_& m) {
         return apps::serve_stats(s.session->server());
       }, "The server's counters and timing figures as they stand (ServeStats), while it runs: read them from "
          "run()'s until callable or another thread; the report has the final ones.")
+      .def("samples", &drain_samples,
+           "The cycles recorded since the last call (Server(..., samples=N) keeps up to N; more are dropped and "
+           "counted in dropped): a dict of numpy arrays, one row a cycle: cycle, wall_ns (the packet's arrival), "
+           "mode (rows, axes) of the request, request and reply (rows, axes, 5): D1..D5 of each axis as the "
+           "packets carry them (the manual's units per mode), and dropped. Call it from one thread (while run() "
+           "runs, from its until callable or another thread; after it, once more for the rest).")
       .def_property_readonly("report", [](const Session& s) { return s.report; }, "The ServeReport once run() ended (also after Ctrl-C), else None.")
       .def("run", &run, py::arg("until") = py::none(),
            "Blocks (GIL released) until the app is done or failed, the controller ends the exchange, duration_s passed, "

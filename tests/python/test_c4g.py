@@ -252,3 +252,25 @@ def test_a_correction_from_a_table_and_a_rearmed_stream_are_built():
     assert axon.c4g.Stream(raised_cosine(0.2, 0.002, [1.0, 0, 0, 0, 0, 0]), rearm=True) is not None
     with pytest.raises(axon.Error):
         axon.c4g.Correct(file="/nonexistent/corrections.csv")
+
+
+def test_samples_give_every_cycle_as_numpy_arrays():
+    positions = raised_cosine(0.6, 0.002, [3.0, 0, 0, 0, 0, 0])
+    app = axon.c4g.Stream(positions, relative=True)
+    taken = []
+    with axon.c4g.Server(app, samples=4096, until_controller_ends=True) as server, \
+            axon.c4g.SimulatedController(server, program=PROGRAM, reply_window="period") as controller:
+        report = server.run(until=lambda: taken.append(server.samples()) and False)
+        taken.append(server.samples())  # the rest, after the run
+        seen = controller.wait(timeout_s=30)
+    assert_every_cycle_answered(report, seen)
+    cycles = np.concatenate([t["cycle"] for t in taken])
+    assert len(cycles) == report.stats.cyclic_packets and taken[-1]["dropped"] == 0, (len(cycles), report.stats)
+    assert np.all(np.diff(cycles) > 0)  # in order, none twice
+    both = [t for t in taken if len(t["cycle"])]
+    mode = np.concatenate([t["mode"] for t in both])
+    reply = np.concatenate([t["reply"] for t in both])
+    assert mode.shape[1] == 6 and reply.shape[1:] == (6, 5)
+    assert (mode[:, 0] == 4).sum() > 200  # the open phase, mode 4 on axis 1
+    with pytest.raises(axon.Error):
+        axon.c4g.Server(axon.c4g.Monitor(), samples=10, csv="/tmp/x.csv")
