@@ -5,6 +5,8 @@ running this, not by hand:
 
   dashboard-fps.png   `axon sim fps --layout default --http`: 500 robots while `axon fps plane move`
                       turns every one of them, robot 42's details open
+  dashboard-fps-replay.png  the same page replaying a plan of `axon fps plan --layout default --to
+                      random` half-way through, robot 42's details open
   dashboard-blmc.png  `axon blmc ... --http pd` against `axon sim blmc`: the scopes of a PD sine
   dashboard-c4g.png   `axon c4g serve --app stream --mode 4 --http` answering `axon sim c4g`: arm 1 in
                       mode 4 while the stream plays, the timing histograms
@@ -83,6 +85,22 @@ def shoot_fps(axon, driver, progs, out):
     return path
 
 
+def shoot_fps_replay(axon, driver, progs, out):
+    plan = os.path.join(progs.tmp, 'plan.json')
+    subprocess.run([axon, 'fps', 'plan', '--layout', 'default', '--to', 'random', '--seed', '5', '-o', plan,
+                    '--allow-partial'], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=120)
+    lines = progs.start('sim-fps', [axon, 'sim', 'fps', '--layout', 'default', '--folded', '--http', '127.0.0.1:0'], 'ready')
+    driver.get(http_of(lines) + '/fps.html')
+    wait_until('500 robots drawn', lambda: page(driver, 'window.axonFps && window.axonFps.drawn.robots') == 500)
+    driver.find_element('id', 'plan-file').send_keys(plan)
+    wait_until('the plan replayed', lambda: page(driver, 'window.axonFps.drawn.source') == 'replay')
+    driver.execute_script('const r = window.axonFps.replay; r.seek(0.45 * r.duration); window.axonFps.selected = 42')
+    wait_until("robot 42's details", lambda: page(driver, "document.getElementById('details').dataset.robot") == '42')
+    path = os.path.join(out, 'dashboard-fps-replay.png')
+    driver.save_screenshot(path)
+    return path
+
+
 def shoot_blmc(axon, driver, progs, out):
     board = os.path.join(progs.tmp, 'board.yaml')
     with open(board, 'w') as f:
@@ -145,7 +163,7 @@ def main():
     progs = Programs(tmp)
     driver = start_chromium()
     try:
-        for shoot in (shoot_fps, shoot_blmc, shoot_c4g):
+        for shoot in (shoot_fps, shoot_fps_replay, shoot_blmc, shoot_c4g):
             print(shoot(a.axon, driver, progs, a.out), flush=True)
             progs.stop()
         return 0

@@ -2,6 +2,8 @@
 // The fps page: the focal plane drawn from the layout (/api/fps/info) with every robot's arms at
 // their live angles and its state, pushed by the server (/ws?source=fps, docs/dashboard.md).
 // window.axonFps holds what the page shows (info, state, what was drawn) for scripts and tests.
+// A plan file (`axon fps plan -o plan.json`) can be loaded and replayed: while it is, the plane is
+// drawn from the plan's trajectories at the replay's time instead of from the live state.
 
 const STATE_COLOURS = {
   'ready': '#2e7d32',
@@ -17,8 +19,22 @@ const fps = {
   state: null,      // the latest state message
   seq: 0,           // its sequence number
   messages: 0,      // state messages received
-  drawn: { seq: 0, robots: 0 },  // what the canvas shows
+  // What the canvas shows: the state's seq, robots drawn, 'live' or 'replay', the replay's time
+  // (null when live) and every drawn robot's [id, alpha, beta] in degrees.
+  drawn: { seq: 0, robots: 0, source: 'live', t: null, angles: [] },
   selected: null,   // id of the robot whose details are shown
+  replay: {
+    active: false,  // drawing from the plan, not from the live state
+    file: null,     // name of the loaded plan file
+    layout: null,   // the plan's layout name
+    duration: 0,    // s: the latest last point of any arm (or the plan's duration_s if later)
+    t: 0,           // s: the replay's time
+    playing: false,
+    speed: 1,       // plan seconds per wall-clock second
+    robots: [],     // the plan's robots that are in the layout: {id, status, alpha, beta} ([deg, s] points)
+    missing: [],    // ids of the plan's robots that are not in the layout (not drawn)
+    absent: [],     // ids of layout robots the plan does not have (not drawn while replaying)
+  },
 };
 window.axonFps = fps;
 
@@ -35,6 +51,7 @@ async function start() {
   $('title').textContent = `${fps.info.layout}, ${fps.info.robots.length} robots`;
   buildLegend();
   $('plane').addEventListener('click', onClick);
+  setUpReplay();
   window.addEventListener('resize', scheduleDraw);
   connect();
 }
@@ -117,20 +134,28 @@ function draw() {
   const ratio = window.devicePixelRatio || 1;
   const w = Math.round(canvas.clientWidth * ratio), h = Math.round(canvas.clientHeight * ratio);
   if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
-  if (!fps.info || !fps.state) return;
+  if (!fps.info) return;
+  const replay = fps.replay;
+  if (replay.active) {
+    const robots = replayPoses(replay.t);
+    drawPlane(canvas, robots, null);
+    $('replay-moving').textContent = robots.filter((r) => r.s === 'moving').length;
+    fps.drawn = { seq: fps.seq, robots: robots.length, source: 'replay', t: replay.t, angles: robots.map((r) => [r.id, r.a, r.b]) };
+  } else if (fps.state) {
+    const robots = fps.state.robots.filter((r) => sites.has(r.id));
+    drawPlane(canvas, robots, fps.state.lock);
+    fps.drawn = { seq: fps.seq, robots: robots.length, source: 'live', t: null, angles: robots.map((r) => [r.id, r.a, r.b]) };
+  }
+}
+
+// The one drawing of the plane, live or replayed: `robots` are {id, a, b, s} (alpha and beta in
+// degrees, a state name for the colour), all in the layout; `lock` the live lock or null.
+function drawPlane(canvas, robots, lock) {
   view = fitView(canvas);
   const ctx = canvas.getContext('2d');
-  ctx.clearRect(0, 0, w, h);
+  ctx.clearRect(0, 0, canvas.width, canvas.height);
   drawFiducials(ctx);
-  const lock = fps.state.lock;
-  let drawn = 0;
-  for (const robot of fps.state.robots) {
-    const site = sites.get(robot.id);
-    if (!site) continue;
-    drawRobot(ctx, site, robot, lock);
-    drawn++;
-  }
-  fps.drawn = { seq: fps.seq, robots: drawn };
+  for (const robot of robots) drawRobot(ctx, sites.get(robot.id), robot, lock);
 }
 
 function drawFiducials(ctx) {
@@ -174,7 +199,7 @@ function drawRobot(ctx, site, robot, lock) {
   ctx.beginPath();
   ctx.arc(view.px(bx), view.py(by), Math.max(1.5, 1.8 * s), 0, 2 * Math.PI);
   ctx.fill();
-  const cause = lock.locked && lock.robot === robot.id;
+  const cause = lock !== null && lock.locked && lock.robot === robot.id;
   if (cause || robot.id === fps.selected) {
     ctx.beginPath();
     ctx.arc(view.px(bx), view.py(by), (site.alpha_mm + site.beta_mm + 1) * s, 0, 2 * Math.PI);
@@ -232,10 +257,200 @@ function showDetails() {
     ['status', `0x${robot.st}`], ['requests', robot.req], ['rejected', robot.rej],
     ['collision reports', robot.col], ['receive overflows', robot.ovf],
   ];
+  const planned = fps.replay.active && fps.replay.robots.find((r) => r.id === robot.id);
+  if (planned) {
+    const t = fps.replay.t;
+    rows.splice(5, 0, ['plan alpha', `${angleAt(planned.alpha, t).toFixed(2)} deg at ${t.toFixed(2)} s`],
+                ['plan beta', `${angleAt(planned.beta, t).toFixed(2)} deg`], ['plan status', planned.status]);
+    rows[3][0] = 'live alpha'; rows[4][0] = 'live beta';
+  }
   const bits = decodeStatus(robot.st).map((b) => `<li title="${b.meaning}">${b.bit} ${b.name}</li>`).join('');
   el.innerHTML = `<table>${rows.map(([k, v]) => `<tr><td>${k}</td><td>${v}</td></tr>`).join('')}</table>` +
                  `<p>status bits set:</p><ul class="bits" id="status-bits">${bits}</ul>`;
   el.dataset.robot = String(robot.id);
 }
+
+// ---- Replaying a plan file ----
+
+// The angle of an arm's [deg, s] points at time t: linear between points, the first angle before
+// the first point and the last after the last (as the positioners run a trajectory).
+function angleAt(points, t) {
+  if (t <= points[0][1]) return points[0][0];
+  const last = points.length - 1;
+  if (t >= points[last][1]) return points[last][0];
+  let lo = 0, hi = last;  // points[lo][1] <= t < points[hi][1]
+  while (hi - lo > 1) {
+    const mid = (lo + hi) >> 1;
+    if (points[mid][1] <= t) lo = mid; else hi = mid;
+  }
+  const [d0, t0] = points[lo], [d1, t1] = points[hi];
+  return d0 + (d1 - d0) * (t - t0) / (t1 - t0);
+}
+
+// Whether the arm turns at time t (inside a segment whose ends differ).
+function turningAt(points, t) {
+  if (t < points[0][1] || t >= points[points.length - 1][1]) return false;
+  for (let i = 1; i < points.length; i++) {
+    if (t < points[i][1]) return points[i][0] !== points[i - 1][0];
+  }
+  return false;
+}
+
+// Every plan robot of the layout at time t, coloured moving while an arm turns, ready otherwise.
+function replayPoses(t) {
+  return fps.replay.robots.map((r) => ({
+    id: r.id, a: angleAt(r.alpha, t), b: angleAt(r.beta, t),
+    s: turningAt(r.alpha, t) || turningAt(r.beta, t) ? 'moving' : 'ready',
+  }));
+}
+
+// The plan document checked: an error message, or null when it can be replayed.
+function planProblem(plan) {
+  if (!plan || typeof plan !== 'object' || plan.format !== 'axon-fps-plan') return 'not an axon fps plan (format is not "axon-fps-plan")';
+  if (!Array.isArray(plan.robots)) return 'the plan has no list "robots"';
+  for (const [n, r] of plan.robots.entries()) {
+    if (!r || !Number.isInteger(r.id)) return `robot entry ${n + 1} has no integer id`;
+    for (const arm of ['alpha', 'beta']) {
+      const pts = r[arm];
+      if (!Array.isArray(pts) || pts.length === 0) return `robot ${r.id}: no ${arm} points`;
+      for (const [i, p] of pts.entries()) {
+        if (!Array.isArray(p) || p.length < 2 || !Number.isFinite(p[0]) || !Number.isFinite(p[1])) {
+          return `robot ${r.id}: ${arm} point ${i + 1} is not [deg, s]`;
+        }
+        if (i > 0 && !(p[1] > pts[i - 1][1])) return `robot ${r.id}: ${arm} point ${i + 1}: time does not increase`;
+      }
+    }
+  }
+  return null;
+}
+
+// Starts replaying `plan` (the parsed file `name`) from its time 0, paused.
+function startReplay(plan, name) {
+  const replay = fps.replay;
+  const inPlan = new Set();
+  replay.robots = [];
+  replay.missing = [];
+  let duration = Number.isFinite(plan.duration_s) ? plan.duration_s : 0;
+  for (const r of plan.robots) {
+    inPlan.add(r.id);
+    if (!sites.has(r.id)) { replay.missing.push(r.id); continue; }
+    replay.robots.push({ id: r.id, status: r.status || '', alpha: r.alpha, beta: r.beta });
+    duration = Math.max(duration, r.alpha[r.alpha.length - 1][1], r.beta[r.beta.length - 1][1]);
+  }
+  replay.absent = fps.info.robots.map((s) => s.id).filter((id) => !inPlan.has(id));
+  replay.file = name;
+  replay.layout = plan.layout || null;
+  replay.duration = duration;
+  replay.active = true;
+  replay.playing = false;
+  $('replay-error').hidden = true;
+  $('replay-controls').hidden = false;
+  $('replay-banner').hidden = false;
+  $('replay-banner').dataset.replaying = 'true';
+  $('replay-name').textContent = name;
+  $('replay-duration').textContent = duration.toFixed(2);
+  const slider = $('replay-slider');
+  slider.max = String(duration);
+  const counts = {};
+  for (const r of replay.robots) counts[r.status] = (counts[r.status] || 0) + 1;
+  const statuses = Object.entries(counts).map(([k, v]) => `${v} ${k || 'no status'}`).join(', ');
+  const layoutNote = replay.layout && replay.layout !== fps.info.layout ? ` (plan made for layout ${replay.layout})` : '';
+  $('replay-info').textContent = `${replay.robots.length} robots replayed${statuses ? `: ${statuses}` : ''}${layoutNote}` +
+    (replay.absent.length ? `; ${replay.absent.length} layout robots not in the plan (not drawn): ${listIds(replay.absent)}` : '');
+  const missing = $('replay-missing');
+  missing.hidden = replay.missing.length === 0;
+  missing.textContent = replay.missing.length ? `${replay.missing.length} plan robots not in this layout (not drawn): ${listIds(replay.missing)}` : '';
+  showPlay();
+  setReplayTime(0);
+}
+
+function listIds(ids) {
+  return ids.length > 20 ? `${ids.slice(0, 20).join(', ')}, ... (${ids.length - 20} more)` : ids.join(', ');
+}
+
+function setReplayTime(t) {
+  const replay = fps.replay;
+  replay.t = Math.min(Math.max(t, 0), replay.duration);
+  $('replay-slider').value = String(replay.t);
+  $('replay-time').textContent = replay.t.toFixed(2);
+  scheduleDraw();
+}
+
+function showPlay() {
+  $('replay-play').textContent = fps.replay.playing ? 'pause' : 'play';
+  for (const b of $('replay-speeds').querySelectorAll('button')) b.className = Number(b.dataset.speed) === fps.replay.speed ? 'on' : '';
+}
+
+let lastFrame = null;  // the previous animation frame's time while playing, ms
+
+function replayFrame(now) {
+  const replay = fps.replay;
+  if (!replay.playing || !replay.active) return;
+  if (lastFrame !== null) setReplayTime(replay.t + replay.speed * (now - lastFrame) / 1000);
+  lastFrame = now;
+  if (replay.t >= replay.duration) { pauseReplay(); return; }
+  requestAnimationFrame(replayFrame);
+}
+
+function playReplay() {
+  const replay = fps.replay;
+  if (!replay.active || replay.playing) return;
+  if (replay.t >= replay.duration) setReplayTime(0);  // play at the end starts again
+  replay.playing = true;
+  lastFrame = null;
+  showPlay();
+  requestAnimationFrame(replayFrame);
+}
+
+function pauseReplay() {
+  fps.replay.playing = false;
+  showPlay();
+}
+
+function backToLive() {
+  const replay = fps.replay;
+  replay.playing = false;
+  replay.active = false;
+  $('replay-controls').hidden = true;
+  $('replay-banner').hidden = true;
+  $('replay-banner').dataset.replaying = 'false';
+  $('plan-file').value = '';
+  scheduleDraw();
+}
+
+function showReplayError(message) {
+  const el = $('replay-error');
+  el.textContent = message;
+  el.hidden = false;
+}
+
+async function loadPlanFile(file) {
+  let plan;
+  try {
+    plan = JSON.parse(await file.text());
+  } catch (error) {
+    showReplayError(`${file.name}: not JSON (${error.message})`);
+    return;
+  }
+  const problem = planProblem(plan);
+  if (problem) { showReplayError(`${file.name}: ${problem}`); return; }
+  startReplay(plan, file.name);
+}
+
+function setUpReplay() {
+  $('plan-file').addEventListener('change', (event) => {
+    const file = event.target.files[0];
+    if (file) loadPlanFile(file);
+  });
+  $('replay-play').addEventListener('click', () => (fps.replay.playing ? pauseReplay() : playReplay()));
+  $('replay-live').addEventListener('click', backToLive);
+  $('replay-slider').addEventListener('input', (event) => setReplayTime(Number(event.target.value)));
+  for (const b of $('replay-speeds').querySelectorAll('button')) {
+    b.addEventListener('click', () => { fps.replay.speed = Number(b.dataset.speed); showPlay(); });
+  }
+}
+
+// For scripts: the replay's controls as functions (the page's buttons and slider call the same).
+Object.assign(fps.replay, { seek: setReplayTime, play: playReplay, pause: pauseReplay, live: backToLive });
 
 start().catch((error) => { $('conn').textContent = `error: ${error}`; });
