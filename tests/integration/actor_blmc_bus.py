@@ -7,12 +7,7 @@ fault whose safety stop a second listener hears with its text, errors and recove
 the idle action (zero current), says so in errors, and answers again. Every reply is checked
 against docs/schema/blmc.json with python3-jsonschema. Skipped only when no broker can start."""
 import json
-import os
-import shutil
-import signal
-import subprocess
 import sys
-import tempfile
 import time
 
 AXON = sys.argv[1]
@@ -21,7 +16,7 @@ ACTOR = 'blmc'
 try:
     import jsonschema  # noqa: F401 (amqp_support needs them; a clear skip without)
     import pika  # noqa: F401
-    from amqp_support import EXCHANGE, Broker, Commander, broker_missing, validator
+    from amqp_support import EXCHANGE, ActorRun, Commander, broker_missing, validator
     import amqp_support
 except ImportError as e:
     print('SKIP: python3-pika and python3-jsonschema are needed (%s)' % e)
@@ -151,20 +146,16 @@ def main():
     if broker_missing():
         print('SKIP: ' + broker_missing())
         return 0
-    tmp = tempfile.mkdtemp(prefix='axon-actor-blmc-')
-    broker = Broker(tmp)
-    actor = None
-    actor_log = open(os.path.join(tmp, 'actor.log'), 'w+')  # a file: a pipe nobody reads would block it
-    try:
+    with ActorRun('axon-actor-blmc-') as run:
         t0 = time.monotonic()
+        broker = run.broker
         up = broker.start()
         if up is None:
-            print('SKIP: rabbitmq-server cannot start here (see %s/server.out)' % tmp)
+            print('SKIP: rabbitmq-server cannot start here (see %s/server.out)' % run.tmp)
             return 0
         print('broker up in %.1f s' % up)
-        actor = subprocess.Popen([AXON, 'actor', 'blmc', '--broker', '127.0.0.1:%d' % broker.port, '--exchange', EXCHANGE,
-                                  '--name', ACTOR, '--status-period', '1', '--no-realtime'],
-                                 stdout=subprocess.PIPE, stderr=actor_log, text=True)
+        run.start_actor([AXON, 'actor', 'blmc', '--broker', '127.0.0.1:%d' % broker.port, '--exchange', EXCHANGE,
+                         '--name', ACTOR, '--status-period', '1', '--no-realtime'])
         c = wait_for_actor(broker.port, 30)
         check_refusals(c)
         check_session(c)
@@ -176,32 +167,11 @@ def main():
         checked += c.checked
         c.close()
 
-        actor.send_signal(signal.SIGINT)
-        actor.communicate(timeout=30)
-        actor_log.seek(0)
-        err = actor_log.read()
-        assert actor.returncode == 0, (actor.returncode, err[-2000:])
+        rc, err = run.stop_actor()
+        assert rc == 0, (rc, err[-2000:])
         assert 'motors disabled' in err and 'broker connection was lost' in err, err[-2000:]
         print('ok: %d replies valid against docs/schema/blmc.json, %.1f s in all' % (checked, time.monotonic() - t0))
         return 0
-    except BaseException:
-        if actor is not None and actor.poll() is None:
-            actor.kill()
-        if actor is not None:
-            actor.communicate()
-            actor_log.seek(0)
-            print('actor stderr (end):\n' + ''.join(actor_log.readlines()[-30:]))
-        with open(os.path.join(tmp, 'server.out')) as f:
-            print('broker output (end):\n' + ''.join(f.readlines()[-20:]))
-        raise
-    finally:
-        if actor is not None and actor.poll() is None:
-            actor.kill()
-            actor.wait()
-        broker.stop()
-        broker.stop_epmd()
-        actor_log.close()
-        shutil.rmtree(tmp, ignore_errors=True)
 
 
 if __name__ == '__main__':

@@ -8,12 +8,7 @@ unknown command, `axon tell c4g status` (human and --json), and the broker stopp
 again while the server goes on answering the controller. Every reply is checked against
 docs/schema/c4g.json with python3-jsonschema. Skipped only when no broker can start at all."""
 import json
-import os
-import shutil
-import signal
-import subprocess
 import sys
-import tempfile
 import time
 
 AXON = sys.argv[1]
@@ -22,7 +17,7 @@ ACTOR = 'c4g'
 try:
     import jsonschema  # noqa: F401 (amqp_support needs them; a clear skip without)
     import pika  # noqa: F401
-    from amqp_support import EXCHANGE, Broker, Commander, broker_missing, validator
+    from amqp_support import EXCHANGE, ActorRun, Commander, broker_missing, validator
     import amqp_support
 except ImportError as e:
     print('SKIP: python3-pika and python3-jsonschema are needed (%s)' % e)
@@ -137,26 +132,21 @@ def main():
     if broker_missing():
         print('SKIP: ' + broker_missing())
         return 0
-    tmp = tempfile.mkdtemp(prefix='axon-actor-c4g-')
-    broker = Broker(tmp)
-    actor = None
-    actor_log = open(os.path.join(tmp, 'actor.log'), 'w+')  # a file: a pipe nobody reads would block it
-    try:
+    with ActorRun('axon-actor-c4g-') as run:
         t0 = time.monotonic()
+        broker = run.broker
         up = broker.start()
         if up is None:
-            print('SKIP: rabbitmq-server cannot start here (see %s/server.out)' % tmp)
+            print('SKIP: rabbitmq-server cannot start here (see %s/server.out)' % run.tmp)
             return 0
         print('broker up in %.1f s' % up)
         # The cycle thread at SCHED_FIFO, as on a robot's PC: on this 2-core machine the broker's own
         # restart (Erlang booting) starved a normal thread for over 20 ms, ten unanswered packets in a
         # row, and the simulated controller raised its communication error. Refused without the rights
         # (a warning): the test then runs at normal priority.
-        actor = subprocess.Popen([AXON, 'actor', 'c4g', '--broker', '127.0.0.1:%d' % broker.port, '--exchange', EXCHANGE,
-                                  '--name', ACTOR, '--listen', '127.0.0.1:0', '--lenient-timing', '--status-period', '1',
-                                  '--rt-priority', '10',
-                                  '--stop-timeout', '3'],
-                                 stdout=subprocess.PIPE, stderr=actor_log, text=True)
+        run.start_actor([AXON, 'actor', 'c4g', '--broker', '127.0.0.1:%d' % broker.port, '--exchange', EXCHANGE,
+                         '--name', ACTOR, '--listen', '127.0.0.1:0', '--lenient-timing', '--status-period', '1',
+                         '--rt-priority', '10', '--stop-timeout', '3'])
         c = amqp_support.wait_for_actor(broker.port, 30, ACTOR, VALIDATOR)
         listener = Commander(broker.port, ACTOR, VALIDATOR)
         check_commands(c, listener, broker.port)
@@ -166,33 +156,12 @@ def main():
         checked += c.checked
         c.close()
 
-        actor.send_signal(signal.SIGINT)
-        actor.communicate(timeout=30)
-        actor_log.seek(0)
-        err = actor_log.read()
-        assert actor.returncode == 0, (actor.returncode, err[-2000:])
+        rc, err = run.stop_actor()
+        assert rc == 0, (rc, err[-2000:])
         assert 'simulated controller:' in err and 'communication error' not in err, err[-2000:]
         print(next(l for l in err.splitlines() if 'simulated controller:' in l))
         print('ok: %d replies valid against docs/schema/c4g.json, %.1f s in all' % (checked, time.monotonic() - t0))
         return 0
-    except BaseException:
-        if actor is not None and actor.poll() is None:
-            actor.kill()
-        if actor is not None:
-            actor.communicate()
-            actor_log.seek(0)
-            print('actor stderr (end):\n' + ''.join(actor_log.readlines()[-20:]))
-        with open(os.path.join(tmp, 'server.out')) as f:
-            print('broker output (end):\n' + ''.join(f.readlines()[-20:]))
-        raise
-    finally:
-        if actor is not None and actor.poll() is None:
-            actor.kill()
-            actor.wait()
-        broker.stop()
-        broker.stop_epmd()
-        actor_log.close()
-        shutil.rmtree(tmp, ignore_errors=True)
 
 
 if __name__ == '__main__':

@@ -8,11 +8,7 @@ Every reply is checked against docs/schema/fps.json with python3-jsonschema. The
 private rabbitmq-server (own node name, ports, data directory, epmd) started once and stopped at the
 end, also on failure; the test is skipped only when no broker can start at all."""
 import json
-import os
-import shutil
-import signal
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -23,7 +19,7 @@ ACTOR = 'fps'
 try:
     import jsonschema  # noqa: F401 (amqp_support needs them; a clear skip without)
     import pika  # noqa: F401
-    from amqp_support import EXCHANGE, Broker, broker_missing, free_port, validator
+    from amqp_support import EXCHANGE, ActorRun, broker_missing, free_port, validator
     import amqp_support
 except ImportError as e:
     print('SKIP: python3-pika and python3-jsonschema are needed (%s)' % e)
@@ -203,22 +199,18 @@ def main():
     if broker_missing():
         print('SKIP: ' + broker_missing())
         return 0
-    tmp = tempfile.mkdtemp(prefix='axon-actor-')
-    broker = Broker(tmp)
-    actor = None
-    actor_log = open(os.path.join(tmp, 'actor.log'), 'w+')  # a file: a pipe nobody reads would block it
-    try:
+    with ActorRun('axon-actor-') as run:
         t0 = time.monotonic()
+        broker = run.broker
         up = broker.start()
         if up is None:
-            print('SKIP: rabbitmq-server cannot start here (see %s/server.out)' % tmp)
+            print('SKIP: rabbitmq-server cannot start here (see %s/server.out)' % run.tmp)
             return 0
         print('broker up in %.1f s' % up)
         p = tell(free_port(), 'ping', timeout_s=1)  # no broker there: an error, exit 1
         assert p.returncode == 1 and 'cannot reach the broker' in p.stderr, (p.returncode, p.stdout, p.stderr)
-        actor = subprocess.Popen([AXON, 'actor', 'fps', '--broker', '127.0.0.1:%d' % broker.port, '--exchange', EXCHANGE,
-                                  '--name', ACTOR, '--status-period', '1', '--time-scale', '20'],
-                                 stdout=subprocess.PIPE, stderr=actor_log, text=True)
+        actor = run.start_actor([AXON, 'actor', 'fps', '--broker', '127.0.0.1:%d' % broker.port, '--exchange', EXCHANGE,
+                                 '--name', ACTOR, '--status-period', '1', '--time-scale', '20'])
         c = wait_for_actor(broker.port, 30)
         check_commands(c, broker.port, actor)
         check_flood(c, actor)
@@ -240,35 +232,13 @@ def main():
         checked += c.checked
         c.close()
 
-        actor.send_signal(signal.SIGINT)
-        actor.communicate(timeout=30)
-        actor_log.seek(0)
-        err = actor_log.read()
-        assert actor.returncode == 0, (actor.returncode, err[-2000:])
+        rc, err = run.stop_actor()
+        assert rc == 0, (rc, err[-2000:])
         assert 'refused' in err, err[-2000:]
         warnings = sum('command refused' in line for line in err.splitlines())
         assert warnings <= 40, '%d refusals logged (the first and every 100th expected)' % warnings
         print('ok: %d replies valid against docs/schema/fps.json, %.1f s in all' % (checked, time.monotonic() - t0))
         return 0
-    except BaseException:
-        if actor is not None and actor.poll() is None:
-            actor.kill()
-        if actor is not None:
-            actor.communicate()
-            actor_log.seek(0)
-            print('actor stderr (end):\n' + ''.join(actor_log.readlines()[-20:]))
-        with open(os.path.join(tmp, 'server.out')) as f:
-            print('broker output (end):\n' + ''.join(f.readlines()[-20:]))
-        raise
-    finally:
-        if actor is not None and actor.poll() is None:
-            actor.kill()
-            actor.wait()
-        broker.stop()
-        broker.stop_epmd()
-        actor_log.close()
-        shutil.rmtree(tmp, ignore_errors=True)
-
 
 if __name__ == '__main__':
     sys.exit(main())

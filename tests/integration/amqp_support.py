@@ -5,9 +5,11 @@ directory and epmd, schedulers that sleep), and a commander written from the SDS
 checked against the actor's JSON schema (docs/schema/<actor>.json)."""
 import json
 import os
+import shutil
 import signal
 import socket
 import subprocess
+import tempfile
 import time
 import uuid
 
@@ -189,3 +191,57 @@ def tell(axon, port, actor, *words, json_out=False, timeout_s=20, exchange=EXCHA
     args = (['ip', 'netns', 'exec', netns] if netns else []) + [axon, 'tell', '--broker', '%s:%d' % (host, port), '--exchange', exchange, '--timeout', str(timeout_s)]
     args += ['--json'] if json_out else []
     return subprocess.run(args + [actor] + list(words), capture_output=True, text=True, timeout=60)
+
+
+class ActorRun:
+    """One actor test's processes: a private broker (`broker`) and one `axon actor` process on it.
+    As a context manager it always cleans up: the actor killed if it still runs, the broker and its
+    epmd stopped, the temporary folder removed; on an exception it first prints the end of the
+    actor's log and of the broker's output."""
+
+    def __init__(self, prefix):
+        self.tmp = tempfile.mkdtemp(prefix=prefix)
+        self.broker = Broker(self.tmp)
+        self.actor = None
+        self.log = open(os.path.join(self.tmp, 'actor.log'), 'w+')  # a file: a pipe nobody reads would block it
+
+    def start_actor(self, args):
+        """Starts `axon actor ...` (stdout a pipe, stderr the log) and returns its process."""
+        self.actor = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=self.log, text=True)
+        return self.actor
+
+    def stop_actor(self, timeout=30):
+        """SIGINT, the way a user ends it; returns (exit code, everything it logged)."""
+        self.actor.send_signal(signal.SIGINT)
+        self.actor.communicate(timeout=timeout)
+        self.log.seek(0)
+        return self.actor.returncode, self.log.read()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, value, traceback):
+        try:
+            if kind is not None:
+                self._report()
+        finally:
+            if self.actor is not None and self.actor.poll() is None:
+                self.actor.kill()
+                self.actor.wait()
+            self.broker.stop()
+            self.broker.stop_epmd()
+            self.log.close()
+            shutil.rmtree(self.tmp, ignore_errors=True)
+        return False
+
+    def _report(self):
+        if self.actor is not None:
+            if self.actor.poll() is None:
+                self.actor.kill()
+            self.actor.communicate()
+            self.log.seek(0)
+            print('actor stderr (end):\n' + ''.join(self.log.readlines()[-30:]))
+        out = os.path.join(self.tmp, 'server.out')
+        if os.path.exists(out):
+            with open(out) as f:
+                print('broker output (end):\n' + ''.join(f.readlines()[-20:]))
