@@ -48,7 +48,10 @@ async function start() {
   const response = await fetch('/api/fps/info');
   fps.info = await response.json();
   for (const r of fps.info.robots) sites.set(r.id, r);
-  $('title').textContent = `${fps.info.layout}, ${fps.info.robots.length} robots`;
+  // The host's view (axon fps plane --http: what the replies say) or the simulator's truth.
+  const kind = fps.info.view === 'host' ? 'host view' : 'simulator';
+  $('title').textContent = `${fps.info.layout}, ${fps.info.robots.length} robots (${kind})`;
+  document.title = `axon fps: ${kind}`;
   buildLegend();
   $('plane').addEventListener('click', onClick);
   setUpReplay();
@@ -101,6 +104,10 @@ function showLock() {
     return;
   }
   const others = lock.collided.filter((id) => id !== lock.robot);
+  if (!lock.robot) {  // the host's lock after a stop without a collision: its reason
+    el.textContent = `LOCKED: ${lock.reason || 'every robot stopped'}`;
+    return;
+  }
   el.textContent = `LOCKED: robot ${lock.robot} (${lock.bus}, ${lock.arm} arm) collided` +
                    (others.length ? `; also collided: ${others.join(', ')}` : '');
 }
@@ -173,6 +180,13 @@ function drawFiducials(ctx) {
 
 function drawRobot(ctx, site, robot, lock) {
   const s = view.scale, rad = Math.PI / 180;
+  if (robot.a === null || robot.b === null) {  // the host has not read its position: its base only
+    ctx.fillStyle = STATE_COLOURS[robot.s] || '#000';
+    ctx.beginPath();
+    ctx.arc(view.px(site.x), view.py(site.y), Math.max(1.5, 1.8 * s), 0, 2 * Math.PI);
+    ctx.fill();
+    return;
+  }
   const a = (site.orientation + robot.a) * rad, b = a + robot.b * rad;
   const bx = site.x, by = site.y;
   const ax = bx + site.alpha_mm * Math.cos(a), ay = by + site.alpha_mm * Math.sin(a);
@@ -251,12 +265,17 @@ function showDetails() {
   const robot = fps.state.robots.find((r) => r.id === fps.selected);
   const site = sites.get(fps.selected);
   if (!robot || !site) return;
+  const angle = (v) => (v === null ? 'not read' : `${v.toFixed(2)} deg`);
+  // Fields one view has and the other not (the simulator's per-robot counters, the host's last
+  // reply and read error) are shown when present.
   const rows = [
     ['robot', robot.id], ['bus', `${site.bus} (sextant ${site.sextant})`], ['state', robot.s],
-    ['alpha', `${robot.a.toFixed(2)} deg`], ['beta', `${robot.b.toFixed(2)} deg`], ['firmware', robot.fw],
+    ['alpha', angle(robot.a)], ['beta', angle(robot.b)], ['firmware', robot.fw || 'unknown'],
     ['status', `0x${robot.st}`], ['requests', robot.req], ['rejected', robot.rej],
     ['collision reports', robot.col], ['receive overflows', robot.ovf],
-  ];
+    ['last reply', robot.ago === undefined ? undefined : (robot.ago === null ? 'none' : `${robot.ago.toFixed(1)} s ago`)],
+    ['last read error', robot.err || undefined],
+  ].filter(([, v]) => v !== undefined);
   const planned = fps.replay.active && fps.replay.robots.find((r) => r.id === robot.id);
   if (planned) {
     const t = fps.replay.t;

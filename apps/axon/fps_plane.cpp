@@ -21,6 +21,8 @@
 #include "layout_name.hpp"
 #include "axon/net/endpoint.hpp"
 #include "axon/core/progress.hpp"
+#include "axon/web/fps_host_view.hpp"
+#include "axon/web/server.hpp"
 #include "run.hpp"
 
 #include <fmt/format.h>
@@ -32,6 +34,7 @@
 #include <boost/asio/this_coro.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -81,6 +84,8 @@ struct PlaneArgs {
   int hall_id = 0;                       // halltest
   host::HallTestOptions hall;            // halltest: step, speed, tolerance
   std::string arm = "both";              // friction, halltest: alpha, beta or both
+  std::string http;                      // the host's view of the plane on HOST:PORT (empty: none)
+  double http_linger_s = 0;              // with --http: keep serving this long after the action
 };
 
 
@@ -125,6 +130,68 @@ host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
   o.sync_hold = to_duration(a.sync_hold_s);
   if (!a.plc.empty()) o.plc = need(net::parse_endpoint(a.plc, 502));
   return o;
+}
+
+// --http: the host's view of the plane (web::FpsHostView) on a web server of its own thread; the
+// view reads and publishes on the array's executor until `alive` turns false, then sets `done`.
+constexpr auto kHostPublishPeriod = std::chrono::milliseconds(200);  // the page: 5 updates a second
+constexpr auto kHostReadPeriod = std::chrono::milliseconds(250);     // a read round at most 4 times a second
+
+struct HostPage {
+  std::unique_ptr<web::Server> server;
+  std::shared_ptr<web::Source> source;
+  std::unique_ptr<web::FpsHostView> view;
+  std::shared_ptr<bool> alive = std::make_shared<bool>(true);
+  bool done = false;
+};
+
+asio::awaitable<void> serve_host_view(HostPage* page) {
+  co_await page->view->run(*page->source, kHostPublishPeriod, kHostReadPeriod, page->alive);
+  page->done = true;
+}
+
+// "PORT" alone listens on the loopback address.
+std::unique_ptr<HostPage> open_host_page(const std::string& address, host::FocalPlaneArray& fpa, asio::any_io_executor ex,
+                                         bool quiet_stdout) {
+  const bool port_only = !address.empty() && std::all_of(address.begin(), address.end(), [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) != 0;
+  });
+  const auto ep = need(net::parse_endpoint(port_only ? "127.0.0.1:" + address : address));
+  web::ServerOptions so;
+  so.address = ep.host;
+  so.port = ep.port;
+  so.push_period = kHostPublishPeriod;
+  auto page = std::make_unique<HostPage>();
+  page->server = std::make_unique<web::Server>(so);
+  page->source = std::make_shared<web::Source>("fps", fmt::format("fps: host view of '{}'", fpa.plane().name()), "fps");
+  page->view = std::make_unique<web::FpsHostView>(fpa);
+  page->source->set_info(page->view->info_json());
+  page->server->add(page->source);
+  std::FILE* out = quiet_stdout ? stderr : stdout;  // --json: stdout carries the one document
+  std::fprintf(out, "listening http %s:%u\n", page->server->address().c_str(), unsigned{page->server->port()});
+  std::fflush(out);
+  asio::co_spawn(ex, serve_host_view(page.get()), asio::detached);
+  return page;
+}
+
+// --http-linger: the view goes on reading and publishing after the action, until the time is up
+// or a stop signal, which is then the normal end (the robots are not moving any more).
+asio::awaitable<void> linger_host_page(double seconds, const SignalHook& on_signal) {
+  const auto stop = std::make_shared<bool>(false);
+  on_signal([stop, on_signal] {
+    on_signal.signal_ends_normally();
+    *stop = true;
+  });
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!*stop && std::chrono::steady_clock::now() < until) co_await core::sleep_for(std::chrono::milliseconds(50));
+}
+
+// What the view may read during an action: nothing during a discovery (it replaces robot handles)
+// or actions whose timing or measurements extra traffic would disturb; everything otherwise.
+web::HostReading reading_for(const std::string& action) {
+  if (action == "status" || action == "check" || action == "upgrade" || action == "friction" || action == "halltest")
+    return web::HostReading::none;
+  return web::HostReading::all;
 }
 
 double phase_s(core::Duration d) { return std::chrono::duration<double>(d).count(); }
@@ -240,7 +307,7 @@ std::size_t approached(const host::TrajectoryReport& rep) {
   return static_cast<std::size_t>(std::count_if(rep.robots.begin(), rep.robots.end(), [](const auto& r) { return r.approached; }));
 }
 
-asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) {
+asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a, web::FpsHostView* view) {
   const auto limits = fps::plan::SpeedLimits::from_motor(a.max_rpm, a.gear_ratio);
   const auto table = co_await fpa.array().status_table(true);
   const double duration_s = move_duration(table, a, limits);
@@ -250,9 +317,17 @@ asio::awaitable<int> plane_move(host::FocalPlaneArray& fpa, const PlaneArgs& a) 
   to.speed_limits = limits;
   to.final_approach = a.approach;
   MoveProgress progress{duration_s, t.size()};
-  to.on_phase = [&progress](std::string_view phase) { progress.started = progress.started || phase == "started"; };
+  to.on_phase = [&progress, view](std::string_view phase) {
+    progress.started = progress.started || phase == "started";
+    // The page's reads: none from the check to the start (the upload is the bus's busiest time),
+    // positions while the robots move (the move polls their status words), everything after.
+    if (view && phase == "started") view->set_reading(web::HostReading::positions);
+    if (view && phase == "finished") view->set_reading(web::HostReading::all);
+  };
+  if (view) view->set_reading(web::HostReading::none);
   asio::co_spawn(co_await asio::this_coro::executor, show_progress(progress), asio::detached);
   auto r = co_await fpa.run_trajectories(std::move(t), to, a.sync);
+  if (view) view->set_reading(web::HostReading::all);
   progress.finished = true;
   while (!progress.done) co_await core::sleep_for(std::chrono::milliseconds(10));
   const auto rep = need(std::move(r));
@@ -409,7 +484,8 @@ asio::awaitable<int> plane_hall_test(host::FocalPlaneArray& fpa, const PlaneArgs
 // One `fps plane` action on the connected plane; returns the exit code.
 asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a, const std::string& action,
                                   const fps::FocalPlane& plane, const SetOnSignal& set_on_signal,
-                                  const std::vector<std::uint8_t>& image, const host::PlaneUpgradeOptions& uo) {
+                                  const std::vector<std::uint8_t>& image, const host::PlaneUpgradeOptions& uo,
+                                  web::FpsHostView* view) {
   int rc = 0;
   if (action == "check") {
     const auto check = co_await fpa.check_layout();
@@ -422,7 +498,7 @@ asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a
     rc = plane_status(fpa, found, a.json);
   } else if (action == "move") {
     stop_robots_on_signal(set_on_signal, fpa.array());
-    rc = co_await plane_move(fpa, a);
+    rc = co_await plane_move(fpa, a, view);
   }
   if (action == "cold") rc = co_await plane_cold(fpa, a, set_on_signal);
   if (action == "backoff") {
@@ -470,10 +546,12 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
     }
     auto connected = co_await host::FocalPlaneArray::connect(ex, plane, array_options(a));
     auto fpa = need(std::move(connected));
+    const auto page = a.http.empty() ? nullptr : open_host_page(a.http, *fpa, ex, a.json);
+    if (page) page->view->set_reading(reading_for(action));
     int rc = 0;
     std::exception_ptr failure;
     try {
-      rc = co_await plane_action(*fpa, a, action, plane, set_on_signal, image, uo);
+      rc = co_await plane_action(*fpa, a, action, plane, set_on_signal, image, uo, page ? page->view.get() : nullptr);
     } catch (...) {
       failure = std::current_exception();  // close first: the robots and connections are left tidy
       // The action's own hook may point into its finished frame (cold's stop flag): a signal
@@ -481,7 +559,14 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
       stop_robots_on_signal(set_on_signal, fpa->array());
     }
     std::fflush(stdout);
+    if (page && !failure && a.http_linger_s > 0) {
+      if (action != "move") page->view->set_reading(web::HostReading::all);  // the action's own traffic is over
+      co_await linger_host_page(a.http_linger_s, set_on_signal);
+      stop_robots_on_signal(set_on_signal, fpa->array());
+    }
+    if (page) *page->alive = false;
     co_await fpa->close();
+    while (page && !page->done) co_await core::sleep_for(std::chrono::milliseconds(10));  // the view reads the array
     set_on_signal([] {});  // the array is closed: a later signal has nothing to stop
     report_signal_stop(fpa->array());
     if (failure) std::rethrow_exception(failure);
@@ -500,6 +585,13 @@ void add_fps_plane_commands(CLI::App& app, GlobalOptions& global) {
   p->add_option("--layout", a.layout, "layout: default, benchtop or FILE (gateway addresses from it)")->required();
   p->add_option("--plc", a.plc, "the PLC at HOST[:PORT] (needed for --sync)");
   p->add_flag("--json", a.json, "check, status, move, backoff, friction, halltest: one JSON document on stdout and nothing else");
+  p->add_option("--http", a.http,
+                "serve the host's view of the plane (what the robots' replies say), /api/state and /metrics on "
+                "HOST:PORT (PORT alone: 127.0.0.1; port 0: any free port, printed as 'listening http HOST:PORT')");
+  p->add_option("--http-linger", a.http_linger_s,
+                "with --http: keep serving (and reading the robots) this many seconds after the action; a stop signal "
+                "ends the wait")
+      ->check(CLI::Range(0.0, 86400.0));
   p->fallthrough();  // --json may also follow the action
   p->add_subcommand("check", "GET_ID on every bus at once, compared with the layout")->callback([args, &global] {
     global.exit_code = run_plane(*args, "check");

@@ -131,7 +131,7 @@ void FpsSimView::update() {
 std::string FpsSimView::info_json() const {
   std::string out;
   auto o = std::back_inserter(out);
-  fmt::format_to(o, "{{\"family\":\"fps\",\"layout\":{},\"pitch_mm\":{},\"robots\":[", json_quote(impl_->plane.name()),
+  fmt::format_to(o, "{{\"family\":\"fps\",\"view\":\"simulator\",\"layout\":{},\"pitch_mm\":{},\"robots\":[", json_quote(impl_->plane.name()),
                  impl_->plane.pitch_mm());
   bool first = true;
   for (auto* m : impl_->simulator.simulator().robots()) {
