@@ -134,7 +134,7 @@ host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
 
 // --http: the host's view of the plane (web::FpsHostView) on a web server of its own thread; the
 // view reads and publishes on the array's executor until `alive` turns false, then sets `done`.
-constexpr auto kHostPublishPeriod = std::chrono::milliseconds(200);  // the page: 5 updates a second
+constexpr auto kHostPublishPeriod = std::chrono::milliseconds(100);  // the page: 10 updates a second
 constexpr auto kHostReadPeriod = std::chrono::milliseconds(250);     // a read round at most 4 times a second
 
 struct HostPage {

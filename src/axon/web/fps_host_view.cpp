@@ -354,8 +354,10 @@ boost::asio::awaitable<void> FpsHostView::run(Source& source, std::chrono::milli
   co_await fhost::for_each_concurrently(2, [self, src, publish_period, read_period, alive](std::size_t i) -> boost::asio::awaitable<void> {
     while (*alive) {
       if (i == 0) {
-        self->publish(*src, 5);  // the metrics once a second at the page's 5 Hz
-        co_await core::sleep_for(publish_period);
+        const auto start = core::steady_now();
+        self->publish(*src);  // the metrics every 10th time
+        const auto spent = core::steady_now() - start;
+        co_await core::sleep_for(spent < publish_period ? publish_period - spent : core::Duration{0});
       } else {
         const auto start = core::steady_now();
         co_await self->read();
