@@ -54,6 +54,7 @@ void StreamApp::setup(const protocol::InitPacket& init, const protocol::AxisMap&
     if (!build(*t.trajectory, t.motor, t.rows)) return set_phase(Phase::refused);
   table_ = tables_.front().motor.data();
   rows_ = tables_.front().rows;
+  rows_shown_.store(rows_, std::memory_order_relaxed);
   hold_cycles_ = static_cast<std::size_t>(std::ceil(options_.hold_s / period - 1e-9));
 }
 
@@ -119,6 +120,7 @@ bool StreamApp::start(std::size_t idx, const protocol::Packet& req, bool from_co
   }
   table_ = t.motor.data();
   rows_ = t.rows;
+  rows_shown_.store(rows_, std::memory_order_relaxed);
   for (std::size_t j = 0; j < n; ++j) {
     if (options_.relative) base_[j] = (from_command ? last_[j] : req.axes[first + j].d3) - table_[j];
     else base_[j] = q0[static_cast<Eigen::Index>(j)];
@@ -252,7 +254,8 @@ void StreamApp::silence() noexcept {
 
 std::string StreamApp::note_text(std::int32_t c) const {
   switch (c) {
-    case kNoteStarted: return fmt::format("stream: trajectory started (mode {}, arm {}, {} cycles)", options_.mode, options_.arm, rows_);
+    case kNoteStarted:
+      return fmt::format("stream: trajectory started (mode {}, arm {}, {} cycles)", options_.mode, options_.arm, table_rows());
     case kNoteEnded: return "stream: trajectory ended, holding the last point";
     case kNoteStopping: return "stream: stop requested, slowing down to rest";
     case kNoteTypeCleared: return "stream: motion type 0: the segments are over, leaving the open mode";
@@ -271,14 +274,16 @@ std::string StreamApp::note_text(std::int32_t c) const {
 std::string StreamApp::status() const {
   const double period = period_.load(std::memory_order_relaxed);
   const std::string_view text = phase() == Phase::idle ? "holding (no segment)" : phase_text();
+  const std::size_t rows = table_rows();
   return App::status() + fmt::format(" {} t={:.3f}/{:.3f} s", text, progress() * period,
-                                     rows_ > 0 ? static_cast<double>(rows_ - 1) * period : 0.0);
+                                     rows > 0 ? static_cast<double>(rows - 1) * period : 0.0);
 }
 
 std::string StreamApp::summary() const {
   const double period = period_.load(std::memory_order_relaxed);
+  const std::size_t rows = table_rows();
   return App::summary() + fmt::format("stream: played {:.3f} s of {:.3f} s, phase {}\n", progress() * period,
-                                      rows_ > 0 ? static_cast<double>(rows_ - 1) * period : 0.0, to_string(phase()));
+                                      rows > 0 ? static_cast<double>(rows - 1) * period : 0.0, to_string(phase()));
 }
 
 }  // namespace axon::c4g::apps

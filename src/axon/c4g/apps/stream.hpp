@@ -79,7 +79,7 @@ class StreamApp final : public OpenModeApp {
   [[nodiscard]] std::string_view name() const noexcept override { return "stream"; }
   [[nodiscard]] std::string status() const override;
   [[nodiscard]] std::string summary() const override;
-  [[nodiscard]] std::size_t table_rows() const noexcept { return rows_; }
+  [[nodiscard]] std::size_t table_rows() const noexcept { return rows_shown_.load(std::memory_order_relaxed); }
   // Motion type of the segment played last (0: none yet, or no segments); any thread.
   [[nodiscard]] std::uint8_t segment() const noexcept { return segment_.load(std::memory_order_relaxed); }
   // Progress through the table in rows (any thread).
@@ -118,7 +118,8 @@ class StreamApp final : public OpenModeApp {
   std::optional<ArmView> view_;
   std::vector<Table> tables_;
   const double* table_ = nullptr;  // the current table
-  std::size_t rows_ = 0;           // its rows
+  std::size_t rows_ = 0;           // its rows (cycle thread)
+  std::atomic<std::size_t> rows_shown_{0};  // the same, for the other threads (status, summary)
   std::atomic<std::uint8_t> segment_{0};
   std::uint8_t type_ = 0;          // motion type seen last (segments)
   bool played_ = false;            // a segment was played in this entry
