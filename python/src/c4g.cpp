@@ -83,6 +83,30 @@ std::vector<double> per_axis(const py::object& values) {
   return std::vector<double>(a.data(), a.data() + a.size());
 }
 
+// {motion type: (rows, axes) array} as the segments of a stream (StreamOptions::segments).
+std::vector<apps::StreamSegment> segments_of(const py::object& segments, std::optional<double> dt_s) {
+  std::vector<apps::StreamSegment> out;
+  if (segments.is_none()) return out;
+  if (!py::isinstance<py::dict>(segments)) invalid("segments: a dict {motion type 1..255: positions_deg array}");
+  for (const auto& [key, table] : segments.cast<py::dict>()) {
+    const auto type = py::isinstance<py::int_>(key) ? key.cast<long>() : 0L;
+    if (type < 1 || type > 255) invalid("segments: each key is a motion type 1..255 (the arm's CMD byte)");
+    const auto what = fmt::format("segments[{}]", type);
+    out.push_back({static_cast<std::uint8_t>(type), trajectory_of(py::reinterpret_borrow<py::object>(table), what.c_str(),
+                                                                  dt_s.value_or(1.0))});
+  }
+  if (out.empty()) invalid("segments: at least one motion type");
+  return out;
+}
+
+// A trajectory or segments (not both) into the config of stream or handover.
+void set_motion(apps::AppConfig& c, const py::object& positions_deg, const py::object& segments, std::optional<double> dt_s) {
+  if (!positions_deg.is_none() && !segments.is_none()) invalid("give positions_deg or segments, not both");
+  c.per_cycle = !dt_s;
+  if (!positions_deg.is_none()) c.trajectory = trajectory_of(positions_deg, "positions_deg", dt_s.value_or(1.0));
+  c.segment_tables = segments_of(segments, dt_s);
+}
+
 void bind_apps(py::module_& m) {
   py::class_<App, std::shared_ptr<App>>(m, "App", "A built-in application: runs on the server's cycle thread once per packet.")
       .def_property_readonly("name", [](const App& a) { return std::string(a.name()); })
@@ -111,11 +135,12 @@ void bind_apps(py::module_& m) {
       .def_property_readonly("echoed", &apps::EchoApp::echoed, "Cycles echoed.");
 
   py::class_<apps::StreamApp, OpenModeApp, std::shared_ptr<apps::StreamApp>>(m, "Stream", "Mode 4 or 5: a joint trajectory played on one arm.")
-      .def(py::init([](const py::object& positions_deg, std::optional<double> dt_s, int mode, std::size_t arm, bool relative,
-                       double start_tolerance_deg, double max_motor_speed, double stop_ramp_s, bool rearm) {
+      .def(py::init([](const py::object& positions_deg, const py::object& segments, std::optional<double> dt_s, int mode,
+                       std::size_t arm, bool relative, double start_tolerance_deg, double max_motor_speed, double stop_ramp_s,
+                       bool rearm) {
              auto c = config("stream");
-             c.per_cycle = !dt_s;
-             c.trajectory = trajectory_of(positions_deg, "positions_deg", dt_s.value_or(1.0));
+             if (positions_deg.is_none() && segments.is_none()) invalid("give positions_deg or segments");
+             set_motion(c, positions_deg, segments, dt_s);
              c.mode = mode;
              c.arm = arm;
              c.relative = relative;
@@ -125,7 +150,8 @@ void bind_apps(py::module_& m) {
              c.rearm = rearm;
              return make<apps::StreamApp>(c);
            }),
-           py::arg("positions_deg"), py::kw_only(), py::arg("dt_s") = py::none(), py::arg("mode") = 4, py::arg("arm") = 1,
+           py::arg("positions_deg") = py::none(), py::kw_only(), py::arg("segments") = py::none(), py::arg("dt_s") = py::none(),
+           py::arg("mode") = 4, py::arg("arm") = 1,
            py::arg("relative") = false, py::arg("start_tolerance_deg") = 0.5, py::arg("max_motor_speed") = 100.0,
            py::arg("stop_ramp_s") = 0.3, py::arg("rearm") = false,
            "positions_deg: (rows, axes) array of joint angles (link side, degrees), one column per axis of the arm. "
@@ -133,9 +159,13 @@ void bind_apps(py::module_& m) {
            "relative: rows are offsets from where the arm stands (the first row must be 0); else the first row must "
            "match the arm within start_tolerance_deg. max_motor_speed: motor turns/s between two cycles. The table is "
            "copied: later changes to the array do not reach the app. rearm: play it again at every open phase (the "
-           "program's next GO OPEN), not once.")
+           "program's next GO OPEN), not once. segments: instead of positions_deg, {motion type: array}: the robot "
+           "program picks the table by the arm's motion type (its CMD byte), each starting with the start-point check "
+           "(relative segments chain from where the last one ended); a motion type without a table holds; motion type 0 "
+           "after a segment ends the stream.")
       .def_property_readonly("rows", &apps::StreamApp::table_rows, "Cycles the trajectory takes (known once the controller's initialization packet came).")
-      .def_property_readonly("progress", &apps::StreamApp::progress, "Rows played so far.");
+      .def_property_readonly("progress", &apps::StreamApp::progress, "Rows played so far.")
+      .def_property_readonly("segment", &apps::StreamApp::segment, "Motion type of the segment played last (0: none yet, or no segments).");
 
   py::class_<apps::CorrectApp, OpenModeApp, std::shared_ptr<apps::CorrectApp>>(m, "Correct", "Mode 7: a sine correction added to the robot program's path.")
       .def(py::init([](const py::object& amplitude_deg, const py::object& frequency_hz, double open_time_s, double ramp_s,
@@ -217,14 +247,11 @@ void bind_apps(py::module_& m) {
 
   py::class_<apps::HandoverApp, App, std::shared_ptr<apps::HandoverApp>>(
       m, "Handover", "The manual's hand-over: a trajectory (or a hold) in modes 4/5, a correction in mode 7, as the program asks.")
-      .def(py::init([](const py::object& positions_deg, std::optional<double> dt_s, bool relative, double start_tolerance_deg,
-                       const py::object& amplitude_deg, const py::object& frequency_hz, const std::string& correct_file,
-                       double hold_s, double ramp_s, std::size_t arm) {
+      .def(py::init([](const py::object& positions_deg, const py::object& segments, std::optional<double> dt_s, bool relative,
+                       double start_tolerance_deg, const py::object& amplitude_deg, const py::object& frequency_hz,
+                       const std::string& correct_file, double hold_s, double ramp_s, std::size_t arm) {
              auto c = config("handover");
-             if (!positions_deg.is_none()) {
-               c.per_cycle = !dt_s;
-               c.trajectory = trajectory_of(positions_deg, "positions_deg", dt_s.value_or(1.0));
-             }
+             set_motion(c, positions_deg, segments, dt_s);
              c.relative = relative;
              c.start_tolerance_deg = start_tolerance_deg;
              c.amplitude = per_axis(amplitude_deg);
@@ -235,10 +262,10 @@ void bind_apps(py::module_& m) {
              c.arm = arm;
              return make<apps::HandoverApp>(c);
            }),
-           py::arg("positions_deg") = py::none(), py::kw_only(), py::arg("dt_s") = py::none(), py::arg("relative") = false,
-           py::arg("start_tolerance_deg") = 0.5, py::arg("amplitude_deg") = py::none(), py::arg("frequency_hz") = py::none(),
+           py::arg("positions_deg") = py::none(), py::kw_only(), py::arg("segments") = py::none(), py::arg("dt_s") = py::none(),
+           py::arg("relative") = false, py::arg("start_tolerance_deg") = 0.5, py::arg("amplitude_deg") = py::none(), py::arg("frequency_hz") = py::none(),
            py::arg("correct_file") = "", py::arg("hold_s") = 0.5, py::arg("ramp_s") = 0.5, py::arg("arm") = 1,
-           "Serves whichever open mode the program enters, phase after phase: modes 4/5 play positions_deg (as Stream; "
+           "Serves whichever open mode the program enters, phase after phase: modes 4/5 play positions_deg or segments (as Stream; "
            "none: hold the arm for hold_s), mode 7 adds the correction (a sine of amplitude_deg at frequency_hz, or the "
            "values of correct_file; none: a zero correction for hold_s). Each phase ends with exit from open.")
       .def_property_readonly("phases", &apps::HandoverApp::phases, "Open phases entered so far.");

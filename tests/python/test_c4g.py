@@ -274,3 +274,41 @@ def test_samples_give_every_cycle_as_numpy_arrays():
     assert (mode[:, 0] == 4).sum() > 200  # the open phase, mode 4 on axis 1
     with pytest.raises(axon.Error):
         axon.c4g.Server(axon.c4g.Monitor(), samples=10, csv="/tmp/x.csv")
+
+
+SEGMENTS_PROGRAM = """steps:
+  - drive_on
+  - cmd: {arm: 1, value: 1}
+  - go_open: {type: A, mode: 4, arms: [1]}
+  - delay: 0.5
+  - cmd: {arm: 1, value: 2}
+  - delay: 0.5
+  - cmd: {arm: 1, value: 7}
+  - delay: 0.2
+  - cmd: {arm: 1, value: 0}
+  - wait_for_pc: {timeout: 10}
+  - exit_open
+"""
+
+
+def test_segments_by_motion_type_are_played_as_the_program_picks_them():
+    out = raised_cosine(0.3, 0.002, [4.0, 0, 0, 2.0, 0, 0])  # motion type 1: out by 4 and 2 deg
+    back = -out                                               # motion type 2: back, from where 1 ended
+    app = axon.c4g.Stream(segments={1: out, 2: back}, relative=True)
+    report, seen = serve(app, SEGMENTS_PROGRAM)
+    assert report.finished and app.error is None, report.text()
+    assert app.segment == 2  # 7 has no table: it held; 0 ended the stream
+    assert_every_cycle_answered(report, seen)
+    np.testing.assert_allclose(seen.joints_deg(1), np.zeros(6), atol=0.05)  # out and back again
+
+
+def test_bad_segments_are_refused_with_the_reason():
+    table = raised_cosine(0.1, 0.002, [1.0, 0, 0, 0, 0, 0])
+    for bad in ({0: table}, {256: table}, {"1": table}, {}, [table], {1: table[0]}):
+        with pytest.raises(axon.Error):
+            axon.c4g.Stream(segments=bad)
+    with pytest.raises(axon.Error, match="not both"):
+        axon.c4g.Stream(table, segments={1: table})
+    with pytest.raises(axon.Error):
+        axon.c4g.Stream()
+    assert axon.c4g.Handover(segments={1: table, 2: table}, relative=True) is not None

@@ -1,5 +1,6 @@
 // StreamApp with trajectory segments chosen by the arm's motion type (CMD byte).
 #include "axon/c4g/apps/stream.hpp"
+#include "axon/c4g/apps/app_factory.hpp"
 
 #include "harness.hpp"
 
@@ -138,4 +139,36 @@ TEST(StreamSegments, RejectsDuplicateMotionTypesAndBothKindsOfInput) {
   StreamOptions both = segments(4);
   both.trajectory = move(1);
   EXPECT_THROW(StreamApp{both}, axon::Exception);
+}
+
+// Segments given as tables (a binding's path through make_app) play as files do; each motion type
+// once, whether it came from a file or a table, and not together with a single trajectory.
+TEST(StreamSegments, TablesThroughTheFactoryAreCheckedAsFilesAre) {
+  AppConfig c;
+  c.app = "stream";
+  c.relative = true;
+  c.segment_tables = {{1, move(4)}, {2, move(-4)}};
+  auto app = make_app(c);
+  Harness h;
+  h.start(*app);
+  h.place_at_link({0, 0, 0, 0, 0, 0});
+  const double start = h.req.axes[0].d3;
+  set_type(h, 1);
+  h.set_modes(code(Mode::mode4));
+  for (int k = 0; k < 80; ++k) h.run(*app);
+  auto* stream = dynamic_cast<StreamApp*>(app.get());
+  ASSERT_NE(stream, nullptr);
+  EXPECT_EQ(stream->segment(), 1);
+  EXPECT_NEAR(h.rep.axes[0].d1 - start, h.motor_axis1(4 * kDeg) - h.motor_axis1(0), 1e-4);
+  EXPECT_FALSE(app->has_error()) << app->error();
+
+  AppConfig twice = c;
+  twice.segment_tables.push_back({2, move(1)});
+  EXPECT_THROW(make_app(twice), axon::Exception);
+  AppConfig both = c;
+  both.trajectory = move(1);
+  EXPECT_THROW(make_app(both), axon::Exception);
+  AppConfig no_type = c;
+  no_type.segment_tables[0].motion_type = 0;
+  EXPECT_THROW(make_app(no_type), axon::Exception);
 }

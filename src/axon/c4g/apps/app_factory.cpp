@@ -49,15 +49,33 @@ StreamSegment parse_segment(const std::string& spec, std::optional<AngleUnit> un
   return {static_cast<std::uint8_t>(type), std::make_shared<Trajectory>(Trajectory::load(spec.substr(eq + 1), unit).value())};
 }
 
+bool has_segments(const AppConfig& c) { return !c.segments.empty() || !c.segment_tables.empty(); }
+bool has_trajectory(const AppConfig& c) { return !c.file.empty() || c.trajectory || has_segments(c); }
+
+// The segments from files and from tables, each motion type once, each with a trajectory.
+std::vector<StreamSegment> segments_of(const AppConfig& c, std::optional<AngleUnit> unit) {
+  std::vector<StreamSegment> all;
+  for (const auto& spec : c.segments) all.push_back(parse_segment(spec, unit));
+  for (const auto& t : c.segment_tables) {
+    if (t.motion_type < 1 || !t.trajectory) throw bad("a segment needs a motion type 1..255 and a trajectory");
+    all.push_back(t);
+  }
+  for (std::size_t i = 0; i < all.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (all[i].motion_type == all[j].motion_type)
+        throw bad(fmt::format("two segments for motion type {}", unsigned{all[i].motion_type}));
+  return all;
+}
+
 StreamOptions stream_options(const AppConfig& c, const std::string& file) {
   const auto unit = unit_of(c);
   StreamOptions s;
-  if (!file.empty() && !c.segments.empty()) throw bad("give --file or --segment, not both");
-  if (c.trajectory && (!file.empty() || !c.segments.empty())) throw bad("give a trajectory or --file/--segment, not both");
+  if (!file.empty() && has_segments(c)) throw bad("give --file or --segment, not both");
+  if (c.trajectory && (!file.empty() || has_segments(c))) throw bad("give a trajectory or --file/--segment, not both");
   if (!file.empty()) s.trajectory = std::make_shared<Trajectory>(Trajectory::load(file, unit).value());
   if (c.trajectory) s.trajectory = c.trajectory;
   s.per_cycle = c.per_cycle;
-  for (const auto& spec : c.segments) s.segments.push_back(parse_segment(spec, unit));
+  s.segments = segments_of(c, unit);
   s.mode = c.mode;
   s.arm = c.arm;
   s.relative = c.relative;
@@ -118,7 +136,7 @@ std::unique_ptr<App> make_handover(const AppConfig& c, const std::function<void(
   HandoverOptions h;
   h.arm = c.arm;
   h.hold_s = c.open_time_s > 0 ? c.open_time_s : 0.5;
-  if (!c.file.empty() || !c.segments.empty() || c.trajectory) h.stream = stream_options(c, c.file);
+  if (has_trajectory(c)) h.stream = stream_options(c, c.file);
   if (!c.correct_file.empty() || !c.feed.empty() || !c.amplitude.empty()) {
     h.correct = correct_options(c, c.correct_file, say);
     if (h.correct->open_time_s <= 0 && !h.correct->values) h.correct->open_time_s = h.hold_s;
@@ -133,7 +151,7 @@ std::unique_ptr<App> make_app(const AppConfig& c, const std::function<void(const
   if (c.app == "monitor") return std::make_unique<MonitorApp>();
   if (c.app == "echo") return std::make_unique<EchoApp>();
   if (c.app == "stream") {
-    if (c.file.empty() && c.segments.empty() && !c.trajectory)
+    if (!has_trajectory(c))
       throw bad("--app stream needs --file TRAJECTORY.csv or --segment N=FILE.csv");
     if (c.mode != 4 && c.mode != 5) throw bad("--app stream: --mode must be 4 or 5");
     auto s = stream_options(c, c.file);

@@ -10,6 +10,7 @@
 
 #include "axon/c4g/apps/app.hpp"
 #include "axon/c4g/apps/correction_limits.hpp"
+#include "axon/c4g/apps/stream.hpp"
 #include "axon/c4g/apps/trajectory.hpp"
 
 #include <functional>
@@ -29,6 +30,9 @@ struct AppConfig {
   bool per_cycle = false;
   std::string correct_file;           // handover: correction values CSV for mode 7
   std::vector<std::string> segments;  // stream/handover: MOTION_TYPE=FILE.csv
+  // stream/handover: segments already in memory (tables from a binding), played as `segments`
+  // (their clocks count cycles with per_cycle); with `segments` files too, each motion type once.
+  std::vector<StreamSegment> segment_tables;
   int mode = 4;                       // stream: 4 or 5; contribute: 8 or 9
   std::string units;                  // angles in the CSV files: rad or deg (empty: the file's)
   bool relative = false;
