@@ -28,6 +28,7 @@ from ._axon.blmc import (
     HomingReport,
     Interrupted,
     InvalidArgument,
+    LoopFigures,
     LoopStats,
     Measurements,
     MotorBoard,

@@ -202,6 +202,20 @@ void bind_report(py::module_& m) {
         return fmt::format("ActionStats(cycles={}, actions={}, idle_cycles={}, stale_cycles={}, stale_episodes={})", a.cycles, a.actions,
                            a.idle_cycles, a.stale_cycles, a.stale_episodes);
       });
+  using blmc::LoopFigures;
+  py::class_<LoopFigures>(m, "LoopFigures",
+                          "The control run's timing so far (seconds), from the loop's records as they are drained "
+                          "(at most 10 ms behind); ControlReport.stats has the exact figures at the end.")
+      .def_readonly("cycles", &LoopFigures::cycles)
+      .def_readonly("overruns", &LoopFigures::overruns, "Cycles that ended after the next cycle's deadline.")
+      .def_readonly("period_max_s", &LoopFigures::period_max_s)
+      .def_readonly("jitter_max_s", &LoopFigures::jitter_max_s, "Largest |period - nominal period|.")
+      .def_readonly("compute_max_s", &LoopFigures::compute_max_s)
+      .def_readonly("running", &LoopFigures::running, "The run has not ended.")
+      .def("__repr__", [](const LoopFigures& f) {
+        return fmt::format("LoopFigures(cycles={}, overruns={}, jitter_max_us={:.0f}, running={})", f.cycles, f.overruns,
+                           f.jitter_max_s * 1e6, f.running ? "True" : "False");
+      });
   py::class_<ControlReport>(m, "ControlReport", "How a control run went.")
       .def_readonly("stats", &ControlReport::stats)
       .def_property_readonly("cycles", [](const ControlReport& r) { return r.stats.cycles; })
@@ -310,6 +324,8 @@ void bind_board_control(py::class_<Board>& c) {
       .def_property_readonly("applied", [](Board& b) { return last_front_end(b).applied(); }, "AppliedAction of the latest cycle.")
       .def_property_readonly("state", [](Board& b) { return last_front_end(b).state(); }, "ControlState of the latest cycle.")
       .def_property_readonly("running", [](Board& b) { return b.get().control_running(); })
+      .def_property_readonly("loop", [](Board& b) { return b.get().loop_figures(); },
+                             "LoopFigures of the run going on (cycles, overruns, jitter so far); after stop(), the last run's.")
       .def("_wait_control", &wait_control, py::arg("duration_s"))
       .def("stop", [](Board& b) {
         auto& m = b.get();

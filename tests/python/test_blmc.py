@@ -82,6 +82,23 @@ def test_a_python_front_end_at_100_hz_drives_the_1_khz_loop_clamped_then_idle(si
     assert board.enabled  # a requested end leaves the motors on, at zero current
 
 
+def test_the_loops_figures_are_read_while_it_runs_and_agree_with_the_report(board):
+    assert board.loop.cycles == 0 and not board.loop.running  # before any run
+    board.start(max_current_a=LIMIT_A, first_action_timeout_s=5.0, **SLACK)
+    board.set_currents([0.1, 0.0])
+    assert wait_until(lambda: board.loop.cycles >= 300)  # about 0.3 s at 1 kHz, counted from Python
+    live = board.loop
+    assert live.running and live.period_max_s > 0 and live.overruns <= live.cycles
+    report = board.stop()
+    done = board.loop
+    assert not done.running and done.cycles >= live.cycles
+    # The drained records are the report's cycles (the loop's last ones drained at the stop).
+    assert report.cycles - 5 <= done.cycles <= report.cycles
+    assert done.overruns <= report.overruns
+    assert done.jitter_max_s <= report.stats.jitter_max_s + 1e-6
+    assert "LoopFigures(cycles=" in repr(done)
+
+
 def test_pd_targets_and_gains_reach_the_back_end(board):
     board.start(**SLACK)
     start = board.state.position_rev

@@ -67,6 +67,28 @@ TEST(BlmcMotorBoard, RunsAPdLawOnBothMotorsAndTheDestructorDisables) {
   expect_board_off(sim);
 }
 
+// The loop's figures while it runs, read from the caller's thread, count up and end at the report's.
+TEST(BlmcMotorBoard, LoopFiguresCountWhileTheLoopRunsAndMatchTheReportAfter) {
+  sim::SimulatedBoard sim(sim_options());
+  MotorBoard board(sim.bus_spec(), board_options());
+  EXPECT_EQ(board.loop_figures().cycles, 0u);
+  board.enable();
+  board.start_control([](const ControlState&) { return Command{}; }, settings());
+  for (int i = 0; i < 500 && board.loop_figures().cycles < 200; ++i) std::this_thread::sleep_for(5ms);
+  const auto live = board.loop_figures();
+  EXPECT_TRUE(live.running);
+  EXPECT_GE(live.cycles, 200u);
+  EXPECT_GT(live.period_max_s, 0.0);
+  const auto report = board.stop_control();
+  const auto done = board.loop_figures();
+  EXPECT_FALSE(done.running);
+  EXPECT_GE(done.cycles, live.cycles);
+  EXPECT_LE(done.cycles, report.stats.cycles);
+  EXPECT_GE(done.cycles + 5, report.stats.cycles);  // every record drained but the last few at most
+  EXPECT_LE(done.overruns, report.stats.overruns);
+  EXPECT_LE(done.jitter_max_s, std::chrono::duration<double>(report.stats.jitter_max).count() + 1e-6);
+}
+
 // A motor that starts just below the board's +100 rev rollover and is driven 0.5 rev on: the
 // host sees 100.3 rev, not -99.7, so the PD law settles there instead of driving the motor on at
 // full current to chase a 200 rev error.

@@ -14,6 +14,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
 #include <condition_variable>
 #include <mutex>
 #include <optional>
@@ -66,11 +68,24 @@ struct ControlRun {
   std::optional<Result<host::ControlOutcome>> outcome;
   std::exception_ptr failure;
   std::optional<host::CycleRecord> last;
+  LoopFigures figures;
+  core::Duration nominal{0};
   std::atomic<bool> stop{false};
   std::unique_ptr<LawController> law;
   std::optional<FrontEnd> front_end;  // when the law is its back end
   std::optional<host::CycleCsv> csv;
 };
+
+// One drained record into the run's live figures (its first record has no period yet).
+void add_to_figures(LoopFigures& f, const host::CycleRecord& rec, core::Duration nominal) {
+  using seconds = std::chrono::duration<double>;
+  f.cycles = rec.cycle + 1;
+  f.overruns = rec.overruns;
+  f.compute_max_s = std::max(f.compute_max_s, seconds(rec.compute).count());
+  if (rec.period <= core::Duration::zero()) return;
+  f.period_max_s = std::max(f.period_max_s, seconds(rec.period).count());
+  f.jitter_max_s = std::max(f.jitter_max_s, std::abs(seconds(rec.period - nominal).count()));
+}
 
 ControlReport to_report(const host::ControlOutcome& o) {
   ControlReport r;
@@ -92,6 +107,7 @@ struct MotorBoard::Impl {
   std::unique_ptr<host::Board> board;
   bool enabled = false;
   std::shared_ptr<ControlRun> run;
+  LoopFigures last_figures;  // the last stopped run's
 
   explicit Impl(MotorBoardOptions o) : options(std::move(o)) {}
   // The loop's thread ends before the bus and the board go (close() ran first, unless the
@@ -181,10 +197,13 @@ void MotorBoard::Impl::start(ControlLaw law, const ControlSettings& settings, co
   if (front_end) r->front_end = *front_end;
   if (!settings.csv.empty()) r->csv.emplace(host::CycleCsv::create(settings.csv).value());
   host::ControlHooks hooks;
+  r->nominal = opts.loop.period;
+  r->figures.running = true;
   hooks.record = [r](const host::CycleRecord& rec) {
     if (r->csv) r->csv->write(rec);
     const std::lock_guard lock(r->mutex);
     r->last = rec;
+    add_to_figures(r->figures, rec, r->nominal);
   };
   hooks.refresh = [r](double, const host::CycleRecord*) {
     const std::lock_guard lock(r->mutex);
@@ -240,6 +259,8 @@ ControlReport MotorBoard::Impl::stop() {
     if (!r->changed.wait_for(lock, std::chrono::seconds(2), [&] { return r->finished; }))
       throw Exception(Error(HostErrc::timeout, fmt::format("{}: the control loop did not stop", options.name)));
   }
+  last_figures = r->figures;
+  last_figures.running = false;
   if (r->failure) std::rethrow_exception(r->failure);
   auto report = to_report(r->outcome->value());
   if (r->front_end) {
@@ -360,6 +381,15 @@ bool MotorBoard::control_running() {
 }
 
 ControlReport MotorBoard::stop_control() { return impl_->stop(); }
+
+LoopFigures MotorBoard::loop_figures() {
+  auto& r = impl_->run;
+  if (!r) return impl_->last_figures;
+  const std::lock_guard lock(r->mutex);
+  auto f = r->figures;
+  f.running = !r->finished;
+  return f;
+}
 
 const char* to_string(ControlEnd e) noexcept {
   switch (e) {

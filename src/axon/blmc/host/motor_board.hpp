@@ -120,6 +120,18 @@ struct ActionStats {
   double first_action_s = -1;        // when it first took an action, since the start (-1: never)
 };
 
+// A control run's timing as it goes, from the loop's records as the event-loop thread drains them
+// (at most ControlSettings::refresh behind the loop; nothing is added to the real-time cycle).
+// ControlReport::stats gives the exact figures, percentiles included, at the end.
+struct LoopFigures {
+  std::uint64_t cycles = 0;
+  std::uint64_t overruns = 0;  // cycles that ended after the next one was due
+  double period_max_s = 0;     // longest start-to-start period
+  double jitter_max_s = 0;     // largest |period - the nominal period|
+  double compute_max_s = 0;    // longest cycle, start to end
+  bool running = false;        // the run has not ended
+};
+
 struct ControlReport {
   host::LoopStats stats;            // cycles, period, jitter, overruns, missed deadlines
   std::optional<host::Fault> fault; // the safety stop that ended the loop, if any
@@ -171,6 +183,8 @@ class MotorBoard {
   void start_control(ControlLaw law, ControlSettings settings = {});
   // False once the loop ended by itself (a safety stop) or was never started.
   [[nodiscard]] bool control_running();
+  // The current run's figures so far; after stop_control, the last run's; zeros before any.
+  [[nodiscard]] LoopFigures loop_figures();
   // Stops the loop (its last frame is IqRef = 0) and tells how it went. The motors stay enabled
   // (at zero current) unless a fault disabled them; disable() or the destructor turns them off.
   ControlReport stop_control();
