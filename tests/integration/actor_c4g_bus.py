@@ -11,19 +11,9 @@ import json
 import sys
 import time
 
+from amqp_support import Actor, restart_broker, run_with_broker
+
 AXON = sys.argv[1]
-ACTOR = 'c4g'
-
-try:
-    import jsonschema  # noqa: F401 (amqp_support needs them; a clear skip without)
-    import pika  # noqa: F401
-    from amqp_support import EXCHANGE, ActorRun, Commander, broker_missing, validator
-    import amqp_support
-except ImportError as e:
-    print('SKIP: python3-pika and python3-jsonschema are needed (%s)' % e)
-    sys.exit(0)
-
-VALIDATOR = validator(ACTOR)
 
 
 def final(replies):
@@ -50,7 +40,7 @@ def changed(broadcasts, frm, to):
     return len(moves) == 6
 
 
-def check_commands(c, listener, port):
+def check_commands(c, listener, actor, port):
     kw = wait_for_modes(c, '4')  # the program's first open phase, held by the monitor
     assert kw['server']['state'] == 'running' and kw['server']['period_ms'] == 2, kw['server']
     assert kw['app'] == dict(kw['app'], name='monitor', installed=False), kw['app']
@@ -96,73 +86,57 @@ def check_commands(c, listener, port):
     assert kw['commands']['not_json'] == 1 and kw['commands']['unknown'] == 1, kw['commands']
 
     # axon tell: human and --json.
-    p = amqp_support.tell(AXON, port, ACTOR, 'status')
+    p = actor.tell(port, 'status')
     assert p.returncode == 0 and 'c4g :' in p.stdout and 'axes=' in p.stdout, (p.returncode, p.stdout, p.stderr)
-    p = amqp_support.tell(AXON, port, ACTOR, 'stats', json_out=True)
+    p = actor.tell(port, 'stats', json_out=True)
     lines = [json.loads(l) for l in p.stdout.splitlines()]
     assert p.returncode == 0 and lines[-1]['message_code'] == ':', (p.returncode, p.stdout, p.stderr)
     for l in lines:
-        assert not list(VALIDATOR.iter_errors(l['keywords'])), l
-    p = amqp_support.tell(AXON, port, ACTOR, 'start', 'nothing')
+        assert not list(actor.validator.iter_errors(l['keywords'])), l
+    p = actor.tell(port, 'start', 'nothing')
     assert p.returncode == 1 and 'c4g f' in p.stdout, (p.returncode, p.stdout, p.stderr)
     assert listener.pump(lambda: any('server' in kw and 'axes' in kw for _, kw in listener.broadcasts), 5), \
         'no periodic status broadcast'
 
 
-def check_broker_loss(c, broker):
+def check_broker_loss(c, broker, actor):
     """The broker goes away for a while: the server answers the controller all along."""
     before = final(c.command('status'))[1]['server']['cycles']
     c.close()
-    broker.stop()
-    t0 = time.monotonic()
-    time.sleep(2)
-    up = broker.start()
-    assert up is not None, 'the broker did not start again'
-    c = amqp_support.wait_for_actor(broker.port, 30, ACTOR, VALIDATOR)
-    away = time.monotonic() - t0
+    c, away = restart_broker(broker, actor, 2.0)
     kw = final(c.command('status'))[1]
     answered = kw['server']['cycles'] - before
     assert kw['server']['state'] == 'running', kw['server']
     assert answered >= 0.5 * away / 0.002, (answered, away)
-    print('broker away %.1f s (restart %.1f s): %d cycles answered meanwhile (%.0f per s)' % (away, up, answered, answered / away))
+    print('broker away %.1f s: %d cycles answered meanwhile (%.0f per s)' % (away, answered, answered / away))
     return c
 
 
-def main():
-    if broker_missing():
-        print('SKIP: ' + broker_missing())
-        return 0
-    with ActorRun('axon-actor-c4g-') as run:
-        t0 = time.monotonic()
-        broker = run.broker
-        up = broker.start()
-        if up is None:
-            print('SKIP: rabbitmq-server cannot start here (see %s/server.out)' % run.tmp)
-            return 0
-        print('broker up in %.1f s' % up)
-        # The cycle thread at SCHED_FIFO, as on a robot's PC: on this 2-core machine the broker's own
-        # restart (Erlang booting) starved a normal thread for over 20 ms, ten unanswered packets in a
-        # row, and the simulated controller raised its communication error. Refused without the rights
-        # (a warning): the test then runs at normal priority.
-        run.start_actor([AXON, 'actor', 'c4g', '--broker', '127.0.0.1:%d' % broker.port, '--exchange', EXCHANGE,
-                         '--name', ACTOR, '--listen', '127.0.0.1:0', '--lenient-timing', '--status-period', '1',
-                         '--rt-priority', '10', '--stop-timeout', '3'])
-        c = amqp_support.wait_for_actor(broker.port, 30, ACTOR, VALIDATOR)
-        listener = Commander(broker.port, ACTOR, VALIDATOR)
-        check_commands(c, listener, broker.port)
-        checked = c.checked + listener.checked
-        listener.close()
-        c = check_broker_loss(c, broker)
-        checked += c.checked
-        c.close()
+def main(run):
+    t0 = time.monotonic()
+    broker, actor = run.broker, Actor(AXON, 'c4g')
+    # The cycle thread at SCHED_FIFO, as on a robot's PC: on this 2-core machine the broker's own
+    # restart (Erlang booting) starved a normal thread for over 20 ms, ten unanswered packets in a
+    # row, and the simulated controller raised its communication error. Refused without the rights
+    # (a warning): the test then runs at normal priority.
+    run.start_actor(actor.args('c4g', broker.port, '--listen', '127.0.0.1:0', '--lenient-timing', '--status-period', '1',
+                               '--rt-priority', '10', '--stop-timeout', '3'))
+    c = actor.wait(broker.port)
+    listener = actor.commander(broker.port)
+    check_commands(c, listener, actor, broker.port)
+    checked = c.checked + listener.checked
+    listener.close()
+    c = check_broker_loss(c, broker, actor)
+    checked += c.checked
+    c.close()
 
-        rc, err = run.stop_actor()
-        assert rc == 0, (rc, err[-2000:])
-        assert 'simulated controller:' in err and 'communication error' not in err, err[-2000:]
-        print(next(l for l in err.splitlines() if 'simulated controller:' in l))
-        print('ok: %d replies valid against docs/schema/c4g.json, %.1f s in all' % (checked, time.monotonic() - t0))
-        return 0
+    rc, err = run.stop_actor()
+    assert rc == 0, (rc, err[-2000:])
+    assert 'simulated controller:' in err and 'communication error' not in err, err[-2000:]
+    print(next(l for l in err.splitlines() if 'simulated controller:' in l))
+    print('ok: %d replies valid against docs/schema/c4g.json, %.1f s in all' % (checked, time.monotonic() - t0))
+    return 0
 
 
 if __name__ == '__main__':
-    sys.exit(main())
+    sys.exit(run_with_broker('axon-actor-c4g-', main))

@@ -13,30 +13,12 @@ import sys
 import tempfile
 import time
 
+from amqp_support import Actor, free_port, restart_broker, run_with_broker
+
 AXON = sys.argv[1]
-ACTOR = 'fps'
-
-try:
-    import jsonschema  # noqa: F401 (amqp_support needs them; a clear skip without)
-    import pika  # noqa: F401
-    from amqp_support import EXCHANGE, ActorRun, broker_missing, free_port, validator
-    import amqp_support
-except ImportError as e:
-    print('SKIP: python3-pika and python3-jsonschema are needed (%s)' % e)
-    sys.exit(0)
-
-VALIDATOR = validator(ACTOR)
 
 
-def wait_for_actor(port, timeout):
-    return amqp_support.wait_for_actor(port, timeout, ACTOR, VALIDATOR)
-
-
-def tell(port, *words, json_out=False, actor=ACTOR, timeout_s=20):
-    return amqp_support.tell(AXON, port, actor, *words, json_out=json_out, timeout_s=timeout_s)
-
-
-def check_commands(c, port, actor_proc):
+def check_commands(c, actor, port, actor_proc):
     status = c.command('status')
     assert status[-1][0] == ':', status
     robots = status[-1][1]['robots']
@@ -54,7 +36,7 @@ def check_commands(c, port, actor_proc):
         r = c.command(body=body)
         assert r[-1][0] == 'f' and reason in r[-1][1]['error'], r
     r = c.command('get_schema')  # clu's built-in: the keyword schema as JSON text, the one shipped in docs/
-    assert r[-1][0] == ':' and json.loads(r[-1][1]['schema']) == VALIDATOR.schema, r[-1][1].keys()
+    assert r[-1][0] == ':' and json.loads(r[-1][1]['schema']) == actor.validator.schema, r[-1][1].keys()
     r = c.command('fly 3')
     assert r[-1][0] == 'f' and 'unknown command' in r[-1][1]['error'], r
     r = c.command('goto %d ninety 170' % ids[0])
@@ -81,18 +63,18 @@ def check_commands(c, port, actor_proc):
     assert c.command('unlock')[-1][0] == ':'
 
     # axon tell: human and --json, exit status from the final code.
-    p = tell(port, 'status')
+    p = actor.tell(port, 'status')
     assert p.returncode == 0 and 'fps :' in p.stdout and 'robots=' in p.stdout, (p.returncode, p.stdout, p.stderr)
-    p = tell(port, 'goto', str(ids[2]), '45', '160', json_out=True)
+    p = actor.tell(port, 'goto', str(ids[2]), '45', '160', json_out=True)
     lines = [json.loads(l) for l in p.stdout.splitlines()]
     assert p.returncode == 0 and lines[-1]['message_code'] == ':', (p.returncode, p.stdout, p.stderr)
     for l in lines:
-        assert not list(VALIDATOR.iter_errors(l['keywords'])), l
-    p = tell(port, 'fly')
+        assert not list(actor.validator.iter_errors(l['keywords'])), l
+    p = actor.tell(port, 'fly')
     assert p.returncode == 1 and 'unknown command' in p.stdout, (p.returncode, p.stdout, p.stderr)
-    p = tell(port, 'goto', str(ids[2]), '-45', '160')  # everything after the actor is the command
+    p = actor.tell(port, 'goto', str(ids[2]), '-45', '160')  # everything after the actor is the command
     assert p.returncode == 1 and 'fps f' in p.stdout, (p.returncode, p.stdout, p.stderr)
-    p = tell(port, 'status', actor='nobody')
+    p = actor.tell(port, 'status', actor='nobody')
     assert p.returncode == 1 and 'no actor "nobody"' in p.stdout, (p.returncode, p.stdout, p.stderr)
 
     # A collision: the alert reaches every listener (this client is one), moves are refused until unlock.
@@ -195,50 +177,36 @@ def round_trip_ms(c, text, n=100):
     return statistics.median(times)
 
 
-def main():
-    if broker_missing():
-        print('SKIP: ' + broker_missing())
-        return 0
-    with ActorRun('axon-actor-') as run:
-        t0 = time.monotonic()
-        broker = run.broker
-        up = broker.start()
-        if up is None:
-            print('SKIP: rabbitmq-server cannot start here (see %s/server.out)' % run.tmp)
-            return 0
-        print('broker up in %.1f s' % up)
-        p = tell(free_port(), 'ping', timeout_s=1)  # no broker there: an error, exit 1
-        assert p.returncode == 1 and 'cannot reach the broker' in p.stderr, (p.returncode, p.stdout, p.stderr)
-        actor = run.start_actor([AXON, 'actor', 'fps', '--broker', '127.0.0.1:%d' % broker.port, '--exchange', EXCHANGE,
-                                 '--name', ACTOR, '--status-period', '1', '--time-scale', '20'])
-        c = wait_for_actor(broker.port, 30)
-        check_commands(c, broker.port, actor)
-        check_flood(c, actor)
-        ping_ms, status_ms = round_trip_ms(c, 'ping'), round_trip_ms(c, 'status')
-        print('round trip over the broker, median of 100: ping %.2f ms, status %.2f ms' % (ping_ms, status_ms))
-        checked = c.checked
-        c.close()
+def main(run):
+    t0 = time.monotonic()
+    broker, actor = run.broker, Actor(AXON, 'fps')
+    p = actor.tell(free_port(), 'ping', timeout_s=1)  # no broker there: an error, exit 1
+    assert p.returncode == 1 and 'cannot reach the broker' in p.stderr, (p.returncode, p.stdout, p.stderr)
+    proc = run.start_actor(actor.args('fps', broker.port, '--status-period', '1', '--time-scale', '20'))
+    c = actor.wait(broker.port)
+    check_commands(c, actor, broker.port, proc)
+    check_flood(c, proc)
+    ping_ms, status_ms = round_trip_ms(c, 'ping'), round_trip_ms(c, 'status')
+    print('round trip over the broker, median of 100: ping %.2f ms, status %.2f ms' % (ping_ms, status_ms))
+    checked = c.checked
+    c.close()
 
-        # The broker goes away and comes back: the same actor process answers again.
-        broker.stop()
-        time.sleep(0.5)
-        assert actor.poll() is None, 'the actor ended when the broker went away'
-        up = broker.start()
-        assert up is not None, 'the broker did not start again'
-        print('broker restarted in %.1f s' % up)
-        c = wait_for_actor(broker.port, 30)
-        r = c.command('status')
-        assert r[-1][0] == ':' and len(r[-1][1]['robots']) == 6, r
-        checked += c.checked
-        c.close()
+    # The broker goes away and comes back: the same actor process answers again.
+    c, _ = restart_broker(broker, actor, 0.5)
+    assert proc.poll() is None, 'the actor ended when the broker went away'
+    r = c.command('status')
+    assert r[-1][0] == ':' and len(r[-1][1]['robots']) == 6, r
+    checked += c.checked
+    c.close()
 
-        rc, err = run.stop_actor()
-        assert rc == 0, (rc, err[-2000:])
-        assert 'refused' in err, err[-2000:]
-        warnings = sum('command refused' in line for line in err.splitlines())
-        assert warnings <= 40, '%d refusals logged (the first and every 100th expected)' % warnings
-        print('ok: %d replies valid against docs/schema/fps.json, %.1f s in all' % (checked, time.monotonic() - t0))
-        return 0
+    rc, err = run.stop_actor()
+    assert rc == 0, (rc, err[-2000:])
+    assert 'refused' in err, err[-2000:]
+    warnings = sum('command refused' in line for line in err.splitlines())
+    assert warnings <= 40, '%d refusals logged (the first and every 100th expected)' % warnings
+    print('ok: %d replies valid against docs/schema/fps.json, %.1f s in all' % (checked, time.monotonic() - t0))
+    return 0
+
 
 if __name__ == '__main__':
-    sys.exit(main())
+    sys.exit(run_with_broker('axon-actor-', main))

@@ -18,14 +18,8 @@ import time
 AXON = sys.argv[1]
 HERE = os.path.dirname(os.path.abspath(__file__))
 
-try:
-    import jsonschema  # noqa: F401 (amqp_support needs them; a clear skip without)
-    import pika  # noqa: F401
-    import amqp_support
-    from amqp_support import EXCHANGE, Broker, broker_missing, validator
-except ImportError as e:
-    print('SKIP: python3-pika and python3-jsonschema are needed (%s)' % e)
-    sys.exit(0)
+import amqp_support
+from amqp_support import EXCHANGE, Broker, broker_missing, validator
 
 ACTORS = ('fps', 'blmc', 'c4g')
 # Each actor's own options: the c4g simulator's reply window is the lenient one (a loaded machine
@@ -166,8 +160,9 @@ def run(net, tmp, procs):
 
 
 def main():
-    if broker_missing():
-        print('SKIP: ' + broker_missing())
+    why = amqp_support.MISSING_LIBRARIES or broker_missing()
+    if why:
+        print('SKIP: ' + why)
         return 0
     tmp = tempfile.mkdtemp(prefix='axon-netns-')
     net, procs = Network(), []

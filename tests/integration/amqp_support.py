@@ -13,7 +13,13 @@ import tempfile
 import time
 import uuid
 
-import pika
+try:
+    import jsonschema  # noqa: F401 (validator() uses it)
+    import pika
+    MISSING_LIBRARIES = None
+except ImportError as e:  # run_with_broker() says so and skips
+    pika = None
+    MISSING_LIBRARIES = 'python3-pika and python3-jsonschema are needed (%s)' % e
 
 SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 RABBITMQ_SERVER = '/usr/lib/rabbitmq/bin/rabbitmq-server'
@@ -164,6 +170,18 @@ class Commander:
     def command(self, text=None, body=None, timeout=30):
         return self.wait(self.send(text, body), timeout)
 
+    def expect_done(self, text, timeout=30):
+        """The command's keywords; asserts that it ended in ':'."""
+        r = self.command(text, timeout=timeout)
+        assert r[-1][0] == ':', (text, r)
+        return r[-1][1]
+
+    def expect_failed(self, text=None, body=None):
+        """The reason of a command that must fail ('f' with an error)."""
+        r = self.command(text, body=body)
+        assert r[-1][0] == 'f' and r[-1][1]['error'], (text, body, r)
+        return r[-1][1]['error']
+
     def close(self):
         try:
             self.conn.close()
@@ -191,6 +209,61 @@ def tell(axon, port, actor, *words, json_out=False, timeout_s=20, exchange=EXCHA
     args = (['ip', 'netns', 'exec', netns] if netns else []) + [axon, 'tell', '--broker', '%s:%d' % (host, port), '--exchange', exchange, '--timeout', str(timeout_s)]
     args += ['--json'] if json_out else []
     return subprocess.run(args + [actor] + list(words), capture_output=True, text=True, timeout=60)
+
+
+class Actor:
+    """One actor under test: its name (its queue, its replies' sender) and its schema, for the calls
+    that talk to it."""
+
+    def __init__(self, axon, name, schema=None):
+        self.axon, self.name = axon, name
+        self.validator = validator(schema or name)
+
+    def args(self, family, port, *more):
+        """The `axon actor FAMILY` command line on the private broker's port."""
+        return [self.axon, 'actor', family, '--broker', '127.0.0.1:%d' % port, '--exchange', EXCHANGE,
+                '--name', self.name] + list(more)
+
+    def wait(self, port, timeout=30, host='127.0.0.1'):
+        """A commander, once the actor answers ping."""
+        return wait_for_actor(port, timeout, self.name, self.validator, host=host)
+
+    def commander(self, port):
+        return Commander(port, self.name, self.validator)
+
+    def tell(self, port, *words, json_out=False, timeout_s=20, actor=None):
+        """`axon tell` (to this actor unless `actor` says another) as a finished process."""
+        return tell(self.axon, port, actor or self.name, *words, json_out=json_out, timeout_s=timeout_s)
+
+
+def restart_broker(broker, actor, pause_s):
+    """The broker goes away for `pause_s` and comes back; returns (a commander once the actor
+    answers again, seconds from the stop to that answer)."""
+    broker.stop()
+    t0 = time.monotonic()
+    time.sleep(pause_s)
+    up = broker.start()
+    assert up is not None, 'the broker did not start again'
+    print('broker restarted in %.1f s' % up)
+    c = actor.wait(broker.port, 30)
+    return c, time.monotonic() - t0
+
+
+def run_with_broker(prefix, body):
+    """The frame of every actor test: skip (exit 0, saying why) without the libraries or a broker
+    that can start; else body(run) with run.broker up, in an ActorRun that always cleans up.
+    Returns the exit code."""
+    why = MISSING_LIBRARIES or broker_missing()
+    if why:
+        print('SKIP: ' + why)
+        return 0
+    with ActorRun(prefix) as run:
+        up = run.broker.start()
+        if up is None:
+            print('SKIP: rabbitmq-server cannot start here (see %s/server.out)' % run.tmp)
+            return 0
+        print('broker up in %.1f s' % up)
+        return body(run)
 
 
 class ActorRun:
