@@ -24,7 +24,7 @@ import time
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..'))
 sys.path.insert(0, os.path.join(ROOT, 'tests', 'integration', 'helpers'))
-from browser import page, start_chromium, wait_until  # noqa: E402
+from browser import http_url, page, start_chromium, start_program, wait_until  # noqa: E402
 
 
 def parse():
@@ -43,14 +43,12 @@ class Programs:
     def start(self, name, args, until):
         """Starts `args`, logging to TMP/NAME.log; returns the stdout lines up to one starting with `until`."""
         log = open(os.path.join(self.tmp, name + '.err'), 'w')
-        p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=log, text=True)
+        try:
+            p, lines = start_program(args, until, stderr=log)
+        except AssertionError as e:
+            raise AssertionError('%s; its log: %s' % (e, log.name))
         self.procs.append(p)
-        lines = []
-        for line in p.stdout:
-            lines.append(line.rstrip('\n'))
-            if line.startswith(until):
-                return lines
-        raise AssertionError('%s ended before printing %r; its log: %s' % (name, until, log.name))
+        return lines
 
     def stop(self):
         for p in reversed(self.procs):
@@ -64,14 +62,10 @@ class Programs:
         self.procs = []
 
 
-def http_of(lines):
-    return 'http://' + next(l.split()[2] for l in lines if l.startswith('listening http '))
-
-
 def shoot_fps(axon, driver, progs, out):
     lines = progs.start('sim-fps', [axon, 'sim', 'fps', '--layout', 'default', '--folded', '--http', '127.0.0.1:0',
                                     '--write-layout', os.path.join(progs.tmp, 'live.yaml')], 'ready')
-    driver.get(http_of(lines) + '/fps.html')
+    driver.get(http_url(lines) + '/fps.html')
     wait_until('500 robots drawn', lambda: page(driver, 'window.axonFps && window.axonFps.drawn.robots') == 500)
     move = subprocess.Popen([axon, 'fps', 'plane', '--layout', os.path.join(progs.tmp, 'live.yaml'), 'move', '--alpha',
                              '60', '--beta', '150', '--duration', '8'], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -90,7 +84,7 @@ def shoot_fps_replay(axon, driver, progs, out):
     subprocess.run([axon, 'fps', 'plan', '--layout', 'default', '--to', 'random', '--seed', '5', '-o', plan,
                     '--allow-partial'], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=120)
     lines = progs.start('sim-fps', [axon, 'sim', 'fps', '--layout', 'default', '--folded', '--http', '127.0.0.1:0'], 'ready')
-    driver.get(http_of(lines) + '/fps.html')
+    driver.get(http_url(lines) + '/fps.html')
     wait_until('500 robots drawn', lambda: page(driver, 'window.axonFps && window.axonFps.drawn.robots') == 500)
     driver.find_element('id', 'plan-file').send_keys(plan)
     wait_until('the plan replayed', lambda: page(driver, 'window.axonFps.drawn.source') == 'replay')
@@ -111,7 +105,7 @@ def shoot_blmc(axon, driver, progs, out):
     lines = progs.start('blmc', [axon, 'blmc', '--socketcand', '127.0.0.1:%s/can0' % port, '--no-realtime', '--stale-ms',
                                  '1000', '--recv-timeout-ms', '0', '--http', '127.0.0.1:0', '--http-linger', '30', 'pd',
                                  '--amplitude', '0.5', '--frequency', '0.5', '--duration', '20'], 'listening http ')
-    driver.get(http_of(lines) + '/blmc.html')
+    driver.get(http_url(lines) + '/blmc.html')
     wait_until('scopes with 6 s of samples', lambda: (page(
         driver, "window.axonBlmc && window.axonBlmc.state && window.axonBlmc.state.boards[0].samples.n") or 0) >= 300,
         seconds=60)
@@ -142,7 +136,7 @@ def shoot_c4g(axon, driver, progs, out):
                                       '--mode', '4', '--relative', '--status-interval', '0', '--rt-priority', '10',
                                       '--http', '127.0.0.1:0', '--http-linger', '30'], 'listening http ')
     port = next(l for l in lines if l.startswith('listening c4g ')).rsplit(':', 1)[1]
-    driver.get(http_of(lines) + '/c4g.html')
+    driver.get(http_url(lines) + '/c4g.html')
     wait_until('the page connected', lambda: page(driver, "document.getElementById('conn').className") == 'live')
     # The lenient reply window of one period: a loaded machine must not end the program early.
     sim = subprocess.Popen([axon, 'sim', 'c4g', '--robot', 'six-axis', '--server', '127.0.0.1:' + port, '--scenario', program,

@@ -13,11 +13,10 @@ import sys
 import tempfile
 import time
 
-from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), 'helpers'))
-from browser import page, start_chromium, wait_until  # noqa: E402
+from browser import click_robot, http_url, page, start_chromium, start_program, wait_until  # noqa: E402
 
 AXON = sys.argv[1]
 COLLIDER = 100  # robot that reports a collision the first time it moves
@@ -26,22 +25,12 @@ COLLIDER = 100  # robot that reports a collision the first time it moves
 def start(tmp):
     with open(os.path.join(tmp, 'scenario.yaml'), 'w') as f:
         f.write('collide_on_move: [%d]\n' % COLLIDER)
-    sim = subprocess.Popen([AXON, 'sim', 'fps', '--layout', 'default', '--folded', '--scenario', os.path.join(tmp, 'scenario.yaml'),
-                            '--write-layout', os.path.join(tmp, 'live.yaml')], stdout=subprocess.PIPE,
-                           stderr=subprocess.DEVNULL, text=True)
-    for line in sim.stdout:
-        if line.strip() == 'ready':
-            break
-    host = subprocess.Popen([AXON, 'fps', 'plane', '--layout', os.path.join(tmp, 'live.yaml'), '--http', '127.0.0.1:0',
-                             '--http-linger', '60', 'move', '--alpha', '20', '--beta', '170', '--duration', '3'],
-                            stdout=subprocess.PIPE, stderr=open(os.path.join(tmp, 'host.err'), 'w'), text=True)
-    url = None
-    for line in host.stdout:
-        if line.startswith('listening http '):
-            url = 'http://' + line.split()[2]
-            break
-    assert url, 'no "listening http" line'
-    return sim, host, url
+    sim, _ = start_program([AXON, 'sim', 'fps', '--layout', 'default', '--folded', '--scenario', os.path.join(tmp, 'scenario.yaml'),
+                            '--write-layout', os.path.join(tmp, 'live.yaml')], 'ready', stderr=subprocess.DEVNULL)
+    host, lines = start_program([AXON, 'fps', 'plane', '--layout', os.path.join(tmp, 'live.yaml'), '--http', '127.0.0.1:0',
+                                 '--http-linger', '60', 'move', '--alpha', '20', '--beta', '170', '--duration', '3'],
+                                'listening http ', stderr=open(os.path.join(tmp, 'host.err'), 'w'))
+    return sim, host, http_url(lines)
 
 
 def check_page(driver):
@@ -55,12 +44,7 @@ def check_page(driver):
 
 
 def check_details(driver):
-    spot = page(driver, 'window.axonFps.robotOnCanvas(42)')
-    canvas = driver.find_element(By.ID, 'plane')
-    size = canvas.size
-    ActionChains(driver).move_to_element_with_offset(canvas, spot['x'] - size['width'] / 2,
-                                                     spot['y'] - size['height'] / 2).click().perform()
-    wait_until('details of robot 42', lambda: page(driver, "document.getElementById('details').dataset.robot") == '42')
+    click_robot(driver, 42)
     wait_until('a last reply', lambda: 's ago' in page(driver, "document.getElementById('details').textContent"))
     bits = page(driver, "document.getElementById('status-bits').textContent")
     assert 'DATUM_ALPHA_INITIALIZED' in bits, bits

@@ -18,11 +18,10 @@ import tempfile
 import time
 import urllib.request
 
-from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), 'helpers'))
-from browser import page, start_chromium, wait_until  # noqa: E402
+from browser import click_robot, http_url, page, start_chromium, start_program, wait_until  # noqa: E402
 
 AXON = sys.argv[1]
 COLLIDER = 100          # robot that reports a collision the first time it moves
@@ -35,16 +34,9 @@ def start_sim(tmp):
     with open(scenario, 'w') as f:
         f.write('collide_on_move: [%d]\n' % COLLIDER)
     err = open(os.path.join(tmp, 'sim.err'), 'w')
-    sim = subprocess.Popen([AXON, 'sim', 'fps', '--layout', 'default', '--folded', '--http', '127.0.0.1:0', '--scenario', scenario,
-                            '--write-layout', os.path.join(tmp, 'live.yaml')], stdout=subprocess.PIPE, stderr=err, text=True)
-    url = None
-    for line in sim.stdout:
-        if line.startswith('listening http '):
-            url = 'http://' + line.split()[2]
-        if line.strip() == 'ready':
-            break
-    assert url, 'no "listening http" line'
-    return sim, url
+    sim, lines = start_program([AXON, 'sim', 'fps', '--layout', 'default', '--folded', '--http', '127.0.0.1:0', '--scenario', scenario,
+                                '--write-layout', os.path.join(tmp, 'live.yaml')], 'ready', stderr=err)
+    return sim, http_url(lines)
 
 
 def gateway_of(layout_file, robot):
@@ -71,14 +63,7 @@ def check_draws_every_robot(driver):
 
 
 def check_click_shows_status(driver):
-    spot = page(driver, 'window.axonFps.robotOnCanvas(42)')
-    canvas = driver.find_element(By.ID, 'plane')
-    size = canvas.size
-    ActionChains(driver).move_to_element_with_offset(canvas, spot['x'] - size['width'] / 2,
-                                                     spot['y'] - size['height'] / 2).click().perform()
-    # The details panel is rebuilt with every state update (10 a second): read it in one script
-    # call each time, never through an element reference an update may have replaced.
-    wait_until('details of robot 42', lambda: page(driver, "document.getElementById('details').dataset.robot") == '42')
+    click_robot(driver, 42)
     bits = page(driver, "document.getElementById('status-bits').textContent")
     for name in ('SYSTEM_INITIALIZATION', 'DATUM_ALPHA_INITIALIZED', 'DATUM_BETA_INITIALIZED', 'DISPLACEMENT_COMPLETED'):
         assert name in bits, (name, bits)

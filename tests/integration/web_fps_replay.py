@@ -22,7 +22,7 @@ from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), 'helpers'))
-from browser import page, start_chromium, wait_until  # noqa: E402
+from browser import http_url, page, start_chromium, start_program, wait_until  # noqa: E402
 
 AXON = sys.argv[1]
 TOLERANCE_DEG = 0.01  # the page's drawn angles against the plan's points
@@ -42,16 +42,9 @@ def make_plan(tmp):
 
 def start_sim(tmp):
     err = open(os.path.join(tmp, 'sim.err'), 'w')
-    sim = subprocess.Popen([AXON, 'sim', 'fps', '--layout', 'default', '--folded', '--http', '127.0.0.1:0'],
-                           stdout=subprocess.PIPE, stderr=err, text=True)
-    url = None
-    for line in sim.stdout:
-        if line.startswith('listening http '):
-            url = 'http://' + line.split()[2]
-        if line.strip() == 'ready':
-            break
-    assert url, 'no "listening http" line'
-    return sim, url
+    sim, lines = start_program([AXON, 'sim', 'fps', '--layout', 'default', '--folded', '--http', '127.0.0.1:0'], 'ready',
+                               stderr=err)
+    return sim, http_url(lines)
 
 
 def angle_at(points, t):

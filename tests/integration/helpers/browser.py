@@ -1,11 +1,15 @@
-"""What the browser tests (tests/integration/web_*.py) share: headless Chromium through Selenium
-(Debian's chromium, chromium-driver and python3-selenium), and waiting for a condition."""
+"""What the browser tests (tests/integration/web_*.py) and scripts/screenshots.py share: headless
+Chromium through Selenium (Debian's chromium, chromium-driver and python3-selenium), starting an axon
+program and reading its address, waiting for a condition, clicking a robot on the fps page."""
 import shutil
+import subprocess
 import sys
 import time
 
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.by import By
 
 
 def start_chromium():
@@ -35,3 +39,37 @@ def wait_until(what, check, seconds=20.0, step=0.02):
 def page(driver, expression):
     """The value of a JavaScript expression in the page."""
     return driver.execute_script('return ' + expression)
+
+
+def start_program(args, until, stderr=None):
+    """Starts `args` with stdout a pipe and reads its lines up to the first that starts with `until`
+    ('ready', 'listening http '); returns (process, the lines read). AssertionError, naming the
+    program, if it ends before."""
+    p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=stderr, text=True)
+    lines = []
+    for line in p.stdout:
+        lines.append(line.rstrip('\n'))
+        if line.startswith(until):
+            return p, lines
+    p.wait()
+    raise AssertionError('%s ended (exit %s) before printing %r' % (' '.join(args[:3]), p.returncode, until))
+
+
+def http_url(lines):
+    """'http://HOST:PORT' from the 'listening http HOST:PORT' line among a program's `lines`."""
+    found = [l.split()[2] for l in lines if l.startswith('listening http ')]
+    assert found, 'no "listening http" line in %r' % lines[-5:]
+    return 'http://' + found[0]
+
+
+def click_robot(driver, robot):
+    """Clicks robot `robot` on the fps page's canvas and waits until the details panel shows it."""
+    spot = page(driver, 'window.axonFps.robotOnCanvas(%d)' % robot)
+    canvas = driver.find_element(By.ID, 'plane')
+    size = canvas.size
+    ActionChains(driver).move_to_element_with_offset(canvas, spot['x'] - size['width'] / 2,
+                                                     spot['y'] - size['height'] / 2).click().perform()
+    # The details panel is rebuilt with every state update (10 a second): read it in one script
+    # call each time, never through an element reference an update may have replaced.
+    wait_until('details of robot %d' % robot,
+               lambda: page(driver, "document.getElementById('details').dataset.robot") == str(robot))
