@@ -36,7 +36,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -88,31 +87,6 @@ struct PlaneArgs {
   double http_linger_s = 0;              // with --http: keep serving this long after the action
 };
 
-
-// Waits (polling) until `path` exists and its size stays the same over two polls (a file still
-// being written is not read), for at most `wait_s` seconds.
-asio::awaitable<Result<void>> wait_for_file(const std::string& path, double wait_s) {
-  namespace fs = std::filesystem;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_s);
-  bool told = false;
-  std::optional<std::uintmax_t> last;
-  for (;;) {
-    std::error_code ec;
-    const bool there = fs::exists(path, ec);
-    if (there) {
-      const auto size = fs::file_size(path, ec);
-      if (!ec && last && *last == size) co_return ok();
-      last = ec ? std::nullopt : std::optional<std::uintmax_t>(size);
-    } else if (!told) {
-      std::fprintf(stderr, "waiting for %s\n", path.c_str());
-      std::fflush(stderr);
-      told = true;
-    }
-    if (std::chrono::steady_clock::now() >= until)
-      co_return Error(CoreErrc::invalid_argument, fmt::format("{}: not there after {:g} s", path, wait_s));
-    co_await core::sleep_for(std::chrono::milliseconds(100));
-  }
-}
 
 std::vector<std::uint8_t> read_image(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -368,20 +342,10 @@ asio::awaitable<int> plane_correct(host::FocalPlaneArray& fpa, const PlaneArgs& 
     std::fputs(r.to_text().c_str(), stdout);
     std::fflush(stdout);
   };
-  const auto files = a.measured;
-  const double wait_s = a.wait_s;
-  host::MeasurementSource source =
-      [files, wait_s, known](int round) -> asio::awaitable<Result<std::optional<host::MeasurementSet>>> {
-    if (round > static_cast<int>(files.size())) co_return std::optional<host::MeasurementSet>();
-    const std::string path = files[static_cast<std::size_t>(round - 1)];
-    if (round > 1) {  // the first measurement is there already; later ones follow the moves
-      auto there = co_await wait_for_file(path, wait_s);
-      if (!there) co_return there.error();
-    }
-    auto m = host::load_measurements(path, known);
-    if (!m) co_return m.error();
-    co_return std::optional<host::MeasurementSet>(std::move(m).value());
-  };
+  const auto source = host::measurement_files(a.measured, known, a.wait_s, [](const std::string& path) {
+    std::fprintf(stderr, "waiting for %s\n", path.c_str());
+    std::fflush(stderr);
+  });
   stop_robots_on_signal(set_on_signal, fpa.array());
   auto run = co_await host::correct_positions(fpa.array(), model, targets, source, co);
   const auto& lock = fpa.array().lock_state();

@@ -9,7 +9,15 @@
 
 #include <gtest/gtest.h>
 
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/this_coro.hpp>
+#include <fmt/format.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
 
 using namespace axon;
 using namespace axon::fps;
@@ -138,4 +146,41 @@ TEST(PlaneCorrect, RobotsWithinToleranceAndProblemsAreNotMoved) {
     EXPECT_NE(rig.sim->simulator().find(2)->physical_deg(sim::Arm::beta), 180.0);
     EXPECT_EQ(rig.sim->simulator().find(1)->physical_deg(sim::Arm::beta), 180.0);
   });
+}
+
+// Measurement files as the CLI gives them: the first read at once, the next one waited for until
+// it is there and complete (written while the source waits), a missing one an error naming it after
+// the wait, and no round after the last file.
+TEST(PlaneCorrect, MeasurementFilesAreReadInTurnWaitingForEachNext) {
+  const auto dir = std::filesystem::temp_directory_path() / fmt::format("axon-measured-{}", ::getpid());
+  std::filesystem::create_directories(dir);
+  const auto first = (dir / "m1.csv").string(), second = (dir / "m2.csv").string(), third = (dir / "m3.csv").string();
+  std::ofstream(first) << "robot,x,y\n1,0.5,-0.25\n";
+  std::vector<std::string> waited;
+  auto source = measurement_files({first, second, third}, {1, 2}, 3.0, [&](const std::string& p) { waited.push_back(p); });
+  Runner runner;
+  runner.run([&]() -> asio::awaitable<void> {
+    auto m1 = co_await source(1);
+    EXPECT_TRUE(m1 && m1.value());
+    if (m1 && m1.value()) {
+      EXPECT_EQ(m1.value()->items.size(), 1u);
+    }
+    asio::steady_timer later(co_await asio::this_coro::executor, std::chrono::milliseconds(300));
+    later.async_wait([&](const boost::system::error_code&) { std::ofstream(second) << "robot,x,y\n1,0,0\n2,1,1\n"; });
+    auto m2 = co_await source(2);
+    EXPECT_TRUE(m2 && m2.value());
+    if (m2 && m2.value()) {
+      EXPECT_EQ(m2.value()->items.size(), 2u);
+    }
+    EXPECT_EQ(waited, std::vector<std::string>{second});
+    auto quick = measurement_files({first, third}, {1}, 0.2);
+    auto m3 = co_await quick(2);
+    EXPECT_FALSE(m3);
+    if (!m3) {
+      EXPECT_NE(m3.error().message().find("m3.csv: not there after 0.2 s"), std::string::npos) << m3.error().message();
+    }
+    auto end = co_await source(4);
+    EXPECT_TRUE(end && !end.value());
+  });
+  std::filesystem::remove_all(dir);
 }

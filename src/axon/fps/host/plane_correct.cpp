@@ -3,7 +3,12 @@
 #include "axon/fps/host/concurrent.hpp"
 #include "axon/fps/host/error.hpp"
 
+#include "axon/core/wakeup.hpp"
+
 #include <fmt/format.h>
+
+#include <chrono>
+#include <filesystem>
 
 namespace axon::fps::host {
 
@@ -170,6 +175,44 @@ asio::awaitable<CorrectionRun> correct_positions(Array& array, const plan::Colli
     run.verified = false;
   }
   co_return run;
+}
+
+asio::awaitable<Result<void>> wait_for_file(const std::string& path, double wait_s,
+                                            const std::function<void(const std::string&)>& on_waiting) {
+  namespace fs = std::filesystem;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_s);
+  bool told = false;
+  std::optional<std::uintmax_t> last;
+  for (;;) {
+    std::error_code ec;
+    if (fs::exists(path, ec)) {
+      const auto size = fs::file_size(path, ec);
+      if (!ec && last && *last == size) co_return ok();
+      last = ec ? std::nullopt : std::optional<std::uintmax_t>(size);
+    } else if (!told) {
+      if (on_waiting) on_waiting(path);
+      told = true;
+    }
+    if (std::chrono::steady_clock::now() >= until)
+      co_return Error(CoreErrc::invalid_argument, fmt::format("{}: not there after {:g} s", path, wait_s));
+    co_await core::sleep_for(std::chrono::milliseconds(100));
+  }
+}
+
+MeasurementSource measurement_files(std::vector<std::string> files, std::vector<std::int32_t> known_robots,
+                                    double wait_s, std::function<void(const std::string&)> on_waiting) {
+  return [files = std::move(files), known = std::move(known_robots), wait_s,
+          on_waiting = std::move(on_waiting)](int round) -> asio::awaitable<Result<std::optional<MeasurementSet>>> {
+    if (round < 1 || round > static_cast<int>(files.size())) co_return std::optional<MeasurementSet>();
+    const std::string path = files[static_cast<std::size_t>(round - 1)];
+    if (round > 1) {  // the first measurement is there already; later ones follow the moves
+      auto there = co_await wait_for_file(path, wait_s, on_waiting);
+      if (!there) co_return there.error();
+    }
+    auto m = load_measurements(path, known);
+    if (!m) co_return m.error();
+    co_return std::optional<MeasurementSet>(std::move(m).value());
+  };
 }
 
 }  // namespace axon::fps::host

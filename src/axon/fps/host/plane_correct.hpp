@@ -50,6 +50,19 @@ asio::awaitable<Result<CorrectionRound>> correction_round(Array& array, const pl
 // Gives the measurement for round `round` (1-based); nullopt when there is none (the run ends).
 using MeasurementSource = std::function<asio::awaitable<Result<std::optional<MeasurementSet>>>(int round)>;
 
+// Waits (polling every 100 ms) until `path` exists and its size is the same on two polls in a row
+// (a file still being written is not read), at most `wait_s` seconds; `on_waiting(path)` once when
+// the file is not there at the first look. CoreErrc::invalid_argument, naming the file, at the end.
+asio::awaitable<Result<void>> wait_for_file(const std::string& path, double wait_s,
+                                            const std::function<void(const std::string&)>& on_waiting = {});
+
+// Measurements from files, one a round, as `axon fps plane correct --measured` reads them: round k
+// reads files[k-1] (load_measurements, robots outside `known_robots` refused), from the second
+// round on after wait_for_file() (the instrument writes it after the moves); no more rounds after
+// the last file.
+MeasurementSource measurement_files(std::vector<std::string> files, std::vector<std::int32_t> known_robots,
+                                    double wait_s, std::function<void(const std::string&)> on_waiting = {});
+
 struct CorrectionRunOptions {
   CorrectionOptions correction;
   int iterations = 3;                                   // most correction moves (the document: 1..3)
