@@ -221,7 +221,10 @@ void bind_apps(py::module_& m) {
            py::arg("amplitude_deg") = py::none(), py::arg("frequency_hz") = py::none(), py::arg("open_time_s") = 0.0,
            py::arg("ramp_s") = 0.5, py::arg("arm") = 1, py::arg("dynamic_model") = true, py::arg("reduce_in_pc") = false,
            "Gains per axis or one for all: kp [1/s], kv [A per turn/s], ki [1/s] (defaults 20, 0.5, 10). Mode 1 holds the "
-           "arm, or swings it by amplitude_deg at frequency_hz; open_time_s=0: until the session stops.");
+           "arm, or swings it by amplitude_deg at frequency_hz; open_time_s=0: until the session stops.")
+      .def_property_readonly("max_following_error_turns", &apps::PidApp::max_following_error,
+                             "Largest |reference - position| on any axis so far (motor turns).")
+      .def_property_readonly("saturated_cycles", &apps::PidApp::saturated_cycles, "Cycles in which a current hit its limit.");
 
   py::class_<apps::ContributeApp, OpenModeApp, std::shared_ptr<apps::ContributeApp>>(
       m, "Contribute", "Modes 8 and 9: a sine added to the controller's own velocity (8) or current (9) references.")
