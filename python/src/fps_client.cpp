@@ -138,8 +138,8 @@ std::unique_ptr<Client> make_client(double reply_timeout_s, double call_timeout_
 }
 
 fps::PlanSettings plan_settings(double speed_deg_s, double buffer_mm, std::uint64_t seed, bool park_bad_targets,
-                                bool allow_partial, bool refuse_outside_safe_zone) {
-  return {speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial, refuse_outside_safe_zone};
+                                bool allow_partial, bool refuse_outside_safe_zone, bool start_by_sync_line) {
+  return {speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial, refuse_outside_safe_zone, start_by_sync_line};
 }
 
 char arm_letter(const std::string& arm) {
@@ -354,20 +354,23 @@ void bind_client_moves(py::class_<Client>& c) {
          const auto t = angles_of(targets);
          return blocking(c, [&c, t] { return c.goto_absolute(t); });
        }, py::arg("targets"), "Moves the robots {id: (alpha, beta)} (degrees) at once and waits for them.")
-      .def("run_trajectories", [](Client& c, const py::dict& paths) {
+      .def("run_trajectories", [](Client& c, const py::dict& paths, bool by_sync_line) {
          std::map<std::uint16_t, fps::ArmPath> p;
          for (const auto& [id, arms] : paths) {
            const auto pair = arms.cast<py::sequence>();
            if (pair.size() != 2) throw Exception(Error(CoreErrc::invalid_argument, "each robot's path is (alpha, beta)"));
            p[id.cast<std::uint16_t>()] = {arm_of(pair[0]), arm_of(pair[1])};
          }
-         return blocking(c, [&c, p] { return c.run_trajectories(p); });
-       }, py::arg("paths"),
+         return blocking(c, [&c, p, by_sync_line] { return c.run_trajectories(p, by_sync_line); });
+       }, py::arg("paths"), py::kw_only(), py::arg("by_sync_line") = false,
        "{id: (alpha, beta)}: each arm an (n, 2) array of degrees and seconds after the start (the robot adds "
-       "where it stands); uploads, starts every robot together, follows and checks the ends.")
+       "where it stands); uploads, starts every robot together, follows and checks the ends. by_sync_line: the "
+       "start is a pulse of the PLC's sync line (open(layout) with plc_address), not the broadcast.")
       .def("plan_and_move", [](Client& c, const py::object& targets, double speed_deg_s, double buffer_mm,
-                               std::uint64_t seed, bool park_bad_targets, bool allow_partial, bool refuse_outside_safe_zone) {
-         const auto s = plan_settings(speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial, refuse_outside_safe_zone);
+                               std::uint64_t seed, bool park_bad_targets, bool allow_partial, bool refuse_outside_safe_zone,
+                               bool start_by_sync_line) {
+         const auto s = plan_settings(speed_deg_s, buffer_mm, seed, park_bad_targets, allow_partial, refuse_outside_safe_zone,
+                                      start_by_sync_line);
          if (py::isinstance<py::str>(targets)) {
            const auto file = targets.cast<std::string>();
            return blocking(c, [&c, file, s] { return c.plan_and_move(file, s); });
@@ -376,7 +379,7 @@ void bind_client_moves(py::class_<Client>& c) {
          return blocking(c, [&c, t, s] { return c.plan_and_move(t, s); });
        }, py::arg("targets"), py::kw_only(), py::arg("speed_deg_s") = 12.0, py::arg("buffer_mm") = 2.0,
        py::arg("seed") = 1, py::arg("park_bad_targets") = true, py::arg("allow_partial") = false,
-       py::arg("refuse_outside_safe_zone") = false,
+       py::arg("refuse_outside_safe_zone") = false, py::arg("start_by_sync_line") = false,
        "Plans from where every robot of the layout stands to {id: (alpha, beta)} or a target file (robots not "
        "listed fold), verifies and runs it; targets outside their safe zones are reported, or refused.")
       .def("back_off", [](Client& c, const std::vector<std::uint16_t>& ids) {
@@ -462,6 +465,7 @@ void bind_plane(py::module_& m) {
       .def("arms", [](const SimulatedPlane& s, std::uint16_t id) { return pair_of(s.arms(id)); }, py::arg("id"),
            "(alpha, beta) where the robot's arms physically are; None for an unknown robot.")
       .def_property_readonly("collisions", &SimulatedPlane::collisions, "Collisions the simulator saw.")
+      .def_property_readonly("sync_edges", &SimulatedPlane::sync_edges, "Rising edges of the sync line the PLC emulator drove.")
       .def("inject_collision", &SimulatedPlane::inject_collision, py::arg("id"),
            "Makes the robot report a collision of its beta arm now (it stops and sets the flag).")
       .def("set_friction_fault", [](SimulatedPlane& s, std::uint16_t id, const std::string& arm, int level) {

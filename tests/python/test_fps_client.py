@@ -166,3 +166,24 @@ def test_check_layout_and_the_cold_policy_through_the_plc():
             fps.open(plane.layout)
             with pytest.raises(axon.Error, match="needs the PLC"):
                 fps.apply_cold_policy()
+
+
+def test_a_start_by_the_sync_line_through_the_plc():
+    with axon.fps.SimulatedPlane("benchtop", time_scale=20.0) as plane:
+        with axon.fps.Client(discover_window_s=0.3, plc_address=plane.plc_address) as fps:
+            fps.open(plane.layout)
+            ids = [r.id for r in fps.discover()]
+            paths = {i: (np.array([[25.0, 1.0]]), np.array([[165.0, 1.0]])) for i in ids}
+            moved = fps.run_trajectories(paths, by_sync_line=True)
+            assert moved.completed, moved.summary
+            assert plane.sync_edges == 1  # one pulse started them all
+            np.testing.assert_allclose([plane.arms(i) for i in ids], [(25.0, 165.0)] * len(ids), atol=0.1)
+            done = fps.plan_and_move({i: (45.0, 150.0) for i in ids}, start_by_sync_line=True)
+            assert done.move.completed and plane.sync_edges == 2
+    with axon.fps.SimulatedPlane("benchtop") as plane:
+        with axon.fps.Client() as fps:  # no PLC: refused before anything moves
+            fps.open(plane.layout)
+            fps.discover()
+            with pytest.raises(axon.Error, match="needs the PLC"):
+                fps.run_trajectories({1: (np.array([[25.0, 1.0]]), np.zeros((0, 2)))}, by_sync_line=True)
+            assert plane.arms(1) == pytest.approx((0.0, 180.0), abs=0.01)

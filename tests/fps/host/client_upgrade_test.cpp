@@ -106,5 +106,42 @@ TEST(ClientPlc, TheColdPolicyWithoutAPlcIsRefused) {
   }
 }
 
+// A start by the sync line (a PLC pulse instead of the START_TRAJECTORY broadcast), from the
+// blocking calls: trajectories and a plan-and-move, each one rising edge, every robot at its end.
+TEST(ClientPlc, TrajectoriesAndPlanAndMoveStartByTheSyncLine) {
+  Rig rig(true);
+  auto& fps = rig.fps;
+  std::map<std::uint16_t, ArmPath> paths;
+  for (const auto id : fps.robots()) paths[id] = {{{20.0, 1.0}}, {{170.0, 1.0}}};
+  const auto moved = fps.run_trajectories(paths, true);
+  EXPECT_TRUE(moved.completed) << moved.summary;
+  EXPECT_EQ(rig.plane.sync_edges(), 1u);
+  for (const auto id : fps.robots()) {
+    const auto a = rig.plane.arms(id);
+    ASSERT_TRUE(a.has_value());
+    EXPECT_NEAR(a->alpha, 20.0, 0.1) << id;
+  }
+  std::map<std::uint16_t, Angles> targets;
+  for (const auto id : fps.robots()) targets[id] = {40.0, 150.0};
+  PlanSettings s;
+  s.start_by_sync_line = true;
+  const auto done = fps.plan_and_move(targets, s);
+  EXPECT_TRUE(done.move.completed) << done.move.summary;
+  EXPECT_EQ(rig.plane.sync_edges(), 2u);
+}
+
+TEST(ClientPlc, AStartByTheSyncLineWithoutAPlcIsRefusedBeforeAnythingMoves) {
+  Rig rig(false);
+  std::map<std::uint16_t, ArmPath> paths;
+  for (const auto id : rig.fps.robots()) paths[id] = {{{20.0, 1.0}}, {}};
+  try {
+    rig.fps.run_trajectories(paths, true);
+    FAIL() << "a sync-line start ran without a PLC";
+  } catch (const Exception& e) {
+    EXPECT_EQ(e.code(), host::HostErrc::invalid_argument) << e.what();
+  }
+  for (const auto id : rig.fps.robots()) EXPECT_NEAR(rig.plane.arms(id)->alpha, 0.0, 0.01) << id;
+}
+
 }  // namespace
 }  // namespace axon::fps::client_upgrade_test

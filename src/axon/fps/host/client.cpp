@@ -111,6 +111,14 @@ struct Client::Impl {
     return *array;
   }
 
+  // The array that can start by the PLC's sync line: opened on a plane, with a PLC.
+  host::FocalPlaneArray& sync_array() const {
+    if (!plane_array || !plane_array->plc())
+      throw Exception(Error(host::HostErrc::invalid_argument,
+                            "a start by the sync line needs the PLC: open(plane) with ClientConfig::plc_address"));
+    return *plane_array;
+  }
+
   [[nodiscard]] host::ArrayOptions array_options() const {
     host::ArrayOptions o;
     o.client.timeout = duration_of(config.reply_timeout_s);
@@ -184,6 +192,7 @@ void Client::open(const FocalPlane& plane, const std::map<std::uint16_t, std::st
   o.array = impl_->array_options();
   for (const auto& [id, text] : gateway_addresses) o.addresses[id] = need(net::parse_endpoint(text, can::kCanNetPort));
   if (!impl_->config.plc_address.empty()) o.plc = need(net::parse_endpoint(impl_->config.plc_address, 502));
+  o.sync_hold = duration_of(impl_->config.sync_hold_s);
   auto* impl = impl_.get();
   impl->run([impl, plane, o]() -> asio::awaitable<void> {
     auto connected = co_await host::FocalPlaneArray::connect(co_await asio::this_coro::executor, plane, o);
@@ -229,8 +238,9 @@ MoveOutcome Client::goto_absolute(const std::map<std::uint16_t, Angles>& targets
   });
 }
 
-MoveOutcome Client::run_trajectories(const std::map<std::uint16_t, ArmPath>& paths) {
+MoveOutcome Client::run_trajectories(const std::map<std::uint16_t, ArmPath>& paths, bool by_sync_line) {
   auto& array = impl_->open_array();
+  auto* sync = by_sync_line ? &impl_->sync_array() : nullptr;
   host::Trajectories uploads;
   for (const auto& [id, path] : paths) {
     std::vector<protocol::ArmPoint> alpha, beta;
@@ -240,9 +250,11 @@ MoveOutcome Client::run_trajectories(const std::map<std::uint16_t, ArmPath>& pat
     if (!t) throw Exception(Error(t.error().code, fmt::format("robot {}: {}", id, t.error().detail)));
     uploads.emplace(id, std::move(t).value());
   }
-  return impl_->run([&array, uploads]() -> asio::awaitable<MoveOutcome> {
-    auto r = co_await array.run_trajectories(uploads);
-    co_return outcome_of(need(std::move(r)));
+  return impl_->run([&array, sync, uploads]() -> asio::awaitable<MoveOutcome> {
+    // Two statements, not one conditional expression: gcc 12 destroys a co_await's temporaries
+    // twice inside ?: (a double free here).
+    if (sync) co_return outcome_of(need(co_await sync->run_trajectories(uploads, {}, true)));
+    co_return outcome_of(need(co_await array.run_trajectories(uploads)));
   });
 }
 
@@ -437,6 +449,10 @@ PlanAndMoveOutcome plan_and_move_on(Client::Impl& impl, const std::vector<plan::
   o.allow_partial = s.allow_partial;
   o.refuse_outside_safe_zone = s.refuse_outside_safe_zone;
   o.point_fibre = plan::point_fibres(*model, targets, poses);
+  if (s.start_by_sync_line) {
+    auto* sync = &impl.sync_array();
+    o.run = [sync](host::Trajectories t, host::TrajectoryOptions to) { return sync->run_trajectories(std::move(t), to, true); };
+  }
   const FocalPlane& plane = *impl.layout;
   return impl.run([&array, &plane, model, poses, o, notes]() -> asio::awaitable<PlanAndMoveOutcome> {
     auto r = co_await host::plan_and_move(array, plane, *model, poses, o);

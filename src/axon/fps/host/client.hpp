@@ -57,8 +57,11 @@ struct ClientConfig {
   bool field_firmware_history = false;
   bool document_version_byte_order = false;
   // The PLC (positioner power and the sync line) at HOST[:PORT] (port 502 by default), connected by
-  // open(plane); upgrade_firmware() needs it. "": none.
+  // open(plane); upgrade_firmware() and a start by the sync line need it. "": none.
   std::string plc_address{};
+  // A start by the sync line holds the line high this long (FIELD-NOTES: about 0.5 s in service;
+  // the robots need a few milliseconds).
+  double sync_hold_s = 0.5;
 };
 
 // One robot's row of status(): plain values.
@@ -107,6 +110,9 @@ struct PlanSettings {
   // docs/fps-plan.md): true refuses the call (PlanErrc::outside_safe_zone naming the robots and by
   // how much) before anything moves; false only reports them in PlanOutcome.
   bool refuse_outside_safe_zone = false;
+  // Start the planned trajectories by a pulse of the PLC's sync line (open(plane) with
+  // ClientConfig::plc_address) instead of the START_TRAJECTORY broadcast.
+  bool start_by_sync_line = false;
 };
 
 struct PlanOutcome {
@@ -254,8 +260,10 @@ class Client {
 
   // Moves the listed robots at once (GO_TO_ABSOLUTE_POSITION) and waits for them.
   MoveOutcome goto_absolute(const std::map<std::uint16_t, Angles>& targets);
-  // Uploads, starts together (broadcast) and follows trajectories, by robot id.
-  MoveOutcome run_trajectories(const std::map<std::uint16_t, ArmPath>& paths);
+  // Uploads, starts together and follows trajectories, by robot id. The start is the
+  // START_TRAJECTORY broadcast, or with `by_sync_line` a pulse of the PLC's sync line (open(plane)
+  // with ClientConfig::plc_address; HostErrc::invalid_argument otherwise, before anything is sent).
+  MoveOutcome run_trajectories(const std::map<std::uint16_t, ArmPath>& paths, bool by_sync_line = false);
   // Plans collision-free moves from where every robot of the layout is to the targets (robots not
   // listed: folded), then runs them (docs/fps-plan.md). Throws when the plan cannot be used.
   PlanAndMoveOutcome plan_and_move(const std::map<std::uint16_t, Angles>& targets, const PlanSettings& settings = {});

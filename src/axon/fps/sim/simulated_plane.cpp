@@ -98,6 +98,11 @@ std::uint64_t SimulatedPlane::collisions() const {
   });
 }
 
+std::uint64_t SimulatedPlane::sync_edges() const {
+  auto* impl = impl_.get();
+  return impl->loop.call([impl] { return impl->sim->counters().sync_edges; });
+}
+
 void SimulatedPlane::inject_collision(std::uint16_t id) {
   auto* impl = impl_.get();
   impl->loop.call([impl, id] { impl->sim->simulator().force_collision(id, Arm::beta).value(); });

@@ -54,6 +54,8 @@ class SimulatedPlane {
   [[nodiscard]] std::optional<Angles> arms(std::uint16_t id) const;
   // Collisions the simulator saw (neighbours and obstacles).
   [[nodiscard]] std::uint64_t collisions() const;
+  // Rising edges of the sync line the PLC emulator drove (a start by the sync line is one).
+  [[nodiscard]] std::uint64_t sync_edges() const;
   // Makes robot `id` report a collision of its beta arm now (it stops and sets the flag), whatever
   // the geometry.
   void inject_collision(std::uint16_t id);
