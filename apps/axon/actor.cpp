@@ -24,16 +24,14 @@ namespace {
 
 struct ActorFpsOptions {
   BrokerOptions bus;
-  std::string name = "fps";
+  ActorOptions actor;
   std::string layout = "benchtop";
   std::vector<std::string> buses;  // real buses: no simulator
   bool connect = false;            // the layout's own gateway addresses: no simulator
   double time_scale = 10.0;
   std::uint64_t seed = 1;
-  double status_period_s = 10.0;
   std::string friction_history;    // the friction verb's CSV history
   std::string plc;                 // real devices: the PLC at HOST[:PORT] (upgrade, power, sync)
-  double duration_s = 0;
 };
 
 // The simulator's own verb, for tests and demonstrations: a robot reports a collision now.
@@ -50,6 +48,7 @@ void add_simulator_verbs(actor::ActorCore& core, fps::sim::SimulatedPlane& sim) 
 }
 
 int run_actor_fps(const ActorFpsOptions& o) {
+  if (!o.actor.http.empty()) throw Exception(usage("actor fps: --http is not served yet (blmc and c4g actors only)"));
   const bool simulate = o.buses.empty() && !o.connect;
   return run_command([&o, simulate](asio::io_context& io, SignalHook hook) -> asio::awaitable<int> {
     std::unique_ptr<fps::sim::SimulatedPlane> sim;
@@ -60,22 +59,22 @@ int run_actor_fps(const ActorFpsOptions& o) {
     fps::Client client(cc);
     if (!o.buses.empty()) client.open(o.buses);
     else client.open(sim ? sim->plane() : need(resolve_layout(o.layout)));
-    actor::BusActor bus({o.name, o.bus.link()});
+    actor::BusActor bus({o.actor.name, o.bus.link()});
     {
       actor::FpsActorOptions fo;
-      fo.status_period_s = o.status_period_s;
+      fo.status_period_s = o.actor.status_period_s;
       fo.friction_history = o.friction_history;
       fo.plc_address = cc.plc_address;
       actor::FpsActor fps_actor(bus.core(), client, fo);
       if (sim) add_simulator_verbs(bus.core(), *sim);
       bus.start();
-      std::fprintf(stderr, "actor %s: %zu robots, commands on %s (exchange %s)\n", o.name.c_str(), client.robots().size(),
+      std::fprintf(stderr, "actor %s: %zu robots, commands on %s (exchange %s)\n", o.actor.name.c_str(), client.robots().size(),
                    o.bus.broker.c_str(), o.bus.exchange.c_str());
-      co_await wait_for_stop(io, o.duration_s, hook);
+      co_await wait_for_stop(io, o.actor.duration_s, hook);
       bus.core().close();  // the simulator's verb too: nothing runs once the devices go
     }
     const auto c = bus.core().counters();
-    std::fprintf(stderr, "actor %s: %llu commands, %llu refused, %llu not understood\n", o.name.c_str(),
+    std::fprintf(stderr, "actor %s: %llu commands, %llu refused, %llu not understood\n", o.actor.name.c_str(),
                  static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.refused + c.busy),
                  static_cast<unsigned long long>(c.not_json + c.malformed + c.unknown + c.oversized));
     co_return 0;
@@ -137,17 +136,15 @@ void add_actor_commands(CLI::App& app, GlobalOptions& global) {
   auto fo = std::make_shared<ActorFpsOptions>();
   auto* f = group->add_subcommand("fps", "the focal plane as an actor (embedded simulated plane unless --bus/--connect)");
   add_broker_options(*f, fo->bus);
-  f->add_option("--name", fo->name, "the actor's name: its queue takes command.NAME.# (default fps)");
+  add_actor_options(*f, fo->actor, "fps");
   f->add_option("--layout", fo->layout, "the plane: default, benchtop or a layout FILE (default benchtop)");
   f->add_option("--bus", fo->buses, "real buses by spec (cannet://HOST:PORT/N, ...): no simulator");
   f->add_flag("--connect", fo->connect, "the layout's gateways at their own addresses: no simulator");
   f->add_option("--time-scale", fo->time_scale, "simulator: simulated seconds per second (default 10)");
   f->add_option("--seed", fo->seed, "simulator: seed (default 1)");
-  f->add_option("--status-period", fo->status_period_s, "seconds between status broadcasts (default 10; 0: none)");
   f->add_option("--plc", fo->plc, "with --connect or --bus: the PLC at HOST[:PORT] for upgrade, plc, power, gateway and sync (the simulator has its own)");
   f->add_option("--friction-history", fo->friction_history,
                  "CSV history the friction verb judges against and appends to (default: none, every arm a baseline)");
-  f->add_option("--duration", fo->duration_s, "stop after this many seconds (default: until Ctrl-C)");
   f->callback([fo, &global] { global.exit_code = run_actor_fps(*fo); });
   add_actor_blmc_command(*group, global);
   add_actor_c4g_command(*group, global);

@@ -5,6 +5,7 @@
 #include "axon/actor/bus_actor.hpp"
 #include "axon/blmc/host/motor_board.hpp"
 #include "axon/blmc/sim/simulated_board.hpp"
+#include "axon/web/live_page.hpp"
 #include "broker_options.hpp"
 #include "commands.hpp"
 #include "run.hpp"
@@ -23,10 +24,8 @@ namespace actor_blmc_cli {
 
 struct ActorBlmcOptions {
   BrokerOptions bus;
-  std::string name = "blmc";
+  ActorOptions actor;
   std::string board_bus;  // a real board by spec: no simulator
-  double status_period_s = 10.0;
-  double duration_s = 0;
   double max_current_a = 2.0;
   double max_velocity_krpm = 2.0;
   double stale_ms = 20;
@@ -54,7 +53,7 @@ void add_blmc_simulator_verbs(actor::ActorCore& core, blmc::sim::SimulatedBoard&
 
 actor::BlmcActorOptions actor_options(const ActorBlmcOptions& o) {
   actor::BlmcActorOptions a;
-  a.status_period_s = o.status_period_s;
+  a.status_period_s = o.actor.status_period_s;
   a.control.limits.max_current_a = o.max_current_a;
   a.control.limits.max_velocity_krpm = o.max_velocity_krpm;
   a.control.limits.stale_after = std::chrono::duration_cast<core::Duration>(std::chrono::duration<double, std::milli>(o.stale_ms));
@@ -78,33 +77,49 @@ struct BrokerStateRelay {
   }
 };
 
+// --http: the board's page (web::BlmcPage), fed what the actor reads of the board.
+std::unique_ptr<web::BlmcPage> open_blmc_page(const ActorBlmcOptions& o, const std::string& spec,
+                                              const actor::BlmcActorOptions& ao) {
+  web::BlmcPageOptions po;
+  po.server = web::server_address(o.actor.http);
+  po.view.boards.push_back({spec, ao.control.limits});
+  po.view.sample_hz = 1.0 / ao.watch_period_s;
+  po.view.command = "actor";
+  po.title = fmt::format("blmc: actor {} on {}", o.actor.name, spec);
+  return std::make_unique<web::BlmcPage>(std::move(po));
+}
+
 int run_actor_blmc(const ActorBlmcOptions& o) {
   if (auto v = actor_options(o).control.limits.validate(); !v) throw Exception(usage(v.error().detail));
   return run_command([&o](asio::io_context& io, SignalHook hook) -> asio::awaitable<int> {
     std::unique_ptr<blmc::sim::SimulatedBoard> sim;
     if (o.board_bus.empty()) sim = std::make_unique<blmc::sim::SimulatedBoard>();
     blmc::MotorBoardOptions bo;
-    bo.name = o.name;
+    bo.name = o.actor.name;
     bo.recv_timeout_ms = o.recv_timeout_ms;
     bo.ready_timeout = std::chrono::milliseconds(static_cast<std::int64_t>(o.ready_timeout_s * 1000));
     const auto spec = sim ? sim->bus_spec() : o.board_bus;
     {
       blmc::MotorBoard board(spec, bo);
-      actor::BusActor bus({o.name, o.bus.link()});
+      actor::BusActor bus({o.actor.name, o.bus.link()});
       BrokerStateRelay relay;
       bus.on_state([&relay](bool up) { relay(up); });
       {
-        actor::BlmcActor blmc_actor(bus.core(), board, actor_options(o));
+        auto ao = actor_options(o);
+        const auto page = o.actor.http.empty() ? nullptr : open_blmc_page(o, spec, ao);
+        if (page) ao.on_board_read = [p = page.get()](const blmc::host::Measurements& m) { p->add_measurements(0, m); };
+        actor::BlmcActor blmc_actor(bus.core(), board, ao);
         relay.set(&blmc_actor);
         if (sim) add_blmc_simulator_verbs(bus.core(), *sim);
         bus.start();
-        std::fprintf(stderr, "actor %s: board on %s%s, commands on %s (exchange %s)\n", o.name.c_str(), spec.c_str(),
+        std::fprintf(stderr, "actor %s: board on %s%s, commands on %s (exchange %s)\n", o.actor.name.c_str(), spec.c_str(),
                      sim ? " (simulated)" : "", o.bus.broker.c_str(), o.bus.exchange.c_str());
-        co_await wait_for_stop(io, o.duration_s, hook);
+        if (page) std::fprintf(stderr, "listening http %s\n", page->where().c_str());
+        co_await wait_for_stop(io, o.actor.duration_s, hook);
         relay.set(nullptr);
       }  // the actor ends a wait in progress, closes the core, stops the loop and disables the motors
       const auto c = bus.core().counters();
-      std::fprintf(stderr, "actor %s: motors disabled; %llu commands, %llu refused, %llu not understood\n", o.name.c_str(),
+      std::fprintf(stderr, "actor %s: motors disabled; %llu commands, %llu refused, %llu not understood\n", o.actor.name.c_str(),
                    static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.refused + c.busy),
                    static_cast<unsigned long long>(c.not_json + c.malformed + c.unknown + c.oversized));
     }
@@ -119,10 +134,8 @@ void add_actor_blmc_command(CLI::App& actor_group, GlobalOptions& global) {
   auto o = std::make_shared<ActorBlmcOptions>();
   auto* b = actor_group.add_subcommand("blmc", "a motor driver board as an actor (embedded simulated board unless --bus)");
   add_broker_options(*b, o->bus);
-  b->add_option("--name", o->name, "the actor's name: its queue takes command.NAME.# (default blmc)");
+  add_actor_options(*b, o->actor, "blmc");
   b->add_option("--bus", o->board_bus, "a real board by spec (socketcan:can0, socketcand://HOST:PORT/CH, ...): no simulator");
-  b->add_option("--status-period", o->status_period_s, "seconds between status broadcasts (default 10; 0: none)");
-  b->add_option("--duration", o->duration_s, "stop after this many seconds (default: until Ctrl-C)");
   b->add_option("--max-current", o->max_current_a, "safety: current clamp, A (default 2; start may lower it)");
   b->add_option("--max-velocity", o->max_velocity_krpm, "safety: zero current above this speed, krpm (default 2)");
   b->add_option("--stale-ms", o->stale_ms, "safety: stop the loop when a measurement is older than this (default 20 ms; 200 with the simulator)");

@@ -9,6 +9,7 @@
 #include "axon/c4g/apps/app_switch.hpp"
 #include "axon/c4g/host/server.hpp"
 #include "axon/c4g/sim/simulated_controller.hpp"
+#include "axon/web/live_page.hpp"
 #include "commands.hpp"
 #include "run.hpp"
 
@@ -25,7 +26,7 @@ namespace {
 
 struct ActorC4gOptions {
   BrokerOptions bus;
-  std::string name = "c4g";
+  ActorOptions actor;
   std::string listen = fmt::format("{}:{}", c4g::host::kDefaultServerAddress, c4g::host::kDefaultPort);
   std::string controller;  // empty: the embedded simulator; "any": a real controller from anywhere
   std::string robot = "six-axis";
@@ -35,8 +36,6 @@ struct ActorC4gOptions {
   int rt_priority = 0;     // SCHED_FIFO for the cycle thread (and mlockall); 0: a normal thread
   std::vector<int> cpus;
   double stop_timeout_s = 5.0;
-  double status_period_s = 10.0;
-  double duration_s = 0;
 };
 
 // The embedded controller's program: drive on, then again and again an open phase of type A in
@@ -84,6 +83,15 @@ std::unique_ptr<c4g::sim::SimulatedController> start_simulator(const ActorC4gOpt
   return std::make_unique<c4g::sim::SimulatedController>(c4g::sim::SimulatedController::start(co));
 }
 
+// --http: the server's page (web::C4gPage), fed the events the actor drains from the switch.
+std::unique_ptr<web::C4gPage> open_c4g_page(const ActorC4gOptions& o, const c4g::apps::AppSwitch& apps,
+                                            const c4g::host::Server& server) {
+  web::C4gViewOptions vo;
+  vo.command = fmt::format("actor {}", o.actor.name);
+  return std::make_unique<web::C4gPage>(web::server_address(o.actor.http), apps, server, std::move(vo),
+                                        fmt::format("c4g: actor {} on {}", o.actor.name, server.local_address().to_string()));
+}
+
 int run_actor_c4g(const ActorC4gOptions& o) {
   return run_command([&o](asio::io_context& io, SignalHook hook) -> asio::awaitable<int> {
     c4g::apps::AppSwitch apps({o.stop_timeout_s, 1.0});
@@ -92,27 +100,30 @@ int run_actor_c4g(const ActorC4gOptions& o) {
     for (const auto& step : server->realtime_report().steps)
       if (!step.granted) spdlog::warn("actor c4g: {} refused: {}", step.name, step.reason);
     auto sim = o.controller.empty() ? start_simulator(o, *server) : nullptr;
-    actor::BusActor bus({o.name, o.bus.link()});
+    actor::BusActor bus({o.actor.name, o.bus.link()});
     {
       actor::C4gActorOptions ao;
-      ao.status_period_s = o.status_period_s;
+      ao.status_period_s = o.actor.status_period_s;
+      const auto page = o.actor.http.empty() ? nullptr : open_c4g_page(o, apps, *server);
+      if (page) ao.on_event = [p = page.get()](const c4g::apps::Event& e, const std::string& text) { p->add_event(e, text); };
       actor::C4gActor c4g_actor(bus.core(), apps, *server, ao);
       bus.start();
-      std::fprintf(stderr, "actor %s: serving c4g on %s (%s), commands on %s (exchange %s)\n", o.name.c_str(),
+      std::fprintf(stderr, "actor %s: serving c4g on %s (%s), commands on %s (exchange %s)\n", o.actor.name.c_str(),
                    server->local_address().to_string().c_str(), sim ? sim->describe().c_str() : "a real controller",
                    o.bus.broker.c_str(), o.bus.exchange.c_str());
-      co_await wait_for_stop(io, o.duration_s, hook);
+      if (page) std::fprintf(stderr, "listening http %s\n", page->where().c_str());
+      co_await wait_for_stop(io, o.actor.duration_s, hook);
       c4g_actor.shutdown();  // the app in force leaves its open modes (drive off if it cannot)
     }
     if (sim) {
       const auto seen = sim->stop();
-      std::fprintf(stderr, "actor %s: simulated controller: %s, %llu packets, %llu misses\n", o.name.c_str(),
+      std::fprintf(stderr, "actor %s: simulated controller: %s, %llu packets, %llu misses\n", o.actor.name.c_str(),
                    seen.outcome_text.c_str(), static_cast<unsigned long long>(seen.stats.packets_sent),
                    static_cast<unsigned long long>(seen.stats.misses));
     }
     server->stop();
     const auto c = bus.core().counters();
-    std::fprintf(stderr, "actor %s: %llu commands, %llu refused, %llu not understood; %llu apps run\n", o.name.c_str(),
+    std::fprintf(stderr, "actor %s: %llu commands, %llu refused, %llu not understood; %llu apps run\n", o.actor.name.c_str(),
                  static_cast<unsigned long long>(c.received), static_cast<unsigned long long>(c.refused + c.busy),
                  static_cast<unsigned long long>(c.not_json + c.malformed + c.unknown + c.oversized),
                  static_cast<unsigned long long>(apps.installs()));
@@ -127,7 +138,7 @@ void add_actor_c4g_command(CLI::App& actor_group, GlobalOptions& global) {
   auto* c = actor_group.add_subcommand(
       "c4g", "the c4g open-interface server as an actor (embedded simulated controller unless --controller)");
   add_broker_options(*c, o->bus);
-  c->add_option("--name", o->name, "the actor's name: its queue takes command.NAME.# (default c4g)");
+  add_actor_options(*c, o->actor, "c4g");
   c->add_option("--listen", o->listen, "HOST[:PORT] to serve the controller on (default 127.0.0.1:11000; port 0: any free)");
   c->add_option("--controller", o->controller,
                 "a real controller: its HOST[:PORT] (only it may start a session), or any; no simulator");
@@ -140,9 +151,6 @@ void add_actor_c4g_command(CLI::App& actor_group, GlobalOptions& global) {
   c->add_option("--cpu", o->cpus, "pin the cycle thread to this CPU (repeatable)");
   c->add_option("--stop-timeout", o->stop_timeout_s, "seconds an app may take to leave its open modes before drive off (default 5)")
       ->check(CLI::NonNegativeNumber);
-  c->add_option("--status-period", o->status_period_s, "seconds between status broadcasts (default 10; 0: none)")
-      ->check(CLI::NonNegativeNumber);
-  c->add_option("--duration", o->duration_s, "stop after this many seconds (default: until Ctrl-C)")->check(CLI::NonNegativeNumber);
   c->callback([o, &global] { global.exit_code = run_actor_c4g(*o); });
 }
 

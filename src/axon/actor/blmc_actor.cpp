@@ -262,6 +262,7 @@ struct BlmcActor::Impl {
   // Reads the board; remembers it; returns the broadcasts its changes call for.
   std::vector<std::pair<MessageCode, json>> read_board_locked() {
     const auto m = board.measurements();
+    if (options.on_board_read) options.on_board_read(m);
     const bool enabled = board.enabled();
     const auto code = bk::error_bits_of(m);
     std::vector<std::pair<MessageCode, json>> out;

@@ -50,6 +50,7 @@
 #include "axon/blmc/host/motor_board.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 
 namespace axon::actor {
@@ -65,6 +66,10 @@ struct BlmcActorOptions {
   double pd_kp = 5.0;                 // pd's default gains (as `axon blmc pd`), A/rev
   double pd_kd = 0.05;                // A/(rev/s)
   std::uint32_t recv_timeout_ms = 50;  // the board's receive timeout as opened (MotorBoardOptions), for status
+  // Every read of the board's measurements the actor makes (its watcher's, every watch period, and
+  // status), on the reading thread, never the loop's: for a view beside the actor (web::BlmcPage),
+  // which must not call the board itself (one thread at a time). Keep it short. Empty: none.
+  std::function<void(const blmc::host::Measurements&)> on_board_read{};
 };
 
 class BlmcActor {

@@ -476,6 +476,7 @@ struct C4gActor::Impl {
     bool drives_off = false;
     for (const auto& d : events) {
       const auto& e = d.event;
+      if (options.on_event) options.on_event(e, d.text);
       if (e.kind == c4g::apps::EventKind::mode_change) {
         changes.push_back(c4g_kw::mode_change_json(e, init));
       } else if (e.kind == c4g::apps::EventKind::drives) {

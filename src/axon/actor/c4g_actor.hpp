@@ -33,10 +33,13 @@
 
 #include "axon/actor/actor_core.hpp"
 
+#include <functional>
 #include <memory>
+#include <string>
 
 namespace axon::c4g::apps {
 class AppSwitch;
+struct Event;
 }
 namespace axon::c4g::host {
 class Server;
@@ -49,6 +52,10 @@ struct C4gActorOptions {
   double watch_period_s = 0.02;   // how often events, the safety state and the counters are read
   double late_period_s = 1.0;     // at most one `late` broadcast this often
   double drive_off_wait_s = 2.0;  // driveoff: how long to wait for the controller to obey
+  // Each event the watcher drains from the switch (AppSwitch::drain, the only consumer), with its
+  // text, oldest first, on the watcher's thread (never the cycle's): for a view beside the actor
+  // (web::C4gView::add_event). Keep it short. Empty: none.
+  std::function<void(const c4g::apps::Event&, const std::string&)> on_event{};
 };
 
 class C4gActor {
