@@ -471,7 +471,9 @@ asio::awaitable<int> plane_action(host::FocalPlaneArray& fpa, const PlaneArgs& a
   }
   if (action == "friction" || action == "halltest") {
     stop_robots_on_signal(set_on_signal, fpa.array());
-    rc = action == "friction" ? co_await plane_friction(fpa, a, plane) : co_await plane_hall_test(fpa, a, plane);
+    // Not one ?: with a co_await on each side: gcc 12 can destroy such temporaries twice.
+    if (action == "friction") rc = co_await plane_friction(fpa, a, plane);
+    else rc = co_await plane_hall_test(fpa, a, plane);
   }
   if (action == "correct") rc = co_await plane_correct(fpa, a, plane, set_on_signal);
   if (action == "upgrade") {
