@@ -260,17 +260,11 @@ std::string Model::info_json() const {
   std::string out;
   auto it = std::back_inserter(out);
   const auto& t = options.soft_switch;
-  fmt::format_to(it, "{{\"family\":\"c4g\",\"command\":{},\"app\":{},\"soft_switch_ms\":[{},{},{}],\"modes\":[",
+  fmt::format_to(it, "{{\"family\":\"c4g\",\"command\":{},\"app\":{},\"soft_switch_ms\":[{},{},{}],\"modes\":",
                  json_quote(options.command), json_quote(app.name()), t.t1_s * 1e3, t.t2_s * 1e3, t.t3_s * 1e3);
+  out += c4g_modes_json();
+  out += ",\"controller_errors\":[";
   bool first = true;
-  for (const auto& m : protocol::all_modes()) {
-    fmt::format_to(it, "{}{{\"code\":{},\"name\":{},\"label\":{},\"kind\":\"{}\",\"description\":{}}}", first ? "" : ",",
-                   protocol::code(m.mode), json_quote(m.name), json_quote(m.label), kind_text(m.kind),
-                   json_quote(m.description));
-    first = false;
-  }
-  out += "],\"controller_errors\":[";
-  first = true;
   for (const auto e : kControllerErrors) {
     fmt::format_to(it, "{}{{\"name\":{},\"meaning\":{}}}", first ? "" : ",", json_quote(host::manual_name(e)),
                    json_quote(host::meaning(e)));
@@ -528,6 +522,16 @@ std::string C4gView::metrics() const { return impl_->metrics(); }
 void C4gView::publish(Source& source, unsigned metrics_every) {
   source.publish(state_json());
   if (metrics_every == 0 || impl_->publishes++ % metrics_every == 0) source.publish_metrics(metrics());
+}
+
+std::string c4g_modes_json() {
+  namespace protocol = c4g::protocol;
+  std::string out = "[";
+  for (const auto& m : protocol::all_modes())
+    fmt::format_to(std::back_inserter(out), "{}{{\"code\":{},\"name\":{},\"label\":{},\"kind\":\"{}\",\"description\":{}}}",
+                   out.size() > 1 ? "," : "", protocol::code(m.mode), json_quote(m.name), json_quote(m.label),
+                   c4g_page::kind_text(m.kind), json_quote(m.description));
+  return out + "]";
 }
 
 std::string c4g_app_phase(const c4g::apps::App& app) {

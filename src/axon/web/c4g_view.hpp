@@ -72,6 +72,10 @@ class C4gView {
   std::unique_ptr<Impl> impl_;
 };
 
+// The open interface's modes as the pages' info carries them: [{code, name, label, kind,
+// description}, ...].
+[[nodiscard]] std::string c4g_modes_json();
+
 // The phase of an application as the page names it: an OpenModeApp's (for handover: the part now
 // serving an open mode, else "waiting"), empty for an app without one (monitor, echo). Any thread.
 [[nodiscard]] std::string c4g_app_phase(const c4g::apps::App& app);
