@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <atomic>
 #include <array>
 #include <charconv>
 #include <chrono>
@@ -203,6 +204,9 @@ struct BlmcActor::Impl {
   BlmcActorOptions options;
   std::uint32_t recv_timeout_ms = 0;
   std::mutex device;  // one MotorBoard call at a time (the library asks for one thread at a time)
+  // A disable came while an enable was accepted: that enable must not turn the motors on after it,
+  // even when it had not reached the board's wait yet (the interrupt would then be cleared unseen).
+  std::atomic<bool> disable_over_enable{false};
 
   std::mutex state;  // what follows
   std::optional<blmc::FrontEnd> front_end;  // while a loop runs
@@ -383,6 +387,12 @@ struct BlmcActor::Impl {
 
   void enable(Command& c) {
     std::lock_guard lock(device);
+    // Whatever way this enable ends, a disable it met is used up with it.
+    const struct Spent {
+      std::atomic<bool>& flag;
+      ~Spent() { flag.store(false); }
+    } spent{disable_over_enable};
+    if (disable_over_enable.exchange(false)) bk::bad_argument("enable: stopped on request: a disable came after it, the motors stay off");
     reap_locked();
     {
       std::lock_guard s(state);
@@ -398,6 +408,7 @@ struct BlmcActor::Impl {
   // as its safety stop).
   void interrupt_waits() {
     const auto busy = core.busy_with();
+    if (busy == "enable") disable_over_enable.store(true);
     if (busy == "enable" || busy == "recover" || busy == "home") board.interrupt();
   }
 
