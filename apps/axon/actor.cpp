@@ -8,6 +8,7 @@
 #include "axon/actor/teller.hpp"
 #include "axon/fps/host/client.hpp"
 #include "axon/fps/sim/simulated_plane.hpp"
+#include "axon/web/fps_host_page.hpp"
 #include "commands.hpp"
 #include "layout_name.hpp"
 #include "run.hpp"
@@ -48,7 +49,8 @@ void add_simulator_verbs(actor::ActorCore& core, fps::sim::SimulatedPlane& sim) 
 }
 
 int run_actor_fps(const ActorFpsOptions& o) {
-  if (!o.actor.http.empty()) throw Exception(usage("actor fps: --http is not served yet (blmc and c4g actors only)"));
+  if (!o.actor.http.empty() && !o.buses.empty())
+    throw Exception(usage("actor fps: --http draws the plane from its layout: give --layout (with --connect), not --bus"));
   const bool simulate = o.buses.empty() && !o.connect;
   return run_command([&o, simulate](asio::io_context& io, SignalHook hook) -> asio::awaitable<int> {
     std::unique_ptr<fps::sim::SimulatedPlane> sim;
@@ -61,7 +63,16 @@ int run_actor_fps(const ActorFpsOptions& o) {
     else client.open(sim ? sim->plane() : need(resolve_layout(o.layout)));
     actor::BusActor bus({o.actor.name, o.bus.link()});
     {
+      // --http: the host's view of the plane, read beside the commands, out of their way.
+      std::unique_ptr<web::FpsClientPage> page;
+      if (!o.actor.http.empty()) {
+        web::FpsHostPageOptions po;
+        po.server = web::server_address(o.actor.http);
+        page = std::make_unique<web::FpsClientPage>(po, client);
+        std::fprintf(stderr, "listening http %s\n", page->where().c_str());
+      }
       actor::FpsActorOptions fo;
+      if (page) fo.on_bus_use = [&page](fps::BusUse use) { page->bus_use(use); };
       fo.status_period_s = o.actor.status_period_s;
       fo.friction_history = o.friction_history;
       fo.plc_address = cc.plc_address;

@@ -21,7 +21,7 @@
 #include "layout_name.hpp"
 #include "axon/net/endpoint.hpp"
 #include "axon/core/progress.hpp"
-#include "axon/web/fps_host_view.hpp"
+#include "axon/web/fps_host_page.hpp"
 #include "axon/web/server.hpp"
 #include "run.hpp"
 
@@ -106,45 +106,16 @@ host::FocalPlaneArrayOptions array_options(const PlaneArgs& a) {
   return o;
 }
 
-// --http: the host's view of the plane (web::FpsHostView) on a web server of its own thread; the
-// view reads and publishes on the array's executor until `alive` turns false, then sets `done`.
-constexpr auto kHostPublishPeriod = std::chrono::milliseconds(100);  // the page: 10 updates a second
-constexpr auto kHostReadPeriod = std::chrono::milliseconds(250);     // a read round at most 4 times a second
-
-struct HostPage {
-  std::unique_ptr<web::Server> server;
-  std::shared_ptr<web::Source> source;
-  std::unique_ptr<web::FpsHostView> view;
-  std::shared_ptr<bool> alive = std::make_shared<bool>(true);
-  bool done = false;
-};
-
-asio::awaitable<void> serve_host_view(HostPage* page) {
-  co_await page->view->run(*page->source, kHostPublishPeriod, kHostReadPeriod, page->alive);
-  page->done = true;
-}
-
-// "PORT" alone listens on the loopback address.
-std::unique_ptr<HostPage> open_host_page(const std::string& address, host::FocalPlaneArray& fpa, asio::any_io_executor ex,
-                                         bool quiet_stdout) {
-  const bool port_only = !address.empty() && std::all_of(address.begin(), address.end(), [](char c) {
-    return std::isdigit(static_cast<unsigned char>(c)) != 0;
-  });
-  const auto ep = need(net::parse_endpoint(port_only ? "127.0.0.1:" + address : address));
-  web::ServerOptions so;
-  so.address = ep.host;
-  so.port = ep.port;
-  so.push_period = kHostPublishPeriod;
-  auto page = std::make_unique<HostPage>();
-  page->server = std::make_unique<web::Server>(so);
-  page->source = std::make_shared<web::Source>("fps", fmt::format("fps: host view of '{}'", fpa.plane().name()), "fps");
-  page->view = std::make_unique<web::FpsHostView>(fpa);
-  page->source->set_info(page->view->info_json());
-  page->server->add(page->source);
+// --http: the host's view of the plane (web::FpsHostPage): its server on a thread of its own, the
+// view reading and publishing on the array's executor.
+std::unique_ptr<web::FpsHostPage> open_host_page(const std::string& address, host::FocalPlaneArray& fpa,
+                                                 asio::any_io_executor ex, bool quiet_stdout) {
+  web::FpsHostPageOptions po;
+  po.server = web::server_address(address);
+  auto page = std::make_unique<web::FpsHostPage>(po, fpa, ex);
   std::FILE* out = quiet_stdout ? stderr : stdout;  // --json: stdout carries the one document
-  std::fprintf(out, "listening http %s:%u\n", page->server->address().c_str(), unsigned{page->server->port()});
+  std::fprintf(out, "listening http %s\n", page->where().c_str());
   std::fflush(out);
-  asio::co_spawn(ex, serve_host_view(page.get()), asio::detached);
   return page;
 }
 
@@ -513,11 +484,11 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
     auto connected = co_await host::FocalPlaneArray::connect(ex, plane, array_options(a));
     auto fpa = need(std::move(connected));
     const auto page = a.http.empty() ? nullptr : open_host_page(a.http, *fpa, ex, a.json);
-    if (page) page->view->set_reading(reading_for(action));
+    if (page) page->view().set_reading(reading_for(action));
     int rc = 0;
     std::exception_ptr failure;
     try {
-      rc = co_await plane_action(*fpa, a, action, plane, set_on_signal, image, uo, page ? page->view.get() : nullptr);
+      rc = co_await plane_action(*fpa, a, action, plane, set_on_signal, image, uo, page ? &page->view() : nullptr);
     } catch (...) {
       failure = std::current_exception();  // close first: the robots and connections are left tidy
       // The action's own hook may point into its finished frame (cold's stop flag): a signal
@@ -526,13 +497,12 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
     }
     std::fflush(stdout);
     if (page && !failure && a.http_linger_s > 0) {
-      if (action != "move") page->view->set_reading(web::HostReading::all);  // the action's own traffic is over
+      if (action != "move") page->view().set_reading(web::HostReading::all);  // the action's own traffic is over
       co_await linger_host_page(a.http_linger_s, set_on_signal);
       stop_robots_on_signal(set_on_signal, fpa->array());
     }
-    if (page) *page->alive = false;
+    if (page) co_await page->finish();  // the view reads the array: it ends first
     co_await fpa->close();
-    while (page && !page->done) co_await core::sleep_for(std::chrono::milliseconds(10));  // the view reads the array
     set_on_signal([] {});  // the array is closed: a later signal has nothing to stop
     report_signal_stop(fpa->array());
     if (failure) std::rethrow_exception(failure);

@@ -155,6 +155,25 @@ struct FpsActor::Impl {
     return json{{"command_id", m.command->id().command_id}, {"robots", m.robots}, {"elapsed_s", seconds_since(m.started)}};
   }
 
+  // What a command does with the buses, told to FpsActorOptions::on_bus_use for as long as the
+  // guard lives (then shared again).
+  struct BusUseGuard {
+    const std::function<void(fps::BusUse)>& hook;
+    BusUseGuard(const std::function<void(fps::BusUse)>& h, fps::BusUse use) : hook(h) {
+      if (hook) hook(use);
+    }
+    BusUseGuard(const BusUseGuard&) = delete;
+    BusUseGuard& operator=(const BusUseGuard&) = delete;
+    ~BusUseGuard() {
+      try {
+        if (hook) hook(fps::BusUse::shared);
+      } catch (const std::exception& e) {
+        spdlog::warn("fps actor: bus use: {}", e.what());
+      }
+    }
+  };
+  [[nodiscard]] BusUseGuard use_buses(fps::BusUse use) const { return BusUseGuard(options.on_bus_use, use); }
+
   void status(Command& c) { c.finish(status_keywords()); }
 
   void go(Command& c) {
@@ -163,6 +182,7 @@ struct FpsActor::Impl {
     if (client.locked())
       throw Exception(Error(CoreErrc::invalid_argument, fmt::format("locked ({}): unlock first", client.lock_reason())));
     const auto tracking = start_move(c, targets);
+    const auto buses = use_buses(fps::BusUse::moving);
     const auto out = client.goto_absolute(targets);
     remember(client.status());
     json kw{{"move_result", fps::to_json(out)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
@@ -198,6 +218,7 @@ struct FpsActor::Impl {
     if (client.locked())
       throw Exception(Error(CoreErrc::invalid_argument, fmt::format("locked ({}): unlock first", client.lock_reason())));
     const auto tracking = start_move(c, targets);
+    const auto buses = use_buses(fps::BusUse::exclusive);  // the plan's upload comes first
     const auto out = file ? client.plan_and_move(args[0]) : client.plan_and_move(targets);
     remember(client.status());
     json kw{{"plan_result", fps::plan_result_json(out)}, {"move_result", fps::to_json(out.move)},
@@ -210,6 +231,7 @@ struct FpsActor::Impl {
   // join).
   void discover(Command& c) {
     std::lock_guard lock(device);
+    const auto buses = use_buses(fps::BusUse::exclusive);
     const auto rows = client.discover();
     remember(rows);
     std::size_t ready = 0;
@@ -221,6 +243,7 @@ struct FpsActor::Impl {
   // check: GET_ID on every bus, compared with the layout.
   void check(Command& c) {
     std::lock_guard lock(device);
+    const auto buses = use_buses(fps::BusUse::exclusive);
     const auto r = client.check_layout();
     json kw{{"layout_check", fps::to_json(r)}, {"locked", client.locked()}, {"locked_by", client.lock_reason()}};
     if (r.ok()) c.finish(std::move(kw));
@@ -230,6 +253,7 @@ struct FpsActor::Impl {
   // cold: the cold-temperature policy once, from the PLC's temperatures to every robot.
   void cold(Command& c) {
     std::lock_guard lock(device);
+    const auto buses = use_buses(fps::BusUse::exclusive);
     const auto r = client.apply_cold_policy();
     json kw{{"cold", fps::to_json(r)}};
     if (r.failed.empty()) c.finish(std::move(kw));
@@ -254,6 +278,7 @@ struct FpsActor::Impl {
 
   void back_off(Command& c) {
     std::lock_guard lock(device);
+    const auto buses = use_buses(fps::BusUse::exclusive);
     std::vector<std::uint16_t> ids;
     for (const auto& a : c.args()) ids.push_back(robot_id(a, client.robots(), "backoff"));
     const auto out = client.back_off(ids);
@@ -265,6 +290,7 @@ struct FpsActor::Impl {
 
   void friction(Command& c) {
     std::lock_guard lock(device);
+    const auto buses = use_buses(fps::BusUse::exclusive);
     std::vector<std::uint16_t> ids;
     for (const auto& a : c.args()) ids.push_back(robot_id(a, client.robots(), "friction"));
     const auto report = client.friction_survey(ids, {}, options.friction_history);
@@ -279,6 +305,7 @@ struct FpsActor::Impl {
     if (args.empty() || args.size() > 2 || (args.size() == 2 && !arm))
       throw Exception(Error(CoreErrc::invalid_argument, "halltest takes ID [alpha|beta]"));
     std::lock_guard lock(device);
+    const auto buses = use_buses(fps::BusUse::exclusive);
     fps::host::HallTestOptions o;
     o.alpha = !arm || *arm == 'a';
     o.beta = !arm || *arm == 'b';
@@ -300,6 +327,7 @@ struct FpsActor::Impl {
     fps::UpgradeSettings s;
     if (args.size() == 2) s.expected_version = args[1];
     std::lock_guard lock(device);
+    const auto buses = use_buses(fps::BusUse::exclusive);
     const auto out = client.upgrade_firmware(image, s, [&c](const fps::SextantUpgrade& p) {
       c.write(MessageCode::running, {{"upgrade_progress", fps::to_json(p)}});
     });
@@ -311,6 +339,7 @@ struct FpsActor::Impl {
 
   void unlock(Command& c) {
     std::lock_guard lock(device);
+    const auto buses = use_buses(fps::BusUse::exclusive);
     const auto out = client.unlock();
     c.finish({{"unlocked", {{"acknowledged", out.acknowledged}, {"silent", out.silent}}},
               {"locked", client.locked()},

@@ -36,11 +36,13 @@
 
 #include "axon/actor/actor_core.hpp"
 
+#include <functional>
 #include <memory>
 #include <string>
 
 namespace axon::fps {
 class Client;
+enum class BusUse;  // fps/host/client.hpp
 }
 
 namespace axon::actor {
@@ -51,6 +53,11 @@ struct FpsActorOptions {
   double progress_period_s = 1.0;  // move_progress while a goto runs
   std::string friction_history{};  // friction's CSV history ("": none, every arm a baseline)
   std::string plc_address{};       // the PLC at HOST[:PORT] for plc, power, gateway, sync ("": none)
+  // Told what a command does with the buses, on the command's thread, before the command calls the
+  // client (goto: moving; plan, discover, check, cold, unlock, backoff, upgrade, friction, halltest:
+  // exclusive) and after it (shared), so that a reader beside the actor (a web view) keeps its own
+  // traffic out of the way; the command waits for it. Empty: nobody is told.
+  std::function<void(fps::BusUse)> on_bus_use{};
 };
 
 class FpsActor {

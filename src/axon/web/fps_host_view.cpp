@@ -83,6 +83,7 @@ struct FpsHostView::Impl {
 
   fhost::FocalPlaneArray& fpa;
   HostReading reading = HostReading::all;
+  bool in_round = false;  // read() under way
   std::map<std::uint16_t, HostReads> reads;
   std::vector<HostRow> rows;
   FpsHostLock lock;
@@ -94,6 +95,7 @@ FpsHostView::~FpsHostView() = default;
 
 void FpsHostView::set_reading(HostReading mode) noexcept { impl_->reading = mode; }
 HostReading FpsHostView::reading() const noexcept { return impl_->reading; }
+bool FpsHostView::reading_now() const noexcept { return impl_->in_round; }
 const FpsHostLock& FpsHostView::lock() const noexcept { return impl_->lock; }
 
 void FpsHostView::Impl::fail(HostReads& r, const Error& e) {
@@ -141,6 +143,11 @@ boost::asio::awaitable<void> FpsHostView::read() {
   slots.reserve(ids.size());
   for (auto id : ids) slots.push_back(&impl_->reads[id]);  // map nodes stay put while the reads run
   Impl* im = impl_.get();
+  struct Round {  // in_round while the requests may go out, whatever ends the round
+    bool& flag;
+    ~Round() { flag = false; }
+  } round{im->in_round};
+  im->in_round = true;
   co_await fhost::for_each_concurrently(ids.size(), [im, &ids, &slots, mode](std::size_t i) -> boost::asio::awaitable<void> {
     co_await im->read_robot(ids[i], *slots[i], mode);
   });

@@ -62,6 +62,8 @@ class FpsHostView {
 
   void set_reading(HostReading mode) noexcept;
   [[nodiscard]] HostReading reading() const noexcept;
+  // True while a read() round is under way (its requests may still go out).
+  [[nodiscard]] bool reading_now() const noexcept;
   // One round of reads of every known robot (see above).
   boost::asio::awaitable<void> read();
   // Rebuilds the rows and the lock from what was read (no I/O).

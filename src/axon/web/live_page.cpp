@@ -1,27 +1,12 @@
 #include "axon/web/live_page.hpp"
 
 #include "axon/core/error.hpp"
-#include "axon/net/endpoint.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <algorithm>
-#include <cctype>
 
 namespace axon::web {
-
-ServerOptions server_address(const std::string& host_port) {
-  const bool port_only = !host_port.empty() && std::all_of(host_port.begin(), host_port.end(), [](char c) {
-    return std::isdigit(static_cast<unsigned char>(c)) != 0;
-  });
-  auto ep = net::parse_endpoint(port_only ? "127.0.0.1:" + host_port : host_port);
-  if (!ep) throw Exception(ep.error());
-  ServerOptions so;
-  so.address = ep.value().host;
-  so.port = ep.value().port;
-  return so;
-}
 
 LivePage::LivePage(const ServerOptions& server, std::shared_ptr<Source> source)
     : server_(std::make_unique<Server>(server)), source_(std::move(source)) {

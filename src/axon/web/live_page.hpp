@@ -9,7 +9,6 @@
 //     or a sampler such as the simulator's truth).
 //   - C4gPage: a web::C4gView on a LivePage, fed the app switch's events (C4gActorOptions::on_event).
 //
-// server_address() reads --http's HOST:PORT (PORT alone: 127.0.0.1; port 0: any free port).
 // Errors: the constructors throw axon::Exception as web::Server does (an address that does not
 // parse, a port in use). The destructors stop and never throw.
 #pragma once
@@ -27,8 +26,6 @@
 #include <thread>
 
 namespace axon::web {
-
-[[nodiscard]] ServerOptions server_address(const std::string& host_port);
 
 class LivePage {
  public:

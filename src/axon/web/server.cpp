@@ -6,6 +6,7 @@
 
 #include "axon/core/error.hpp"
 #include "axon/core/log.hpp"
+#include "axon/net/endpoint.hpp"
 
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
@@ -21,6 +22,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cctype>
 #include <deque>
 #include <future>
 #include <map>
@@ -407,6 +410,18 @@ void Server::stop() noexcept {
   // Every coroutine ends once its socket or timer is closed; then run() returns.
   if (impl_->thread.joinable()) impl_->thread.join();
   impl_->joined = true;
+}
+
+ServerOptions server_address(const std::string& host_port) {
+  const bool port_only = !host_port.empty() && std::all_of(host_port.begin(), host_port.end(), [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) != 0;
+  });
+  auto ep = net::parse_endpoint(port_only ? "127.0.0.1:" + host_port : host_port);
+  if (!ep) throw Exception(ep.error());
+  ServerOptions so;
+  so.address = ep.value().host;
+  so.port = ep.value().port;
+  return so;
 }
 
 }  // namespace axon::web

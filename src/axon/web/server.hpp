@@ -36,6 +36,10 @@ struct ServerOptions {
   std::chrono::seconds idle_timeout{30};     // an HTTP connection with no complete request
 };
 
+// The options for --http's HOST:PORT (PORT alone: 127.0.0.1; port 0: any free port); throws
+// axon::Exception when it does not parse.
+[[nodiscard]] ServerOptions server_address(const std::string& host_port);
+
 class Server {
  public:
   explicit Server(ServerOptions options = {});

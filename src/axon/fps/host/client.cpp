@@ -223,6 +223,10 @@ std::vector<RobotStatus> Client::status() {
   });
 }
 
+void Client::with_loop(const std::function<void(host::FocalPlaneArray*, asio::io_context&)>& f) {
+  impl_->loop.call([this, &f] { f(impl_->plane_array.get(), impl_->loop.executor().context()); });
+}
+
 std::vector<std::uint16_t> Client::robots() const {
   auto& array = impl_->open_array();
   return impl_->loop.call([&array] { return array.ids(); });

@@ -38,7 +38,15 @@
 #include <string>
 #include <vector>
 
+namespace boost::asio {
+class io_context;
+}
+
 namespace axon::fps {
+
+namespace host {
+class FocalPlaneArray;
+}
 
 struct Angles {
   double alpha = 0;  // degrees
@@ -233,6 +241,12 @@ struct ColdOutcome {
   std::string text;                   // the decision and its reasons, then the robots
 };
 
+// What a caller is doing with the client's buses, for a reader beside it that must not disturb the
+// work (web::FpsClientPage): nothing that minds other traffic; a move (it polls the status words
+// itself, positions may still be read); work no other traffic may meet (a trajectory upload, a
+// discovery, which replaces the robots' handles, a firmware upgrade, a measurement).
+enum class BusUse { shared, moving, exclusive };
+
 class Client {
  public:
   explicit Client(ClientConfig config = {});
@@ -342,6 +356,12 @@ class Client {
   // waiting on the client's loop, if any, then ends soon (its moves fail as locked). Nothing
   // happens when the client is not open. Never throws.
   void interrupt(const std::string& reason) noexcept;
+
+  // For code that works beside the blocking calls on the client's own loop thread (a web view
+  // reading the robots between and during calls, web::FpsClientPage): runs f there with the focal
+  // plane array (nullptr unless open(plane); it lives until close()) and the loop's io_context, and
+  // waits for it. What f starts on the loop must be over before close(). f must not call the client.
+  void with_loop(const std::function<void(host::FocalPlaneArray*, boost::asio::io_context&)>& f);
 
   // Stops what this client set moving, closes the connections. Idempotent, never throws.
   void close() noexcept;
