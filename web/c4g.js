@@ -4,7 +4,8 @@
 // application; two histograms (Chart.js from Debian's libjs-chart.js, served at /javascript/chart.js/)
 // of the cycle timing: receive-to-send with the answer deadline marked, and the controller's period
 // with its nominal value marked; late and unanswered replies, the Safety layer's following-error and
-// drive-off replies, the controller's errors and the latest events. The server pushes the state
+// drive-off replies, the following error of each axis as the cycle last measured it (|D1 - D3|, with
+// its peak since the axis entered its mode), the controller's errors and the latest events. The server pushes the state
 // (/ws?source=c4g, docs/dashboard.md). window.axonC4g holds what the page shows, for scripts and tests.
 
 const c4g = {
@@ -128,9 +129,14 @@ function showAxes(axes, arms) {
     tr.dataset.phase = a.phase;
     tr.className = a.mode === 0 ? '' : 'open';
     const cells = [a.i, a.arm ? `${a.arm}.${a.axis}` : '-', a.mode, a.label, a.name, a.phase || '-', num(a.in_mode_s, 1),
-                   num(a.fe_threshold, 3)];
+                   num(a.following_error, 5), num(a.following_error_peak, 5), num(a.fe_threshold, 3)];
     for (const v of cells) tr.insertCell().textContent = v;
     tr.cells[3].title = modeTitle(a.mode);
+    // Against the threshold in the modes the Safety checks; near it (over 80 %) shown as a warning.
+    const fe = tr.cells[7];
+    fe.dataset.fe = a.following_error;
+    fe.className = a.fe_checked && a.fe_threshold > 0 && a.following_error > 0.8 * a.fe_threshold ? 'near' : '';
+    fe.title = a.fe_checked ? 'checked against the threshold in this mode' : 'not checked in this mode';
   }
   const list = $('arms');
   list.innerHTML = '';
@@ -164,7 +170,9 @@ function showSafety(safety, c, axes) {
     ['drive-off replies', safety.drive_off_replies],
   ]);
   const thresholds = axes.map((a) => num(a.fe_threshold, 2));
+  const largest = axes.reduce((best, a) => (a.following_error > (best ? best.following_error : -1) ? a : best), null);
   rows($('following'), [
+    ['largest now [motor turns]', largest ? `${num(largest.following_error, 5)} (axis ${largest.i})` : '-'],
     ['following-error replies (508)', safety.following_error_replies],
     ['following-error fault', safety.fault === 'following error' ? `axis ${safety.fault_axis + 1}` : 'none'],
     ['thresholds [motor turns]', thresholds.length ? thresholds.join(' ') : '-'],

@@ -1,8 +1,14 @@
 // `axon sim c4g`: a simulated C4G robot controller that plays a robot program (scenario) and talks
 // to a PC server over the open interface's UDP protocol, as the real controller would. The run is
-// c4g::sim::SimulatedController; here are the arguments and the printing.
+// c4g::sim::SimulatedController; here are the arguments and the printing. --http serves the
+// controller's own truth (joints, modes, the program's step, the PC's replies judged, events) on the
+// c4g simulator page (docs/dashboard.md): snapshots the controller's thread queues lock-free, taken
+// and published on this thread.
 #include "axon/c4g/host/server.hpp"
 #include "axon/c4g/sim/simulated_controller.hpp"
+#include "axon/net/endpoint.hpp"
+#include "axon/web/c4g_sim_view.hpp"
+#include "axon/web/server.hpp"
 #include "checks.hpp"
 #include "commands.hpp"
 #include "run.hpp"
@@ -15,6 +21,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <thread>
 
 namespace axon::app {
 namespace {
@@ -37,6 +44,8 @@ struct SimC4gArgs {
   double switch_t1_ms = -1, switch_t2_ms = -1, switch_t3_ms = -1;
   double switch_tolerance = -1;
   std::string switch_reducer = "controller";
+  std::string http;          // HOST:PORT of the live page (empty: none)
+  double http_linger_s = 0;  // keep serving the final state this long after the run
 };
 
 sim::SimulatedControllerOptions sim_options(const SimC4gArgs& o) {
@@ -97,17 +106,85 @@ void print_text(const sim::SimulatedControllerReport& r) {
               r.rtt_p50_us, r.rtt_p99_us, r.rtt_max_us, r.reply_window_us);
 }
 
+// ---- --http: the simulator's page -----------------------------------------------------------------
+
+constexpr auto kLivePeriod = std::chrono::milliseconds(20);  // snapshots: 50 a second
+constexpr auto kPublishPeriod = std::chrono::milliseconds(100);  // the page: 10 updates a second
+
+struct SimWebPage {
+  std::unique_ptr<web::Server> server;
+  std::shared_ptr<web::Source> source;
+  std::unique_ptr<web::C4gSimView> view;
+  sim::LiveState live;
+  std::chrono::steady_clock::time_point next{};
+
+  [[nodiscard]] std::string where() const { return fmt::format("{}:{}", server->address(), server->port()); }
+  // Takes what the controller's thread queued; publishes every kPublishPeriod (the metrics once a second).
+  void tick(sim::SimulatedController& c, bool force = false) {
+    const bool got = c.take_live(live, [this](const sim::LiveEvent& e) { view->add_event(e); });
+    if (got) view->update(live, c.live_dropped());
+    const auto now = std::chrono::steady_clock::now();
+    if (!force && now < next) return;
+    next = now + kPublishPeriod;
+    view->publish(*source, force ? 1 : 10);
+  }
+};
+
+std::unique_ptr<SimWebPage> open_sim_page(const SimC4gArgs& o, const sim::SimulatedController& c) {
+  const auto ep = need(net::parse_endpoint(o.http));
+  web::ServerOptions so;
+  so.address = ep.host;
+  so.port = ep.port;
+  auto page = std::make_unique<SimWebPage>();
+  web::C4gSimViewOptions vo;
+  vo.command = fmt::format("sim c4g --robot {}", o.robot);
+  vo.robot = c.robot().name;
+  vo.program = o.scenario.empty() ? "the default program" : o.scenario;
+  vo.server = o.server;
+  vo.period_ms = c.robot().init.period_ms;
+  if (o.period_ms > 0) vo.period_ms = o.period_ms;
+  vo.steps = c.program_steps();
+  page->view = std::make_unique<web::C4gSimView>(std::move(vo));
+  page->server = std::make_unique<web::Server>(so);
+  page->source = std::make_shared<web::Source>("c4g-sim", fmt::format("c4g simulator: {} to {}", c.robot().name, o.server), "c4g-sim");
+  page->source->set_info(page->view->info_json());
+  page->view->publish(*page->source, 1);
+  page->server->add(page->source);
+  return page;
+}
+
+// --http-linger: the page goes on showing how the run ended until the time is up or a stop signal.
+void linger_sim_page(SimWebPage& page, sim::SimulatedController& c, double seconds, const StopSignals& signals) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < until && signals.count() == 0) {
+    std::this_thread::sleep_for(kPublishPeriod);
+    page.tick(c, true);
+  }
+}
+
 int run_sim_c4g(const SimC4gArgs& o) {
   std::optional<StopSignals> signals(std::in_place);
-  auto controller = sim::SimulatedController::start(sim_options(o));
+  auto options = sim_options(o);
+  if (!o.http.empty()) options.live_period_s = std::chrono::duration<double>(kLivePeriod).count();
+  auto controller = sim::SimulatedController::start(std::move(options));
   std::fprintf(stderr, "sim c4g: %s\n", controller.describe().c_str());
+  auto page = o.http.empty() ? nullptr : open_sim_page(o, controller);
+  if (page) {
+    std::fprintf(o.json ? stderr : stdout, "listening http %s\n", page->where().c_str());
+    std::fflush(o.json ? stderr : stdout);
+  }
   std::optional<sim::SimulatedControllerReport> report;
-  while (!(report = controller.wait_for(std::chrono::milliseconds(20))))
+  while (!(report = controller.wait_for(kLivePeriod))) {
     if (signals->count() > 0) report = controller.stop();
-  signals.reset();
+    if (page) page->tick(controller);
+  }
+  if (page) page->tick(controller, true);  // the last snapshot and events
   if (o.json) std::printf("%s\n", report_json(*report).dump(2).c_str());
   else print_text(*report);
   std::fflush(stdout);
+  // A run a signal ended does not linger: the user asked to stop.
+  if (page && o.http_linger_s > 0 && signals->count() == 0) linger_sim_page(*page, controller, o.http_linger_s, *signals);
+  signals.reset();
   return report->exit_code();
 }
 
@@ -132,6 +209,10 @@ void add_sim_c4g_command(CLI::App& sim_cmd, GlobalOptions& global) {
   c->add_option("--switch-t3-ms", o->switch_t3_ms, "soft switching post-switching interval T3 [ms] (default 50)")->check(CLI::Range(0.0, 60000.0));
   c->add_option("--switch-tolerance", o->switch_tolerance, "motor turns the robot may move during T1..T3 (default 0.02)")->check(CLI::Range(0.0, 1e6));
   c->add_option("--switch-reducer", o->switch_reducer, "who scales the PC's current while switching: controller (default) or pc");
+  c->add_option("--http", o->http, "serve the controller's live page (the simulator's truth), /api/state and /metrics on "
+                                   "HOST:PORT (port 0: any; docs/dashboard.md)");
+  c->add_option("--http-linger", o->http_linger_s, "with --http: keep serving the final state this many seconds after the "
+                                                   "run (a stop signal ends it; default 0)")->check(non_negative());
   c->callback([o, &global] { global.exit_code = run_sim_c4g(*o); });
 }
 

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <deque>
 #include <iterator>
 #include <optional>
@@ -84,6 +85,9 @@ std::string hist_json(const core::LatencyHistogram& h, std::int64_t width) {
                      fmt::join(counts, ","), h.count(), static_cast<double>(h.max()) / 1e3);
 }
 
+// A float as JSON: null when it is not finite (a NaN in the controller's packet).
+std::string json_number(float v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "null"; }
+
 struct AxisTrack {
   std::int32_t mode = 0;
   double since_wall_ns = 0;  // when the mode appeared (the packet's arrival), 0: unknown
@@ -154,6 +158,7 @@ class Model {
   void write_counter_metrics(MetricsText& m) const;
   void write_timing_metrics(MetricsText& m) const;
   void write_state_metrics(MetricsText& m) const;
+  void write_following_error_metrics(MetricsText& m) const;
   [[nodiscard]] std::int64_t nominal_ns() const;
   [[nodiscard]] std::vector<std::size_t> arms_present() const;
 
@@ -260,17 +265,11 @@ std::string Model::info_json() const {
   std::string out;
   auto it = std::back_inserter(out);
   const auto& t = options.soft_switch;
-  fmt::format_to(it, "{{\"family\":\"c4g\",\"command\":{},\"app\":{},\"soft_switch_ms\":[{},{},{}],\"modes\":[",
+  fmt::format_to(it, "{{\"family\":\"c4g\",\"command\":{},\"app\":{},\"soft_switch_ms\":[{},{},{}],\"modes\":",
                  json_quote(options.command), json_quote(app.name()), t.t1_s * 1e3, t.t2_s * 1e3, t.t3_s * 1e3);
+  out += c4g_modes_json();
+  out += ",\"controller_errors\":[";
   bool first = true;
-  for (const auto& m : protocol::all_modes()) {
-    fmt::format_to(it, "{}{{\"code\":{},\"name\":{},\"label\":{},\"kind\":\"{}\",\"description\":{}}}", first ? "" : ",",
-                   protocol::code(m.mode), json_quote(m.name), json_quote(m.label), kind_text(m.kind),
-                   json_quote(m.description));
-    first = false;
-  }
-  out += "],\"controller_errors\":[";
-  first = true;
   for (const auto e : kControllerErrors) {
     fmt::format_to(it, "{}{{\"name\":{},\"meaning\":{}}}", first ? "" : ",", json_quote(host::manual_name(e)),
                    json_quote(host::meaning(e)));
@@ -310,11 +309,15 @@ std::string Model::axes_json() const {
     const auto axis = map && i < map->count() ? map->logical(i).axis : 0;
     const double in_mode = a.since_wall_ns > 0 ? std::max(0.0, (now - a.since_wall_ns) * 1e-9) : 0.0;
     const bool exit_sent = arm > 0 && arms[arm - 1].exit_sent;
+    const auto& safety = server.safety();
     fmt::format_to(it, "{}{{\"i\":{},\"arm\":{},\"axis\":{},\"mode\":{},\"name\":{},\"label\":{},\"phase\":\"{}\","
-                       "\"in_mode_s\":{:.3f},\"fe_threshold\":{},\"current_limit\":{}}}",
+                       "\"in_mode_s\":{:.3f},\"fe_threshold\":{},\"current_limit\":{},\"following_error\":{},"
+                       "\"following_error_peak\":{},\"fe_checked\":{}}}",
                    i ? "," : "", i + 1, arm, static_cast<unsigned>(axis), a.mode,
                    json_quote(info ? info->name : "unknown"), json_quote(info ? info->label : std::to_string(a.mode)),
-                   open_phase(a.mode, in_mode, exit_sent, options.soft_switch), in_mode, fe_threshold[i], current_limit[i]);
+                   open_phase(a.mode, in_mode, exit_sent, options.soft_switch), in_mode, fe_threshold[i], current_limit[i],
+                   json_number(safety.following_error(i)), json_number(safety.following_error_peak(i)),
+                   host::Safety::checks_following_error(a.mode));
   }
   return out + "]";
 }
@@ -487,6 +490,7 @@ void Model::write_state_metrics(MetricsText& m) const {
   for (const auto arm : arms_present()) m.sample(arms[arm - 1].drives_off, {{"arm", std::to_string(arm)}});
   m.family("axon_c4g_safety_faulted", MetricType::gauge, "1 while the PC-side safety layer has a fault latched, else 0")
       .sample(std::uint64_t{server.safety().faulted()});
+  write_following_error_metrics(m);
   m.family("axon_c4g_following_error_threshold_revolutions", MetricType::gauge,
            "The initialization packet's following-error threshold of each open axis, in motor revolutions");
   if (map)
@@ -498,6 +502,22 @@ void Model::write_state_metrics(MetricsText& m) const {
   for (const auto p : {apps::Phase::waiting, apps::Phase::running, apps::Phase::fading, apps::Phase::holding, apps::Phase::idle,
                        apps::Phase::exiting, apps::Phase::done, apps::Phase::refused})
     m.sample(std::uint64_t{apps::to_string(p) == phase}, {{"phase", apps::to_string(p)}});
+}
+
+// The cycle's latest |D1 - D3| per open axis and its peak in the mode (Safety's atomics). A NaN
+// (a packet that carried one) is left out: Prometheus would take it, but a graph would not.
+void Model::write_following_error_metrics(MetricsText& m) const {
+  const auto& safety = server.safety();
+  const auto each = [&](auto value) {
+    for (std::size_t i = 0; i < axis_count; ++i)
+      if (const float v = value(i); std::isfinite(v)) m.sample(static_cast<double>(v), {{"axis", std::to_string(i + 1)}});
+  };
+  m.family("axon_c4g_following_error_revolutions", MetricType::gauge,
+           "Each open axis's following error |target - actual| (D1 - D3) in the latest packet, in motor revolutions");
+  each([&](std::size_t i) { return safety.following_error(i); });
+  m.family("axon_c4g_following_error_peak_revolutions", MetricType::gauge,
+           "Each open axis's largest following error since it entered its present mode, in motor revolutions");
+  each([&](std::size_t i) { return safety.following_error_peak(i); });
 }
 
 std::string Model::metrics() const {
@@ -528,6 +548,16 @@ std::string C4gView::metrics() const { return impl_->metrics(); }
 void C4gView::publish(Source& source, unsigned metrics_every) {
   source.publish(state_json());
   if (metrics_every == 0 || impl_->publishes++ % metrics_every == 0) source.publish_metrics(metrics());
+}
+
+std::string c4g_modes_json() {
+  namespace protocol = c4g::protocol;
+  std::string out = "[";
+  for (const auto& m : protocol::all_modes())
+    fmt::format_to(std::back_inserter(out), "{}{{\"code\":{},\"name\":{},\"label\":{},\"kind\":\"{}\",\"description\":{}}}",
+                   out.size() > 1 ? "," : "", protocol::code(m.mode), json_quote(m.name), json_quote(m.label),
+                   c4g_page::kind_text(m.kind), json_quote(m.description));
+  return out + "]";
 }
 
 std::string c4g_app_phase(const c4g::apps::App& app) {

@@ -4,7 +4,9 @@
 // force (an OpenModeApp's waiting / running / fading / holding / idle / exiting / done / refused);
 // the cycle timing as two histograms, receive-to-send (the PC's processing time, against the answer
 // deadline) and the controller's inter-packet period; late and unanswered packets; the Safety
-// layer's following-error and drive-off replies and the fault in force; the controller's errors as
+// layer's following-error and drive-off replies and the fault in force; per open axis the
+// following error |D1 - D3| the cycle last measured and its peak since the axis entered its mode
+// (Safety::following_error, relaxed atomics the cycle thread writes); the controller's errors as
 // the packets showed them.
 //
 // Where the data comes from, and why nothing here touches the cycle thread:
@@ -71,6 +73,10 @@ class C4gView {
  private:
   std::unique_ptr<Impl> impl_;
 };
+
+// The open interface's modes as the pages' info carries them: [{code, name, label, kind,
+// description}, ...].
+[[nodiscard]] std::string c4g_modes_json();
 
 // The phase of an application as the page names it: an OpenModeApp's (for handover: the part now
 // serving an open mode, else "waiting"), empty for an app without one (monitor, echo). Any thread.

@@ -65,6 +65,34 @@ TEST(Safety, FollowingErrorIsCheckedWhereThePcGeneratesTheTrajectoryNotWhereItOn
   EXPECT_EQ(s.apply(req, rep), FaultReason::none);
 }
 
+TEST(Safety, KeepsEachAxisFollowingErrorAndItsPeakInTheModeForOtherThreads) {
+  Safety s;  // no thresholds: nothing is checked, the figures are kept all the same
+  auto req = packet(code(Mode::mode4));
+  const auto cycle = [&](float d1, float d3, std::int32_t mode) {
+    req.axes[1].mode = mode;
+    req.axes[1].d1 = d1;
+    req.axes[1].d3 = d3;
+    auto rep = req;
+    s.apply(req, rep);
+  };
+  EXPECT_EQ(s.following_error(1), 0.0f);  // before any packet
+  cycle(1.0f, 0.75f, code(Mode::mode4));
+  EXPECT_FLOAT_EQ(s.following_error(1), 0.25f);
+  EXPECT_FLOAT_EQ(s.following_error_peak(1), 0.25f);
+  cycle(1.0f, 1.1f, code(Mode::mode4));  // the other side of the target: the size counts
+  EXPECT_FLOAT_EQ(s.following_error(1), 0.1f);
+  EXPECT_FLOAT_EQ(s.following_error_peak(1), 0.25f);  // the peak stays while the mode does
+  cycle(1.0f, 0.95f, code(Mode::mode0));
+  EXPECT_FLOAT_EQ(s.following_error(1), 0.05f);
+  EXPECT_FLOAT_EQ(s.following_error_peak(1), 0.05f);  // a new mode: a new peak
+  EXPECT_EQ(s.following_error(0), 0.0f);
+  EXPECT_EQ(s.following_error(protocol::kMaxAxes), 0.0f);  // out of range reads 0
+  EXPECT_TRUE(Safety::checks_following_error(code(Mode::mode4)));
+  EXPECT_TRUE(Safety::checks_following_error(code(Mode::mode1)));
+  EXPECT_FALSE(Safety::checks_following_error(code(Mode::mode7)));
+  EXPECT_FALSE(Safety::checks_following_error(code(Mode::mode0)));
+}
+
 TEST(Safety, StrokeEndsAndContinuityAreOnByDefault) {
   const SafetyConfig c;
   EXPECT_TRUE(c.check_stroke_ends);

@@ -117,6 +117,9 @@ void Safety::configure(const protocol::InitPacket& init, const protocol::AxisMap
   set_steps(init.period_ms > 0 ? init.period_ms * 1e-3 : 0.002);
   configure_arms(init, map);
   have_last_ = {};
+  // A new initialization packet: the peaks start again.
+  fe_peak_local_ = {};
+  for (auto& p : fe_peak_) p.store(0.0f, std::memory_order_relaxed);
 }
 
 void Safety::configure_arms(const protocol::InitPacket& init, const protocol::AxisMap& map) noexcept {
@@ -246,10 +249,27 @@ bool Safety::check_joints(const protocol::Packet& request) noexcept {
   return true;
 }
 
+bool Safety::checks_following_error(std::int32_t mode) noexcept { return pc_checks_following(mode); }
+
+void Safety::track_following_errors(std::span<const protocol::Axis> request) noexcept {
+  for (std::size_t i = 0; i < request.size() && i < protocol::kMaxAxes; ++i) {
+    const auto& q = request[i];
+    const float e = std::fabs(q.d1 - q.d3);
+    if (q.mode != fe_mode_[i]) {
+      fe_mode_[i] = q.mode;
+      fe_peak_local_[i] = 0.0f;
+    }
+    if (!(e <= fe_peak_local_[i])) fe_peak_local_[i] = e;  // a NaN sticks until the mode changes
+    fe_now_[i].store(e, std::memory_order_relaxed);
+    fe_peak_[i].store(fe_peak_local_[i], std::memory_order_relaxed);
+  }
+}
+
 FaultReason Safety::apply(const protocol::Packet& request, protocol::Packet& reply) noexcept {
   begin_cycle();
   const auto req = request.open_axes();
   auto rep = reply.open_axes();
+  track_following_errors(req);
   const std::size_t n = std::min(req.size(), rep.size());
 
   if (!faulted()) {

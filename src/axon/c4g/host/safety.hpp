@@ -28,6 +28,10 @@
 // controller is no longer called) until reset(). A following-error fault answers 508 on the first
 // offending axis instead.
 //
+// The following error |D1 - D3| of every open axis is also kept for readers on other threads (a
+// page): the latest cycle's and the largest since the axis entered the mode it is in, in relaxed
+// atomics the cycle writes, whatever the mode and whether or not the check is on.
+//
 // Allocation-free and noexcept. configure() and apply() belong to the cycle thread; trip(),
 // reset() and the readers may be called from any thread.
 #pragma once
@@ -41,6 +45,7 @@
 #include <atomic>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -131,6 +136,17 @@ class Safety {
   // The continuity step in force per open axis [motor turns per cycle] (after configure()).
   [[nodiscard]] const std::array<float, protocol::kMaxAxes>& max_steps() const noexcept { return steps_; }
 
+  // |D1 - D3| of open axis i in the latest packet [motor turns] (0 before any), and the largest since
+  // the axis entered its present mode. Any thread; NaN when the packet carried one.
+  [[nodiscard]] float following_error(std::size_t i) const noexcept {
+    return i < protocol::kMaxAxes ? fe_now_[i].load(std::memory_order_relaxed) : 0.0f;
+  }
+  [[nodiscard]] float following_error_peak(std::size_t i) const noexcept {
+    return i < protocol::kMaxAxes ? fe_peak_[i].load(std::memory_order_relaxed) : 0.0f;
+  }
+  // The modes whose following error is checked against the threshold (1, 2, 4, 5 and their standbys).
+  static bool checks_following_error(std::int32_t mode) noexcept;
+
   // Writes the reply that asks for drive off on every axis (505).
   static void make_drive_off(const protocol::Packet& request, protocol::Packet& reply) noexcept;
 
@@ -144,6 +160,8 @@ class Safety {
     std::array<double, protocol::kAxesPerArm> min_rad{}, max_rad{};
   };
   void latch(FaultReason r, int axis) noexcept;
+  // The following errors of this packet into fe_now_ / fe_peak_.
+  void track_following_errors(std::span<const protocol::Axis> request) noexcept;
   // The checks of one axis; false once a fault is latched.
   bool check_axis(std::size_t i, const protocol::Axis& q, protocol::Axis& r) noexcept;
   // The joint ranges of every arm with a checked axis; false once a fault is latched.
@@ -168,6 +186,9 @@ class Safety {
   std::atomic<bool> reset_requested_{false};
   std::atomic<bool> drive_off_done_{false};  // written by the cycle thread
   SafetyCounters counters_;
+  std::array<std::atomic<float>, protocol::kMaxAxes> fe_now_{}, fe_peak_{};
+  std::array<std::int32_t, protocol::kMaxAxes> fe_mode_{};  // the mode each peak belongs to (cycle thread)
+  std::array<float, protocol::kMaxAxes> fe_peak_local_{};
 };
 
 }  // namespace axon::c4g::host

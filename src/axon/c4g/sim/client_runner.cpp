@@ -82,6 +82,7 @@ RunReport run_client(Controller& c, UdpClient& udp, const RunOptions& o) {
     if (late.size > 0) c.on_datagram(std::span<const std::byte>(late.bytes.data(), late.size));
     if (o.on_event)
       for (const auto& e : c.take_events()) o.on_event(e);
+    if (o.on_tick) o.on_tick(c, report);
     next += period;
     const auto now = Clock::now();
     if (now > next + period) {

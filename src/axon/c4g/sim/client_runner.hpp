@@ -20,20 +20,23 @@
 
 namespace axon::c4g::sim {
 
-struct RunOptions {
-  double duration_s = 0;                          // 0: until the controller finishes (or stop)
-  ReplyWindow window = ReplyWindow::manual;
-  std::chrono::nanoseconds reply_deadline{0};     // > 0: this window after the send, whatever `window` says
-  const std::atomic<bool>* stop = nullptr;        // set from another thread / a signal handler
-  std::function<void(const Event&)> on_event;     // called on the cycle thread, between ticks
-};
-
 struct RunReport {
   core::LatencyHistogram rtt;  // 1 us buckets to 20 ms
   std::uint64_t overruns = 0;   // ticks that started more than a period late (schedule reset)
   std::int64_t window_ns = 0;   // the reply window used
   double elapsed_s = 0;
   bool stopped = false;         // ended by stop or duration rather than by the controller
+};
+
+struct RunOptions {
+  double duration_s = 0;                          // 0: until the controller finishes (or stop)
+  ReplyWindow window = ReplyWindow::manual;
+  std::chrono::nanoseconds reply_deadline{0};     // > 0: this window after the send, whatever `window` says
+  const std::atomic<bool>* stop = nullptr;        // set from another thread / a signal handler
+  std::function<void(const Event&)> on_event;     // called on the cycle thread, between ticks
+  // Called after each tick's events with the report so far, on the cycle thread: keep it short,
+  // without allocation or locks (SimulatedController copies its live state here).
+  std::function<void(const Controller&, const RunReport&)> on_tick;
 };
 
 RunReport run_client(Controller& controller, UdpClient& udp, const RunOptions& options);

@@ -129,17 +129,26 @@ void Controller::emit(EventLevel level, std::string_view name, std::string text)
 }
 
 std::vector<double> Controller::joint_degrees(std::size_t arm) const {
-  std::vector<double> out;
-  if (arm < 1 || arm > P::kMaxArms || !arms_[arm].transform) return out;
+  std::array<double, P::kAxesPerArm> q{};
+  const auto n = link_degrees(arm, false, q);
+  return {q.begin(), q.begin() + static_cast<std::ptrdiff_t>(n)};
+}
+
+std::size_t Controller::link_degrees(std::size_t arm, bool target, std::span<double> out) const noexcept {
+  if (arm < 1 || arm > P::kMaxArms || !arms_[arm].transform) return 0;
   const auto& t = *arms_[arm].transform;
+  // Fixed capacity (transform.hpp): no allocation.
   P::ArmTransform::Vector motor(static_cast<Eigen::Index>(t.axes()));
   for (std::size_t k = 0; k < t.axes(); ++k) {
     const auto open = map_.open_index(arm, k + 1);
-    motor[static_cast<Eigen::Index>(k)] = open ? axes_[*open].model.position() : t.calibration()[static_cast<Eigen::Index>(k)];
+    motor[static_cast<Eigen::Index>(k)] = !open ? t.calibration()[static_cast<Eigen::Index>(k)]
+                                          : target ? axes_[*open].ref_pos
+                                                   : axes_[*open].model.position();
   }
   const auto q = t.link_position(motor);
-  for (Eigen::Index k = 0; k < q.size(); ++k) out.push_back(q[k] * 180.0 / std::numbers::pi);
-  return out;
+  const auto n = std::min(out.size(), static_cast<std::size_t>(q.size()));
+  for (std::size_t k = 0; k < n; ++k) out[k] = q[static_cast<Eigen::Index>(k)] * 180.0 / std::numbers::pi;
+  return n;
 }
 
 // ---- sending ---------------------------------------------------------------------------------

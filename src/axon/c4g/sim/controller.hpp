@@ -120,6 +120,19 @@ class Controller {
   [[nodiscard]] bool drives_on(std::size_t arm) const noexcept;
   // Joint positions of an arm at the link [deg], from the motor positions.
   [[nodiscard]] std::vector<double> joint_degrees(std::size_t arm) const;
+  // The same into `out` without allocating (at most out.size() joints; returns how many): from the
+  // motor positions, or (target) from the targets the packets report (D1).
+  std::size_t link_degrees(std::size_t arm, bool target, std::span<double> out) const noexcept;
+  // The mode code the PC's last good reply asked for on an open axis.
+  [[nodiscard]] std::int32_t axis_pc_request(std::size_t open) const noexcept { return axes_[open].last_request; }
+  // The open mode the robot program's GO OPEN asked for on an arm; 0 while no GO OPEN is in force.
+  [[nodiscard]] std::int32_t arm_program_mode(std::size_t arm) const noexcept {
+    return arm >= 1 && arm <= protocol::kMaxArms && arms_[arm].open ? arms_[arm].open_mode : 0;
+  }
+  // The program's step under way (0-based; the step count once it ended) and the program.
+  [[nodiscard]] std::size_t step_index() const noexcept { return step_index_; }
+  [[nodiscard]] const Scenario& scenario() const noexcept { return scenario_; }
+  [[nodiscard]] int consecutive_misses() const noexcept { return consecutive_misses_; }
 
  private:
   struct ExitSeq {

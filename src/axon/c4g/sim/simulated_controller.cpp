@@ -5,6 +5,7 @@
 #include "axon/c4g/sim/udp_client.hpp"
 #include "axon/net/endpoint.hpp"
 
+#include <boost/lockfree/spsc_queue.hpp>
 #include <fmt/format.h>
 
 #include <atomic>
@@ -37,6 +38,11 @@ Scenario scenario_for(const SimulatedControllerOptions& o) {
 
 double us(std::int64_t ns) { return static_cast<double>(ns) / 1000.0; }
 
+// Live hand-over queues: snapshots (a reader at 50 Hz takes them as they come; a few spare) and
+// events (a program's burst of mode changes on ten axes fits many times over).
+constexpr std::size_t kLiveStates = 16;
+constexpr std::size_t kLiveEvents = 1024;
+
 }  // namespace
 
 int SimulatedControllerReport::exit_code() const noexcept {
@@ -63,6 +69,31 @@ struct SimulatedController::Impl {
   bool done = false;  // under mutex
   SimulatedControllerReport report;
   std::thread thread;
+  // Live hand-over (live_period_s > 0): written on the controller's thread, read by take_live().
+  std::uint64_t live_every = 0;  // ticks between two snapshots
+  std::unique_ptr<boost::lockfree::spsc_queue<LiveState>> live_states;
+  std::unique_ptr<boost::lockfree::spsc_queue<LiveEvent>> live_events;
+  std::atomic<std::uint64_t> live_dropped{0};
+  LiveState scratch;  // the controller's thread's copy, queued whole
+
+  void open_live() {
+    if (options.live_period_s <= 0) return;
+    live_every = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(options.live_period_s / controller.period_s() + 0.5));
+    live_states = std::make_unique<boost::lockfree::spsc_queue<LiveState>>(kLiveStates);
+    live_events = std::make_unique<boost::lockfree::spsc_queue<LiveEvent>>(kLiveEvents);
+  }
+
+  // The controller's thread: a snapshot into the queue (dropped, and counted, when it is full).
+  void queue_live(const RunReport& rr, bool ended) noexcept {
+    capture(controller, scratch);
+    ++scratch.sequence;
+    scratch.ended = ended;
+    scratch.overruns = rr.overruns;
+    scratch.rtt_count = rr.rtt.count();
+    scratch.rtt_mean_us = rr.rtt.mean() / 1000.0;
+    scratch.rtt_max_us = us(rr.rtt.max());
+    if (!live_states->push(scratch)) live_dropped.fetch_add(1, std::memory_order_relaxed);
+  }
 
   void run() noexcept {
     RunOptions ro;
@@ -73,14 +104,20 @@ struct SimulatedController::Impl {
     std::vector<Event> events;
     ro.on_event = [&](const Event& e) {
       events.push_back(e);
+      if (live_events && !live_events->push(live_event(e))) live_dropped.fetch_add(1, std::memory_order_relaxed);
       if (options.on_event) options.on_event(e);
     };
+    if (live_states)
+      ro.on_tick = [this](const Controller& c, const RunReport& rr) {
+        if (c.stats().ticks % live_every == 0) queue_live(rr, false);
+      };
     RunReport rr;
     try {
       rr = run_client(controller, udp, ro);
     } catch (...) {  // an event callback that threw: the run ends there
       rr.stopped = true;
     }
+    if (live_states) queue_live(rr, true);
     SimulatedControllerReport r = summarise(rr);
     r.events = std::move(events);
     {
@@ -159,6 +196,7 @@ SimulatedController SimulatedController::start(SimulatedControllerOptions option
                                   impl->options.reply_deadline.count() > 0          ? ""
                                   : impl->options.reply_window == ReplyWindow::manual ? " (the manual's T_CYCLE1)"
                                                                                       : " (lenient: one period)");
+  impl->open_live();
   impl->thread = std::thread([p = impl.get()] { p->run(); });
   return SimulatedController(std::move(impl));
 }
@@ -189,5 +227,29 @@ bool SimulatedController::running() const noexcept { return impl_ && impl_->runn
 std::string SimulatedController::local_address() const { return impl_->local; }
 
 std::string SimulatedController::describe() const { return impl_->description; }
+
+std::vector<std::string> SimulatedController::program_steps() const {
+  std::vector<std::string> out;
+  for (const auto& step : impl_->controller.scenario().steps) out.push_back(fmt::format("{} ({})", to_string(step.kind), step.where));
+  return out;
+}
+
+const RobotConfig& SimulatedController::robot() const noexcept { return impl_->controller.robot(); }
+
+bool SimulatedController::take_live(LiveState& state, const std::function<void(const LiveEvent&)>& on_event) {
+  if (!impl_->live_states) return false;
+  // Events first: a snapshot taken after them must not be shown before them.
+  impl_->live_events->consume_all([&](const LiveEvent& e) {
+    if (on_event) on_event(e);
+  });
+  bool got = false;
+  impl_->live_states->consume_all([&](const LiveState& s) {
+    state = s;
+    got = true;
+  });
+  return got;
+}
+
+std::uint64_t SimulatedController::live_dropped() const noexcept { return impl_->live_dropped.load(std::memory_order_relaxed); }
 
 }  // namespace axon::c4g::sim

@@ -12,11 +12,15 @@
 // Errors: start() throws axon::Exception (its Error carries the std::error_code: a bad robot name
 // or scenario CoreErrc::invalid_argument, a socket failure the system's errno) naming the cause.
 // Events: in the report once the run ended, and live through the options' on_event (its thread).
+// Live state (a page beside the run): with live_period_s > 0 the controller's thread copies its
+// state (live_state.hpp) into a lock-free queue every that many seconds, and its events too;
+// take_live() hands them to one other thread.
 #pragma once
 
 #include "axon/c4g/protocol/packet.hpp"
 #include "axon/c4g/sim/controller.hpp"
 #include "axon/c4g/sim/events.hpp"
+#include "axon/c4g/sim/live_state.hpp"
 #include "axon/c4g/sim/reply_window.hpp"
 #include "axon/c4g/sim/robots.hpp"
 
@@ -49,6 +53,8 @@ struct SimulatedControllerOptions {
   bool pc_reduces_current = false;  // the PC scales its current while switching, not the controller
   // Called for each event as it happens, on the controller's thread (between ticks: keep it short).
   std::function<void(const Event&)> on_event{};
+  // A live snapshot for take_live() every this many seconds of the controller's ticks (0: none).
+  double live_period_s = 0;
 };
 
 // What the controller saw, once the run ended.
@@ -92,6 +98,17 @@ class SimulatedController {
   [[nodiscard]] std::string local_address() const;
   // One line: robot, open axes, period, program, server and local address.
   [[nodiscard]] std::string describe() const;
+  // The program's steps in words ("go_open (program.yaml:4:5)"), in order.
+  [[nodiscard]] std::vector<std::string> program_steps() const;
+  [[nodiscard]] const RobotConfig& robot() const noexcept;
+
+  // With options.live_period_s > 0: what the controller's thread queued since the last call, the
+  // latest snapshot into `state` (true when there was one; the last one a run takes has ended set)
+  // and each event, in order, to `on_event`. One thread only may call it; it may go on after the
+  // run ended, until the queues are empty. Without live_period_s: false, nothing.
+  bool take_live(LiveState& state, const std::function<void(const LiveEvent&)>& on_event = {});
+  // Snapshots and events the controller's thread could not queue (the reader was too slow).
+  [[nodiscard]] std::uint64_t live_dropped() const noexcept;
 
  private:
   struct Impl;
