@@ -476,7 +476,10 @@ void settle_targets(const Context& ctx, Work& w) {
   }
 }
 
-Folds no_folds(std::size_t n) { return Folds{std::vector<StepperRobot>(n), std::vector<StepperRobot>(n), std::vector<bool>(n, false), std::vector<bool>(n, false)}; }
+Folds no_folds(std::size_t n) {
+  return Folds{std::vector<StepperRobot>(n), std::vector<StepperRobot>(n), std::vector<bool>(n, false),
+               std::vector<bool>(n, false)};
+}
 
 void choose_folds(const Context& ctx, const Work& w, Folds& f) {
   const std::size_t n = ctx.size();

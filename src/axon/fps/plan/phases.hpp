@@ -12,8 +12,9 @@
 //   verify_layers        the checker, robots of a flagged pair falling back one layer at a time
 //   collect_stats        points, speeds and the move's duration
 //
-// Internal to the planner (and its tests): not installed as a public interface. Every phase reads
-// one Context (the request and the PlannerOptions it was given) and changes the Work it is handed.
+// Internal to the planner and its tests: installed with the other headers, but not part of the
+// documented interface (it follows the algorithm). Every phase reads one Context (the request and
+// the PlannerOptions it was given) and changes the Work it is handed.
 #pragma once
 
 #include "axon/fps/plan/planner.hpp"
