@@ -501,8 +501,9 @@ int run_plane(const PlaneArgs& a, const std::string& action) {
       co_await linger_host_page(a.http_linger_s, set_on_signal);
       stop_robots_on_signal(set_on_signal, fpa->array());
     }
-    if (page) co_await page->finish();  // the view reads the array: it ends first
+    if (page) page->stop();
     co_await fpa->close();
+    if (page) co_await page->finish();  // the view reads the array: its last round ends before the array goes
     set_on_signal([] {});  // the array is closed: a later signal has nothing to stop
     report_signal_stop(fpa->array());
     if (failure) std::rethrow_exception(failure);

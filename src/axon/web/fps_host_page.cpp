@@ -11,7 +11,6 @@
 #include <spdlog/spdlog.h>
 
 #include <boost/asio/co_spawn.hpp>
-#include <boost/asio/detached.hpp>
 
 #include <thread>
 
@@ -53,19 +52,17 @@ void wait_on_loop(fps::Client& client, const std::function<bool()>& ask, std::st
 struct FpsHostPage::State {
   std::shared_ptr<Source> source;
   std::unique_ptr<FpsHostView> view;
-  bool alive = true;
+  std::shared_ptr<bool> alive = std::make_shared<bool>(true);
   bool done = false;
 };
 
 namespace fps_host_page {
 
+// No try block and no temporaries around the co_await: gcc 12 has destroyed such locals twice in
+// coroutines (a shared_ptr's count then runs out early). The end and any exception come to
+// co_spawn's completion handler instead.
 boost::asio::awaitable<void> serve(std::shared_ptr<FpsHostPage::State> s, FpsHostPageOptions o) {
-  try {
-    co_await s->view->run(*s->source, o.publish_period, o.read_period, std::shared_ptr<const bool>(s, &s->alive));
-  } catch (const std::exception& e) {
-    spdlog::error("fps page: the view stopped: {}", e.what());
-  }
-  s->done = true;
+  co_await s->view->run(*s->source, o.publish_period, o.read_period, s->alive);
 }
 
 }  // namespace fps_host_page
@@ -79,14 +76,23 @@ FpsHostPage::FpsHostPage(FpsHostPageOptions o, fps::host::FocalPlaneArray& array
   state_->source->set_info(state_->view->info_json());
   server_ = std::make_unique<Server>(o.server);
   server_->add(state_->source);
-  boost::asio::co_spawn(ex, fps_host_page::serve(state_, o), boost::asio::detached);
+  boost::asio::co_spawn(ex, fps_host_page::serve(state_, o), [s = state_](std::exception_ptr e) {
+    if (e) {
+      try {
+        std::rethrow_exception(e);
+      } catch (const std::exception& x) {
+        spdlog::error("fps page: the view stopped: {}", x.what());
+      }
+    }
+    s->done = true;
+  });
 }
 
 FpsHostPage::~FpsHostPage() { stop(); }
 
 FpsHostView& FpsHostPage::view() noexcept { return *state_->view; }
 std::string FpsHostPage::where() const { return fmt::format("{}:{}", server_->address(), server_->port()); }
-void FpsHostPage::stop() noexcept { state_->alive = false; }
+void FpsHostPage::stop() noexcept { *state_->alive = false; }
 bool FpsHostPage::done() const noexcept { return state_->done; }
 
 boost::asio::awaitable<void> FpsHostPage::finish() {
