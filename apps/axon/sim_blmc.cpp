@@ -1,30 +1,22 @@
 // `axon sim blmc`: simulated motor driver boards, one per bus (can0, can1 ...), served over
 // socketcand until Ctrl-C or --duration: the library's SimulatedBoard (blmc/sim/simulated_board.hpp)
 // and a wait. --http serves the boards' truth (currents, positions, velocities, status) on the blmc
-// page (docs/dashboard.md), sampled from the simulator's loop at 50 Hz on this thread.
+// page (docs/dashboard.md), sampled from the simulator at 50 Hz on the page's own thread.
 #include "axon/blmc/sim/board_config.hpp"
 #include "axon/blmc/sim/fault_plan.hpp"
 #include "axon/blmc/sim/simulated_board.hpp"
 #include "axon/core/config.hpp"
-#include "axon/net/endpoint.hpp"
-#include "axon/web/blmc_view.hpp"
-#include "axon/web/server.hpp"
+#include "axon/web/live_page.hpp"
 #include "checks.hpp"
 #include "commands.hpp"
 #include "run.hpp"
 
-#include <boost/asio/co_spawn.hpp>
-#include <boost/asio/detached.hpp>
-#include <boost/asio/redirect_error.hpp>
-#include <boost/asio/steady_timer.hpp>
-#include <boost/asio/use_awaitable.hpp>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
 #include <memory>
-#include <optional>
 
 namespace axon::app {
 namespace {
@@ -62,45 +54,22 @@ blmc::host::Measurements sampled(const bsim::SimulatedBoardReport& r) {
   return m;
 }
 
-struct BoardsPage {
-  std::unique_ptr<web::Server> server;
-  std::shared_ptr<web::Source> source;
-  std::unique_ptr<web::BlmcView> view;
-};
-
-BoardsPage open_boards_page(const std::string& address, unsigned boards) {
-  const auto ep = need(net::parse_endpoint(address));
-  web::ServerOptions so;
-  so.address = ep.host;
-  so.port = ep.port;
-  BoardsPage page;
-  web::BlmcViewOptions vo;
-  for (unsigned i = 0; i < boards; ++i) vo.boards.push_back({fmt::format("can{}", i), std::nullopt});
-  vo.sample_hz = 1000.0 / static_cast<double>(kSamplePeriod.count());
-  vo.command = "sim";
-  page.view = std::make_unique<web::BlmcView>(std::move(vo));
-  page.server = std::make_unique<web::Server>(so);
-  page.source = std::make_shared<web::Source>("blmc", fmt::format("blmc: {} simulated board{}", boards, boards == 1 ? "" : "s"), "blmc");
-  page.source->set_info(page.view->info_json());
-  page.view->publish(*page.source, 1);
-  page.server->add(page.source);
-  return page;
-}
-
-// Samples every board until *stop (the simulator, view and source outlive it until then);
-// publishes every kSamplesPerPublish samples.
-asio::awaitable<void> feed_boards_page(const bsim::SimulatedBoard& sim, web::BlmcView& view, web::Source& source,
-                                       std::shared_ptr<const bool> stop) {
-  asio::steady_timer timer(co_await asio::this_coro::executor);
-  const auto t0 = std::chrono::steady_clock::now();
-  for (unsigned tick = 1; !*stop; ++tick) {
-    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    for (unsigned i = 0; i < sim.boards(); ++i) view.add_measurements(i, t, sampled(sim.report(i)));
-    if (tick % kSamplesPerPublish == 0) view.publish(source);
-    timer.expires_after(kSamplePeriod);
-    boost::system::error_code ec;
-    co_await timer.async_wait(asio::redirect_error(asio::use_awaitable, ec));
-  }
+// The page (web::BlmcPage): its own thread samples every board each kSamplePeriod and publishes
+// every kSamplesPerPublish samples; nothing runs on the boards' 1 kHz thread.
+std::unique_ptr<web::BlmcPage> open_boards_page(const std::string& address, const bsim::SimulatedBoard& sim) {
+  const unsigned boards = sim.boards();
+  web::BlmcPageOptions po;
+  po.server = web::server_address(address);
+  for (unsigned i = 0; i < boards; ++i) po.view.boards.push_back({fmt::format("can{}", i), std::nullopt});
+  po.view.sample_hz = 1000.0 / static_cast<double>(kSamplePeriod.count());
+  po.view.command = "sim";
+  po.title = fmt::format("blmc: {} simulated board{}", boards, boards == 1 ? "" : "s");
+  po.period = kSamplePeriod;
+  po.publish_every = kSamplesPerPublish;
+  po.sample = [&sim](web::BlmcView& view, double t_s) {
+    for (unsigned i = 0; i < sim.boards(); ++i) view.add_measurements(i, t_s, sampled(sim.report(i)));
+  };
+  return std::make_unique<web::BlmcPage>(std::move(po));
 }
 
 void log_end(const bsim::SimulatedBoard& sim) {
@@ -129,16 +98,13 @@ int run_sim_blmc(const SimBlmcOptions& o) {
     std::vector<std::string> channels;
     for (unsigned i = 0; i < o.boards; ++i) channels.push_back(fmt::format("can{}", i));
     spdlog::info("sim: {} blmc board{} on {} (Ctrl-C to stop)", o.boards, o.boards == 1 ? "" : "s", fmt::join(channels, ", "));
-    std::optional<BoardsPage> page;
-    auto stop_feeding = std::make_shared<bool>(false);
-    if (!o.http.empty()) {
-      page = open_boards_page(o.http, o.boards);
-      std::printf("listening http %s:%u\n", page->server->address().c_str(), unsigned{page->server->port()});
+    const auto page = o.http.empty() ? nullptr : open_boards_page(o.http, sim);
+    if (page) {
+      std::printf("listening http %s\n", page->where().c_str());
       std::fflush(stdout);
-      asio::co_spawn(io, feed_boards_page(sim, *page->view, *page->source, stop_feeding), asio::detached);
     }
     co_await wait_for_stop(io, o.duration_s, set_on_signal);
-    *stop_feeding = true;
+    if (page) page->stop();  // its sampling reads the simulator
     sim.stop();
     log_end(sim);
     co_return 0;
