@@ -18,3 +18,13 @@ function axonConnect(source, onMessage) {
     if (message.source === source) onMessage(message);
   };
 }
+
+// Fills `table` with one row per [name, value] pair (text only), replacing what it held.
+function axonRows(table, pairs) {
+  table.innerHTML = '';
+  for (const [name, value] of pairs) {
+    const tr = table.insertRow();
+    tr.insertCell().textContent = name;
+    tr.insertCell().textContent = value;
+  }
+}

@@ -52,19 +52,10 @@ function buildFlags() {
   }
 }
 
-function rows(table, pairs) {
-  table.innerHTML = '';
-  for (const [name, value] of pairs) {
-    const tr = table.insertRow();
-    tr.insertCell().textContent = name;
-    tr.insertCell().textContent = value;
-  }
-}
-
 function showLimits() {
   const l = blmc.info.boards[blmc.board].limits;
   if (!l) {
-    rows($('limits'), [['none', 'monitoring only: no control loop']]);
+    axonRows($('limits'), [['none', 'monitoring only: no control loop']]);
     return;
   }
   const pairs = [
@@ -74,7 +65,7 @@ function showLimits() {
     ['stale after', `${l.stale_after_ms} ms (status ${l.status_stale_after_ms} ms)`],
   ];
   l.position.forEach((p, i) => pairs.push([`motor ${i + 1} position`, p.enabled ? `${p.min_rev} .. ${p.max_rev} rev` : 'no limit']));
-  rows($('limits'), pairs);
+  axonRows($('limits'), pairs);
 }
 
 function buildCharts() {
@@ -147,10 +138,10 @@ function showStatus(b) {
 
 function showLoop(loop) {
   if (!loop) {
-    rows($('loop'), [['loop', 'none (monitoring)']]);
+    axonRows($('loop'), [['loop', 'none (monitoring)']]);
     return;
   }
-  rows($('loop'), [
+  axonRows($('loop'), [
     ['state', loop.running ? 'running' : 'ended'],
     ['cycles', loop.cycles],
     ['overruns', loop.overruns],

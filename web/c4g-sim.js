@@ -66,15 +66,6 @@ function modeTitle(code) {
   return m ? m.description : 'not a mode the interface defines';
 }
 
-function rows(table, pairs) {
-  table.innerHTML = '';
-  for (const [name, value] of pairs) {
-    const tr = table.insertRow();
-    tr.insertCell().textContent = name;
-    tr.insertCell().textContent = value;
-  }
-}
-
 function show() {
   const s = c4gSim.state;
   if (!s) return;
@@ -149,7 +140,7 @@ function showCounters(s) {
   box.className = s.communication_error ? 'bad' : 'ok';
   box.textContent = s.communication_error ? 'Communication error: ERR_C4GOPEN_UDP (10 misses in a row), drives off'
     : `Communication: no error (${c.consecutive_misses} misses in a row now)`;
-  rows($('counters'), [
+  axonRows($('counters'), [
     ['cycles', c.ticks],
     ['packets sent (sync, init, cyclic)', `${c.packets_sent} (${c.sync_sent}, ${c.init_sent}, ${c.cyclic_sent})`],
     ['replies in time', c.replies_ok],
@@ -162,7 +153,7 @@ function showCounters(s) {
     ['saturated axis-cycles', c.saturated_cycles],
     ['schedule overruns', c.overruns],
   ]);
-  rows($('rtt'), [
+  axonRows($('rtt'), [
     ['replies timed', s.rtt.count],
     ['mean', `${num(s.rtt.mean_us, 0)} µs`],
     ['max', `${num(s.rtt.max_us, 0)} µs`],

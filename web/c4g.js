@@ -85,15 +85,6 @@ function buildCharts() {
   };
 }
 
-function rows(table, pairs) {
-  table.innerHTML = '';
-  for (const [name, value] of pairs) {
-    const tr = table.insertRow();
-    tr.insertCell().textContent = name;
-    tr.insertCell().textContent = value;
-  }
-}
-
 function show() {
   const s = c4g.state;
   if (!s) return;
@@ -158,7 +149,7 @@ function showSafety(safety, c, axes) {
   box.textContent = safety.fault === 'none' ? 'Safety: no fault'
     : `Safety: ${safety.fault}${safety.fault_axis >= 0 ? ` (axis ${safety.fault_axis + 1})` : ''}` +
       `${safety.obeyed ? ', drives off obeyed' : ', asking for drive off'}`;
-  rows($('counters'), [
+  axonRows($('counters'), [
     ['cycles', c.cyclic],
     ['late replies', c.late_replies],
     ['missed (unanswered, send errors)', c.unanswered + c.send_errors],
@@ -171,7 +162,7 @@ function showSafety(safety, c, axes) {
   ]);
   const thresholds = axes.map((a) => num(a.fe_threshold, 2));
   const largest = axes.reduce((best, a) => (a.following_error > (best ? best.following_error : -1) ? a : best), null);
-  rows($('following'), [
+  axonRows($('following'), [
     ['largest now [motor turns]', largest ? `${num(largest.following_error, 5)} (axis ${largest.i})` : '-'],
     ['following-error replies (508)', safety.following_error_replies],
     ['following-error fault', safety.fault === 'following error' ? `axis ${safety.fault_axis + 1}` : 'none'],
@@ -181,7 +172,7 @@ function showSafety(safety, c, axes) {
 }
 
 function showTiming(t) {
-  rows($('timing'), [
+  axonRows($('timing'), [
     ['deadline', `${num(t.deadline_us, 0)} µs`],
     ['receive to send p50 / p99 / p99.9', `${num(t.p50_us, 0)} / ${num(t.p99_us, 0)} / ${num(t.p999_us, 0)} µs`],
     ['worst', `${num(t.worst_cycle_us, 1)} µs`],
@@ -206,7 +197,7 @@ function fill(chart, hist, marker_us, label) {
 }
 
 function showServer(server, errors, events) {
-  rows($('server'), [
+  axonRows($('server'), [
     ['state', server.state],
     ['controller', server.controller || 'none yet'],
     ['listening', server.local],
