@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
 #include <vector>
 
 namespace axon::fps::plan::test {
@@ -16,6 +18,20 @@ inline CollisionModel build(std::vector<RobotSpec> robots, std::vector<FiducialS
   auto m = CollisionModel::build(robots, ArmDesign{}, fids, obs);
   EXPECT_TRUE(m) << m.error().message();
   return std::move(m).value();
+}
+
+// A robot at (x, y) mm with the default arms and a 2 mm buffer.
+inline RobotSpec robot_at(std::int32_t id, double x, double y) { return RobotSpec{id, {x, y}, {}, {}, 2.0}; }
+
+// A hex patch: `rings` rings around the origin, pitch 22.4 mm, ids from 1 row by row.
+inline std::vector<RobotSpec> hex_patch(int rings) {
+  std::vector<RobotSpec> out;
+  const double pitch = 22.4, row = pitch * std::sqrt(3.0) / 2;
+  std::int32_t id = 1;
+  for (int j = -rings; j <= rings; ++j)
+    for (int i = -rings; i <= rings; ++i)
+      if (std::abs(i + j) <= rings) out.push_back(robot_at(id++, (i + 0.5 * j) * pitch, j * row));
+  return out;
 }
 
 // Two robots one pitch (22.4 mm) apart on the x axis, 2 mm buffers.

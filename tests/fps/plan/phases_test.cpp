@@ -16,20 +16,9 @@ namespace axon::fps::plan::phases_test {
 
 using namespace axon::fps::plan::phases;
 using test::build;
+using test::hex_patch;
+using test::robot_at;
 using test::static_clearance;
-
-RobotSpec robot_at(std::int32_t id, double x, double y) { return RobotSpec{id, {x, y}, {}, {}, 2.0}; }
-
-// `rings` hexagonal rings around the origin, pitch 22.4 mm.
-std::vector<RobotSpec> hex(int rings) {
-  std::vector<RobotSpec> out;
-  const double pitch = 22.4, row = pitch * std::sqrt(3.0) / 2;
-  std::int32_t id = 1;
-  for (int j = -rings; j <= rings; ++j)
-    for (int i = -rings; i <= rings; ++i)
-      if (std::abs(i + j) <= rings) out.push_back(robot_at(id++, (i + 0.5 * j) * pitch, j * row));
-  return out;
-}
 
 // Contacts between targets that not both stay (what settle_targets must clear).
 std::size_t moving_contacts(const CollisionModel& m, const Work& w) {
@@ -63,7 +52,7 @@ StepperResult standing(const std::vector<Pose>& poses) {
 
 // A small random problem on 19 robots (folded lattice to random targets), prepared and settled.
 struct Patch {
-  CollisionModel model = build(hex(2));
+  CollisionModel model = build(hex_patch(2));
   PlanRequest request;
   PlannerOptions options;
   Patch() {
@@ -142,7 +131,7 @@ TEST(PlanPhases, PrepareHoldsFrozenAndStartContactsAndParksTargetsOutsideTheLimi
 TEST(PlanPhases, SettleTargetsLeavesNoTargetInContact) {
   // Six robots stretched towards the centre robot, whose target is its fold: theirs overlap each
   // other's and the centre's.
-  const auto m = build(hex(1));
+  const auto m = build(hex_patch(1));
   const std::size_t centre = 3;
   ASSERT_EQ(m.robot(centre).centre(), (Vec2{0, 0}));
   PlanRequest req;
@@ -285,7 +274,7 @@ TEST(PlanPhases, TakeStuckRobotsHoldsThoseStuckInAAndParksThoseStuckInB) {
 }
 
 TEST(PlanPhases, RunMiddleTurnsFoldedRobotsFromTheirAFoldToTheirBFold) {
-  const auto m = build(hex(1));
+  const auto m = build(hex_patch(1));
   PlanRequest req;
   req.current = folded_poses(m);
   req.target = req.current;

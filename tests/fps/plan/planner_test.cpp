@@ -16,22 +16,9 @@ namespace axon::fps::plan {
 namespace {
 
 using test::build;
+using test::hex_patch;
+using test::robot_at;
 using test::static_clearance;
-
-RobotSpec at(std::int32_t id, double x, double y) { return RobotSpec{id, {x, y}, {}, {}, 2.0}; }
-
-// A hex patch: `rings` rings around the origin, pitch 22.4 mm.
-std::vector<RobotSpec> hex_patch(int rings) {
-  std::vector<RobotSpec> out;
-  const double pitch = 22.4, row = pitch * std::sqrt(3.0) / 2;
-  std::int32_t id = 1;
-  for (int j = -rings; j <= rings; ++j)
-    for (int i = -rings; i <= rings; ++i) {
-      const double x = (i + 0.5 * j) * pitch, y = j * row;
-      if (std::abs(i) <= rings && std::abs(j) <= rings && std::abs(i + j) <= rings) out.push_back(at(id++, x, y));
-    }
-  return out;
-}
 
 // What every plan must satisfy, checked independently of the planner's own report.
 // `start_in_contact`: robots held where they started in contact may stay in that contact.
@@ -84,7 +71,7 @@ void expect_sound(const CollisionModel& m, const Plan& p, const PlanRequest& req
 TEST(Planner, TwoRobotsSwapSides) {
   // Robot 1's arm starts in the gap between the two robots (pointing up-right), robot 2's must
   // end there (cw elbow, pointing up-left): robot 1 has to clear out before robot 2 comes in.
-  const auto m = build({at(1, 0, 0), at(2, 22.4, 0)});
+  const auto m = build({robot_at(1, 0, 0), robot_at(2, 22.4, 0)});
   PlanRequest req;
   req.current = {{0, 60}, {0, 0}};
   req.target = {{180, 0}, {180, 300}};
@@ -144,7 +131,7 @@ TEST(Planner, RobotBoxedInByStillNeighboursReachesItsTarget) {
 TEST(Planner, BoxedInRobotWhoseTargetIsTakenIsReportedNotDropped) {
   // The target of robot 2 lies where frozen robot 1's arm stands: robot 2 is parked, with the
   // reason and the blocker, and the plan for the others is still checked clear.
-  const auto m = build({at(1, 0, 0), at(2, 22.4, 0), at(3, -22.4, 0)});
+  const auto m = build({robot_at(1, 0, 0), robot_at(2, 22.4, 0), robot_at(3, -22.4, 0)});
   PlanRequest req;
   req.current = {{0, 90}, {90, 180}, {90, 180}};
   req.target = {{0, 90}, {180, 10}, {0, 150}};
@@ -166,7 +153,7 @@ TEST(Planner, BoxedInRobotWhoseTargetIsTakenIsReportedNotDropped) {
 TEST(Planner, TargetNextToAFiducial) {
   // A fiducial in the hex hole at (22.4, 0): the target puts the arm's capsule 0.3 mm from the
   // fiducial's buffer.
-  const auto m = build({at(1, 0, 0)}, {{7, {22.4, 0}, 3.0}});
+  const auto m = build({robot_at(1, 0, 0)}, {{7, {22.4, 0}, 3.0}});
   // Segment along the x axis ending at 22.1 mm: distance 0.3 to the fiducial; limit 5 mm.
   // Turn the arm up until the distance is 5.3 mm: alpha 0, beta b with the end at 5.3 mm.
   Pose target{0, 0};
@@ -192,7 +179,7 @@ TEST(Planner, TargetNextToAFiducial) {
 }
 
 TEST(Planner, UnreachableTargetIntoAFiducialIsParkedAndReported) {
-  const auto m = build({at(1, 0, 0), at(2, 0, 22.4 * std::sqrt(3.0))}, {{7, {22.4, 0}, 3.0}});
+  const auto m = build({robot_at(1, 0, 0), robot_at(2, 0, 22.4 * std::sqrt(3.0))}, {{7, {22.4, 0}, 3.0}});
   PlanRequest req;
   req.current = {{10, 170}, {10, 170}};
   req.target = {{0, 0}, {270, 30}};  // robot 1 stretched onto the fiducial
@@ -210,7 +197,7 @@ TEST(Planner, UnreachableTargetIntoAFiducialIsParkedAndReported) {
 // held where they stand, each naming the other; the third is planned around them, and the plan is
 // verified. Before, the whole plan was refused ("current poses already in contact").
 TEST(Planner, RobotsThatStartInContactAreHeldAndTheRestIsPlanned) {
-  const auto m = build({at(1, 0, 0), at(2, 22.4, 0), at(3, 11.2, 22.4 * std::sqrt(3.0) / 2)});
+  const auto m = build({robot_at(1, 0, 0), robot_at(2, 22.4, 0), robot_at(3, 11.2, 22.4 * std::sqrt(3.0) / 2)});
   PlanRequest req;
   req.current = {{0, 0}, {180, 0}, {90, 170}};
   req.target = {{10, 170}, {10, 170}, {270, 60}};
@@ -236,11 +223,11 @@ TEST(Planner, RobotsThatStartInContactAreHeldAndTheRestIsPlanned) {
 TEST(Planner, ARobotBoxedInByAFiducialAndItsAlphaStopIsHeldWithTheReason) {
   // The fiducial sits on the arm's collision segment at alpha 12, beta 12: from alpha 1, beta 0
   // every way to the fold (beta 180) sweeps the arm across it, and alpha cannot go below 0.
-  const auto probe = build({at(1, 0, 0)});
+  const auto probe = build({robot_at(1, 0, 0)});
   std::vector<Segment> seg(1);
   probe.segments(std::vector<Pose>{{12, 12}}, seg);
   const Vec2 f = seg[0].b;
-  const auto m = build({at(1, 0, 0), at(2, 0, -22.4 * std::sqrt(3.0))}, {{7, f, 3.0}});
+  const auto m = build({robot_at(1, 0, 0), robot_at(2, 0, -22.4 * std::sqrt(3.0))}, {{7, f, 3.0}});
   PlanRequest req;
   req.current = {{1, 0}, {90, 170}};
   req.target = {{200, 170}, {100, 170}};
@@ -266,7 +253,7 @@ TEST(Planner, ARobotBoxedInByAFiducialAndItsAlphaStopIsHeldWithTheReason) {
 }
 
 TEST(Planner, WrongRequestSizeIsAnError) {
-  const auto m = build({at(1, 0, 0)});
+  const auto m = build({robot_at(1, 0, 0)});
   PlanRequest req;
   req.current = {{0, 0}};
   auto r = plan_moves(m, req);
@@ -297,7 +284,7 @@ TEST(Planner, SeededRandomPatchEveryRobotAccountedFor) {
 }
 
 TEST(Planner, SlowerSpeedGivesALongerMoveWithinThatSpeed) {
-  const auto m = build({at(1, 0, 0), at(2, 22.4, 0)});
+  const auto m = build({robot_at(1, 0, 0), robot_at(2, 22.4, 0)});
   PlanRequest req;
   req.current = {{0, 60}, {90, 170}};
   req.target = {{90, 180}, {180, 60}};
