@@ -1,9 +1,11 @@
-// The dense-sampling checker: collisions that only happen mid-move, clearances, sampling step.
+// The checker, both methods: collisions that only happen mid-move, clearances, the dense method's
+// sampling step, the advancing method against brute force.
 #include "axon/fps/plan/checker.hpp"
 #include "model_util.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -27,6 +29,12 @@ struct Sweep {
                                     RobotTrajectory::hold({90, 0})};
 };
 
+CheckOptions dense() {
+  CheckOptions o;
+  o.method = CheckMethod::dense;
+  return o;
+}
+
 TEST(PlanChecker, CatchesCollisionThatOnlyHappensMidMove) {
   Sweep s;
   EXPECT_GT(static_clearance(s.model, {{-60, 0}, {90, 0}}), 5.0);
@@ -34,7 +42,7 @@ TEST(PlanChecker, CatchesCollisionThatOnlyHappensMidMove) {
 
   TrajectoryChecker checker(s.model);
   CheckReport r;
-  ASSERT_TRUE(checker.check(s.traj, {}, r));
+  ASSERT_TRUE(checker.check(s.traj, dense(), r));
   EXPECT_FALSE(r.ok());
   EXPECT_EQ(r.collided_pairs, 1u);
   ASSERT_EQ(r.robot_pairs.size(), 1u);
@@ -84,7 +92,7 @@ TEST(PlanChecker, StepKeepsEveryArmPointWithinTheLimit) {
   Sweep s;
   TrajectoryChecker checker(s.model);
   CheckReport r;
-  CheckOptions o;
+  CheckOptions o = dense();
   o.max_step_mm = 0.05;
   ASSERT_TRUE(checker.check(s.traj, o, r));
   // 12 deg/s at up to 22.1 mm from the alpha axis: 4.63 mm/s, so steps of at most 10.8 ms.
@@ -101,7 +109,7 @@ TEST(PlanChecker, SameReportWithOneOrTwoThreads) {
   // A slower step so the run is long enough to be split.
   TrajectoryChecker checker(s.model);
   CheckReport one, two;
-  CheckOptions o;
+  CheckOptions o = dense();
   o.max_step_mm = 0.01;
   o.threads = 1;
   ASSERT_TRUE(checker.check(s.traj, o, one));
@@ -113,13 +121,165 @@ TEST(PlanChecker, SameReportWithOneOrTwoThreads) {
   EXPECT_DOUBLE_EQ(one.robot_pairs[0].min_clearance_s, two.robot_pairs[0].min_clearance_s);
 }
 
+// The advancing method on the same sweep: the contact's first instant is found to within the
+// shortest step it takes (it never steps over a clear stretch's end), the deepest point to within
+// the precision.
+TEST(PlanChecker, AdvancingFindsTheContactWhereItBegins) {
+  Sweep s;
+  TrajectoryChecker checker(s.model);
+  CheckReport r;
+  ASSERT_TRUE(checker.check(s.traj, {}, r));
+  EXPECT_FALSE(r.ok());
+  const PairOutcome& p = r.robot_pairs[0];
+  ASSERT_TRUE(p.collided);
+  auto clearance_at = [&](double t) { return static_clearance(s.model, {{angle_at(s.traj[0].alpha, t), 0}, {90, 0}}); };
+  double lo = 0, hi = 6.43;  // clear at 0, in contact at the closest approach
+  for (int k = 0; k < 60; ++k) (clearance_at(0.5 * (lo + hi)) < 0 ? hi : lo) = 0.5 * (lo + hi);
+  EXPECT_NEAR(p.first_collision_s, hi, 1e-4);
+  const double deepest = std::hypot(24.0, 7.4) - 22.1 - 4;
+  EXPECT_GE(p.min_clearance_mm, deepest - 1e-9);
+  EXPECT_LE(p.min_clearance_mm, deepest + 0.05);
+  EXPECT_EQ(r.step_s, 0.0);
+  EXPECT_GT(r.evaluations(), 10u);
+}
+
+// Close but clear (0.3 mm at the closest approach): the reported clearance is a real one and
+// within the precision (0.05 mm) of the smallest.
+TEST(PlanChecker, AdvancingReportsACloseClearanceWithinItsPrecision) {
+  const double x = std::sqrt(std::pow(22.1 + 4 + 0.3, 2) - 7.4 * 7.4);
+  auto model = build({{1, {0, 0}, {}, {}, 2.0}, {2, {x, 0}, {}, {}, 2.0}});
+  std::vector<RobotTrajectory> traj{RobotTrajectory::linear({-60, 0}, {60, 0}, 0, 10), RobotTrajectory::hold({90, 0})};
+  TrajectoryChecker checker(model);
+  CheckReport r;
+  ASSERT_TRUE(checker.check(traj, {}, r));
+  EXPECT_TRUE(r.ok());
+  EXPECT_GE(r.min_clearance_mm, 0.3 - 1e-9);
+  EXPECT_LE(r.min_clearance_mm, 0.3 + 0.05);
+
+  // The beta arm turns its side at a fiducial (closing at 35-70% of the bound's rate) and back at
+  // once: the clearance falls and rises in a V whose point is a trajectory point. Stretches end
+  // at trajectory points, so the point is evaluated, not stepped over.
+  for (const double along : {5.0, 7.35, 10.0})
+    for (const double gap : {0.3, 0.6, 0.9}) {
+      auto near_fiducial = build({{1, {0, 0}, {}, {}, 2.0}}, {{3, {7.4 + along, 2 + 3 + gap}, 3.0}});
+      const RobotTrajectory poke{{{0, 0}}, {{0, -40}, {40.0 / 12, 0}, {80.0 / 12, -40}}};
+      TrajectoryChecker fc(near_fiducial);
+      ASSERT_TRUE(fc.check(std::vector{poke}, {}, r));
+      EXPECT_TRUE(r.ok()) << gap;
+      EXPECT_NEAR(r.min_clearance_mm, gap, 1e-9) << along << " mm along, gap " << gap;
+      EXPECT_NEAR(r.obstacle_pairs[0].min_clearance_s, 40.0 / 12, 1e-9);
+    }
+}
+
+// Random moves of several points per arm on a hex patch (7 rings: 169 robots), checked by the advancing
+// method and by an evaluation of every pair at instants 0.01 mm of travel apart, written here.
+struct RandomPatchMove {
+  CollisionModel model;
+  std::vector<RobotTrajectory> traj;
+  double speed_mm_s = 0;  // the fastest body point of any robot
+  explicit RandomPatchMove(unsigned seed, int rings = 7) : model(build(test::hex_patch(rings))) {
+    std::mt19937 rng(seed);
+    // Arms 12-30 deg/s at most (hops of up to 60 deg in 2-5 s), some standing still.
+    std::uniform_real_distribution<double> a(0, 360), b(0, 180), turn(-60, 60), hop(2, 5), still(0, 1);
+    for (std::size_t i = 0; i < model.size(); ++i) {
+      RobotTrajectory t;
+      for (auto* arm : {&t.alpha, &t.beta}) {
+        double time = still(rng) < 0.3 ? 0.0 : hop(rng);
+        const double hi = arm == &t.alpha ? 360 : 180;
+        double angle = arm == &t.alpha ? a(rng) : b(rng);
+        arm->push_back({time, angle});
+        const int points = still(rng) < 0.2 ? 0 : 1 + static_cast<int>(still(rng) * 3);
+        for (int k = 0; k < points; ++k) {
+          time += hop(rng);
+          angle = std::clamp(angle + turn(rng), 0.0, hi);
+          arm->push_back({time, angle});
+        }
+      }
+      const Positioner& p = model.robot(i);
+      speed_mm_s = std::max(speed_mm_s, (max_speed(t.alpha) * p.reach_mm() + max_speed(t.beta) * p.collision_length_mm()) *
+                                            std::numbers::pi / 180);
+      traj.push_back(std::move(t));
+    }
+  }
+  // Per robot pair: the smallest clearance at the brute-force instants.
+  [[nodiscard]] std::vector<double> brute_force(double end_s, double travel_mm) const {
+    std::vector<double> out(model.robot_pairs().size(), std::numeric_limits<double>::infinity());
+    std::vector<Pose> poses(model.size());
+    std::vector<Segment> segs(model.size());
+    const double dt = travel_mm / speed_mm_s;
+    for (double t = 0;; t = std::min(end_s, t + dt)) {
+      for (std::size_t i = 0; i < model.size(); ++i) poses[i] = {angle_at(traj[i].alpha, t), angle_at(traj[i].beta, t)};
+      model.segments(poses, segs);
+      for (std::size_t k = 0; k < out.size(); ++k) out[k] = std::min(out[k], model.clearance(model.robot_pairs()[k], segs));
+      if (t >= end_s) break;
+    }
+    return out;
+  }
+};
+
+TEST(PlanChecker, AdvancingAgreesWithBruteForceOnRandomPatchMoves) {
+  std::size_t contacts = 0, close = 0;
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    RandomPatchMove mv(seed, 4);
+    TrajectoryChecker checker(mv.model);
+    CheckReport r;
+    CheckOptions o;
+    o.obstacles = false;
+    ASSERT_TRUE(checker.check(mv.traj, o, r));
+    const double travel = 0.01;
+    const auto brute = mv.brute_force(r.end_s, travel);
+    for (std::size_t k = 0; k < brute.size(); ++k) {
+      const PairOutcome& p = r.robot_pairs[k];
+      // Brute force lies above the true minimum by at most the travel between its instants; the
+      // advancing report is a true clearance, and within its precision of the minimum below 1 mm.
+      EXPECT_GE(p.min_clearance_mm, brute[k] - 2 * travel - 1e-9) << "seed " << seed << " pair " << k;
+      EXPECT_GE(brute[k], std::min(p.min_clearance_mm, 1.0) - 0.05 - 1e-9) << "seed " << seed << " pair " << k;
+      if (brute[k] < 0) {
+        EXPECT_TRUE(p.collided) << "seed " << seed << " pair " << k;
+      }
+      if (p.collided) {
+        EXPECT_LT(brute[k], 2 * travel) << "seed " << seed << " pair " << k;
+      }
+      contacts += brute[k] < 0 ? 1 : 0;
+      close += brute[k] >= 0 && brute[k] < 1.0 ? 1 : 0;
+    }
+  }
+  // The moves exercise both cases.
+  EXPECT_GT(contacts, 20u);
+  EXPECT_GT(close, 10u);
+}
+
+TEST(PlanChecker, AdvancingGivesTheSameReportWithOneOrTwoThreadsAndFewerEvaluations) {
+  RandomPatchMove mv(7);
+  TrajectoryChecker checker(mv.model);
+  CheckReport one, two, by_samples;
+  CheckOptions o;
+  o.threads = 1;
+  ASSERT_TRUE(checker.check(mv.traj, o, one));
+  o.threads = 2;
+  ASSERT_TRUE(checker.check(mv.traj, o, two));
+  ASSERT_GT(mv.model.robot_pairs().size(), 512u);  // enough pairs to be split
+  ASSERT_EQ(one.robot_pairs.size(), two.robot_pairs.size());
+  for (std::size_t k = 0; k < one.robot_pairs.size(); ++k) {
+    EXPECT_EQ(one.robot_pairs[k].collided, two.robot_pairs[k].collided);
+    EXPECT_EQ(one.robot_pairs[k].min_clearance_mm, two.robot_pairs[k].min_clearance_mm);
+    EXPECT_EQ(one.robot_pairs[k].min_clearance_s, two.robot_pairs[k].min_clearance_s);
+  }
+  EXPECT_EQ(one.evaluations(), two.evaluations());
+  EXPECT_EQ(one.collided_pairs, two.collided_pairs);
+  // The same verdict as dense sampling with a tenth of the pair evaluations or fewer.
+  ASSERT_TRUE(checker.check(mv.traj, dense(), by_samples));
+  EXPECT_EQ(one.collided_pairs, by_samples.collided_pairs);
+  EXPECT_LT(one.evaluations() * 10, by_samples.evaluations());
+}
+
 TEST(PlanChecker, ClearMoveReportsItsClearance) {
   // Robot 2 moved to (30, 0): closest approach hypot(30, 7.4) - 22.1 = 8.799, clearance 4.799.
   auto model = build({{1, {0, 0}, {}, {}, 2.0}, {2, {30, 0}, {}, {}, 2.0}});
   std::vector<RobotTrajectory> traj{RobotTrajectory::linear({-60, 0}, {60, 0}, 0, 10), RobotTrajectory::hold({90, 0})};
   TrajectoryChecker checker(model);
   CheckReport r;
-  ASSERT_TRUE(checker.check(traj, {}, r));
+  ASSERT_TRUE(checker.check(traj, dense(), r));
   EXPECT_TRUE(r.ok());
   EXPECT_FALSE(r.robot_pairs[0].collided);
   EXPECT_TRUE(std::isnan(r.robot_pairs[0].first_collision_s));
@@ -167,7 +327,7 @@ TEST(PlanChecker, MatchesBruteForceOnRandomHexMoves) {
       traj.push_back(RobotTrajectory::linear({a(rng), b(rng)}, {a(rng), b(rng)}, 0, dur(rng)));
     TrajectoryChecker checker(model);
     CheckReport r;
-    CheckOptions o;
+    CheckOptions o = dense();
     o.threads = 1;
     o.max_step_mm = 0.2;
     ASSERT_TRUE(checker.check(traj, o, r));
@@ -203,7 +363,7 @@ TEST(PlanChecker, AContactBetweenSamplesIsFoundNotSteppedOver) {
   Sweep s;
   TrajectoryChecker checker(s.model);
   CheckReport r;
-  CheckOptions o;
+  CheckOptions o = dense();
   o.threads = 1;
   bool found_gap = false;
   for (double step = 3.0; step < 12.0 && !found_gap; step += 0.25) {
@@ -251,6 +411,19 @@ TEST(PlanTrajectory, InterpolationAndCursor) {
   AngleCursor c(pts);
   for (double t = 0; t <= 5; t += 0.25) EXPECT_DOUBLE_EQ(c.at(t), angle_at(pts, t)) << t;
   EXPECT_DOUBLE_EQ(c.at(2), 20);  // going back restarts
+  // Speed and the next point from where the cursor stands.
+  c.at(0.5);
+  EXPECT_EQ(c.speed(), 0.0);
+  EXPECT_EQ(c.next_point(), 1.0);
+  c.at(1);
+  EXPECT_DOUBLE_EQ(c.speed(), 10);
+  EXPECT_EQ(c.next_point(), 3.0);
+  c.at(3);
+  EXPECT_DOUBLE_EQ(c.speed(), 30);
+  EXPECT_EQ(c.next_point(), 4.0);
+  c.at(4);
+  EXPECT_EQ(c.speed(), 0.0);
+  EXPECT_EQ(c.next_point(), std::numeric_limits<double>::infinity());
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 
 namespace axon::fps::plan {
 
-namespace {
+namespace checker_detail {
 
 void merge(PairOutcome& into, const PairOutcome& from) {
   if (from.collided && (!into.collided || from.first_collision_s < into.first_collision_s)) {
@@ -57,7 +57,108 @@ void certify(PairOutcome& o, const Clearance& at, double rate, double t0, double
   certify(o, at, rate, tm, cm, t1, c1, depth + 1, halvings);
 }
 
-}  // namespace
+// A moving body of a pair: one robot's collision segment along its trajectory, read at increasing
+// times (the advancing method).
+class Body {
+ public:
+  Body(const Positioner& robot, const RobotTrajectory& t) : robot_(&robot), alpha_(t.alpha), beta_(t.beta) {}
+  // The segment at t; then rate() and next() hold from t on.
+  Segment at(double t) noexcept { return robot_->collision_segment({alpha_.at(t), beta_.at(t)}); }
+  // How fast any point of the segment can move until next(), mm/s.
+  [[nodiscard]] double rate() const noexcept {
+    return (alpha_.speed() * robot_->reach_mm() + beta_.speed() * robot_->collision_length_mm()) * kRad;
+  }
+  [[nodiscard]] double next() const noexcept { return std::min(alpha_.next_point(), beta_.next_point()); }
+
+ private:
+  const Positioner* robot_;
+  AngleCursor alpha_, beta_;
+};
+
+struct Walked {
+  std::size_t evaluations = 0;
+  std::size_t forced = 0;
+};
+
+// One pair's time line from `start` to `end` (the advancing method, checker.hpp). `clearance(t)`
+// reads both bodies at t (after which `rate()` and `next()` describe the stretch from t on).
+template <class Pair>
+Walked walk(PairOutcome& o, Pair& pair, double start, double end, const CheckOptions& opt) {
+  Walked w;
+  double t = start;
+  for (;;) {
+    // Also read where nothing moved since the last evaluation: it moves the bodies' cursors on.
+    const double c = pair.clearance(t);
+    ++w.evaluations;
+    note(o, c, t);
+    if (t >= end) break;
+    const double stretch_end = std::min(pair.next(), end);
+    const double v = pair.rate();
+    if (v <= 0) {  // neither body moves until stretch_end: the clearance stays c
+      t = stretch_end;
+      continue;
+    }
+    // Precision: the bound over the step stays at or above min(smallest so far, precise_below) -
+    // precision; proof: never below 0 from a clear evaluation.
+    const double floor = std::min(o.min_clearance_mm, opt.precise_below_mm) - opt.precision_mm;
+    double step = (c - floor) / v;
+    if (c >= 0) step = std::min(step, c / v);
+    if (step < opt.min_step_s) {
+      step = opt.min_step_s;
+      note(o, c - v * step, t);  // not proven: the bound counts (a contact when below 0)
+      ++w.forced;
+    }
+    t = std::min(t + step, stretch_end);
+  }
+  return w;
+}
+
+struct RobotPairWalk {
+  Body a, b;
+  double limit;
+  double clearance(double t) noexcept { return segment_distance(a.at(t), b.at(t)) - limit; }
+  [[nodiscard]] double rate() const noexcept { return a.rate() + b.rate(); }
+  [[nodiscard]] double next() const noexcept { return std::min(a.next(), b.next()); }
+};
+
+struct ObstaclePairWalk {
+  Body a;
+  Segment obstacle;
+  double limit;
+  double clearance(double t) noexcept { return segment_distance(a.at(t), obstacle) - limit; }
+  [[nodiscard]] double rate() const noexcept { return a.rate(); }
+  [[nodiscard]] double next() const noexcept { return a.next(); }
+};
+
+}  // namespace checker_detail
+
+using checker_detail::certify;
+using checker_detail::merge;
+using checker_detail::note;
+
+void TrajectoryChecker::advance(Worker& w, std::span<const RobotTrajectory> trajectories, std::size_t first,
+                                std::size_t last, const CheckOptions& options, CheckReport& out) const {
+  const CollisionModel& m = *model_;
+  const auto rp = m.robot_pairs();
+  const auto op = m.obstacle_pairs();
+  w.evaluations = w.busiest = w.forced = 0;
+  auto tally = [&](const checker_detail::Walked& k) {
+    w.evaluations += k.evaluations;
+    w.busiest = std::max(w.busiest, k.evaluations);
+    w.forced += k.forced;
+  };
+  for (std::size_t k = first; k < last; ++k) {
+    if (k < rp.size()) {
+      const RobotPair& p = rp[k];
+      checker_detail::RobotPairWalk pair{{m.robot(p.a), trajectories[p.a]}, {m.robot(p.b), trajectories[p.b]}, p.limit_mm};
+      tally(checker_detail::walk(out.robot_pairs[k], pair, out.start_s, out.end_s, options));
+    } else {
+      const ObstaclePair& p = op[k - rp.size()];
+      checker_detail::ObstaclePairWalk pair{{m.robot(p.robot), trajectories[p.robot]}, m.obstacles()[p.obstacle].shape, p.limit_mm};
+      tally(checker_detail::walk(out.obstacle_pairs[k - rp.size()], pair, out.start_s, out.end_s, options));
+    }
+  }
+}
 
 Result<void> TrajectoryChecker::check(std::span<const RobotTrajectory> trajectories, const CheckOptions& options,
                                       CheckReport& out) {
@@ -90,49 +191,85 @@ Result<void> TrajectoryChecker::check(std::span<const RobotTrajectory> trajector
   out.end_s = end;
   out.step_s = 0;
   out.samples = 1;
-  if (end > start && point_speed > 0) {
-    const double dt = options.max_step_mm / point_speed;
-    const auto intervals = static_cast<std::size_t>(std::ceil((end - start) / dt));
-    out.samples = std::max<std::size_t>(intervals, 1) + 1;
-    out.step_s = (end - start) / static_cast<double>(out.samples - 1);
-  }
+  out.halvings = out.forced_steps = out.pair_evaluations = 0;
   out.robot_pairs.assign(m.robot_pairs().size(), PairOutcome{});
   out.obstacle_pairs.assign(options.obstacles ? m.obstacle_pairs().size() : 0, PairOutcome{});
+  const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  if (options.method == CheckMethod::dense)
+    check_dense(trajectories, options, point_speed, threads, out);
+  else
+    check_advancing(trajectories, options, threads, out);
+  summarize(options, out);
+  return ok();
+}
 
-  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+// Runs `work(k, first, last)` on `threads` contiguous blocks of [0, count).
+template <class Work>
+void TrajectoryChecker::split(std::size_t count, unsigned threads, const Work& work) {
+  if (workers_.size() < threads) workers_.resize(threads);
+  if (threads <= 1) {
+    work(0u, std::size_t{0}, count);
+    return;
+  }
+  const std::size_t per = (count + threads - 1) / threads;
+  std::vector<std::thread> pool;
+  pool.reserve(threads);
+  for (unsigned k = 0; k < threads; ++k) {
+    const std::size_t first = std::min(count, k * per);
+    const std::size_t last = std::min(count, first + per);
+    pool.emplace_back([&work, k, first, last] { work(k, first, last); });
+  }
+  for (auto& t : pool) t.join();
+}
+
+void TrajectoryChecker::check_dense(std::span<const RobotTrajectory> trajectories, const CheckOptions& options,
+                                    double point_speed, unsigned threads, CheckReport& out) {
+  if (out.end_s > out.start_s && point_speed > 0) {
+    const double dt = options.max_step_mm / point_speed;
+    const auto intervals = static_cast<std::size_t>(std::ceil((out.end_s - out.start_s) / dt));
+    out.samples = std::max<std::size_t>(intervals, 1) + 1;
+    out.step_s = (out.end_s - out.start_s) / static_cast<double>(out.samples - 1);
+  }
   // Below a few hundred samples threads cost more than they save.
   threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, out.samples / 256)));
-  if (workers_.size() < threads) workers_.resize(threads);
-
-  const std::size_t per = (out.samples + threads - 1) / threads;
-  if (threads == 1) {
-    run(workers_[0], trajectories, 0, out.samples, out, options.obstacles);
-  } else {
-    std::vector<std::thread> pool;
-    pool.reserve(threads);
-    for (unsigned k = 0; k < threads; ++k) {
-      const std::size_t first = k * per;
-      const std::size_t last = std::min(out.samples, first + per);
-      pool.emplace_back([this, k, first, last, trajectories, &out, &options] {
-        run(workers_[k], trajectories, first, last, out, options.obstacles);
-      });
-    }
-    for (auto& t : pool) t.join();
-  }
-  out.collided_pairs = 0;
-  out.standing_contacts = 0;
-  out.min_clearance_mm = std::numeric_limits<double>::infinity();
+  split(out.samples, threads, [&](unsigned k, std::size_t first, std::size_t last) {
+    run(workers_[k], trajectories, first, last, out, options.obstacles);
+  });
   for (unsigned k = 0; k < threads; ++k) {
     for (std::size_t p = 0; p < out.robot_pairs.size(); ++p) merge(out.robot_pairs[p], workers_[k].robot_pairs[p]);
     for (std::size_t p = 0; p < out.obstacle_pairs.size(); ++p)
       merge(out.obstacle_pairs[p], workers_[k].obstacle_pairs[p]);
+    out.halvings += workers_[k].halvings;
   }
+  out.pair_evaluations = out.samples * (out.robot_pairs.size() + out.obstacle_pairs.size()) + out.halvings;
+}
+
+void TrajectoryChecker::check_advancing(std::span<const RobotTrajectory> trajectories, const CheckOptions& options,
+                                        unsigned threads, CheckReport& out) {
+  const std::size_t pairs = out.robot_pairs.size() + out.obstacle_pairs.size();
+  // Below a few hundred pairs threads cost more than they save.
+  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(1, pairs / 256)));
+  split(pairs, threads, [&](unsigned k, std::size_t first, std::size_t last) {
+    advance(workers_[k], trajectories, first, last, options, out);
+  });
+  out.samples = 0;
+  for (unsigned k = 0; k < threads; ++k) {
+    out.pair_evaluations += workers_[k].evaluations;
+    out.forced_steps += workers_[k].forced;
+    out.samples = std::max(out.samples, workers_[k].busiest);
+  }
+  out.samples = std::max<std::size_t>(out.samples, 1);
+}
+
+void TrajectoryChecker::summarize(const CheckOptions& options, CheckReport& out) const {
+  const CollisionModel& m = *model_;
+  out.collided_pairs = 0;
+  out.standing_contacts = 0;
+  out.min_clearance_mm = std::numeric_limits<double>::infinity();
   auto standing = [&](std::size_t i) { return speed_[i] == 0; };
   for (std::size_t p = 0; p < out.robot_pairs.size(); ++p)
     out.robot_pairs[p].standing = standing(m.robot_pairs()[p].a) && standing(m.robot_pairs()[p].b);
   for (std::size_t p = 0; p < out.obstacle_pairs.size(); ++p) out.obstacle_pairs[p].standing = standing(m.obstacle_pairs()[p].robot);
-  out.halvings = 0;
-  for (unsigned k = 0; k < threads; ++k) out.halvings += workers_[k].halvings;
   for (const auto* v : {&out.robot_pairs, &out.obstacle_pairs})
     for (const auto& o : *v) {
       if (o.standing && options.allow_standing_contacts) {
@@ -142,7 +279,6 @@ Result<void> TrajectoryChecker::check(std::span<const RobotTrajectory> trajector
       out.collided_pairs += o.move_collided(options) ? 1 : 0;
       out.min_clearance_mm = std::min(out.min_clearance_mm, o.min_clearance_mm);
     }
-  return ok();
 }
 
 void TrajectoryChecker::run(Worker& w, std::span<const RobotTrajectory> trajectories, std::size_t first,

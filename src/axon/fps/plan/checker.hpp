@@ -1,22 +1,28 @@
-// Collision check of a whole move, independent of any planner: dense samples, and a proof between them.
+// Collision check of a whole move, independent of any planner, that cannot miss a contact.
 //
-// Every robot follows its alpha and beta trajectories (linear between points). The checker picks
-// one time step for the move such that no point of any collision segment travels more than
-// `max_step_mm` between two samples: a point at distance r from an axis turning at w rad/s moves
-// at most w * r, so with alpha speed wa and beta speed wb (the fastest segment of each robot)
-// a step dt moves any point of the segment at most (wa * reach + wb * collision length) * dt.
-// At every sample it evaluates the exact segment distances of the neighbour pairs and the
-// robot-obstacle pairs, and keeps per pair the first sample in collision and the smallest
-// clearance. Between samples nothing is left to chance: a pair's clearance changes no faster than
-// the sum of its two bodies' fastest point speeds (rate), so over an interval of dt it stays at or
-// above (c0 + c1 - rate * dt) / 2, c0 and c1 being the clearances at its ends. Where that bound is
-// negative while both ends are clear, the interval is halved (exact clearance at the midpoint)
-// until it is proven clear or a contact shows; after 12 halvings the negative bound itself counts
-// as a contact. A clean report is therefore a proof, not a sampling result (docs/fps-plan.md).
+// Every robot follows its alpha and beta trajectories (linear between points). A point at distance
+// r from an axis turning at w rad/s moves at most w * r, so a robot's collision segment moves no
+// point faster than wa * reach + wb * collision length (wa, wb: its arms' speeds), and a pair's
+// clearance (distance minus both buffers) changes no faster than the sum of its two bodies' bounds.
+// Two methods use that bound:
 //
-// The sample range is split over threads in contiguous blocks. A checker keeps its scratch
-// storage between calls and fills a caller-owned report, so repeated checks allocate nothing
-// once warmed up (with threads = 1; more threads start std::threads per call).
+// - advancing (the default): each pair walks its own time line. From the clearance c at t, with
+//   V the pair's bound over the stretch where all four arms keep their speeds (trajectory points
+//   end stretches), the clearance cannot reach 0 before t + c / V: the next evaluation is there
+//   (closer when the reported minimum must be precise, see CheckOptions), or at the end of the
+//   stretch. Pairs that stand still are evaluated once per stretch, far pairs rarely, close pairs
+//   often. A step that would have to be shorter than `min_step_s` is taken with its bound, which
+//   then counts as a contact (a pair touching within about V x 1 us, 1e-5 mm, is reported as one).
+// - dense: one time step for the whole move, such that no point of any collision segment travels
+//   more than `max_step_mm` between two samples, every pair evaluated at every sample; between
+//   samples the interval is proven with the two-ended bound (c0 + c1 - rate * dt) / 2 and halved
+//   where that is negative, up to 12 halvings (then the bound counts as a contact).
+//
+// Both give a proof at the full buffer, not a sampling result (docs/fps-plan.md). Pairs (advancing)
+// or samples (dense) are split over threads in contiguous blocks; the report does not depend on
+// the thread count. A checker keeps its scratch storage between calls and fills a caller-owned
+// report, so repeated checks allocate nothing once warmed up (with threads = 1; more threads start
+// std::threads per call).
 #pragma once
 
 #include "axon/fps/plan/collision.hpp"
@@ -29,8 +35,17 @@
 
 namespace axon::fps::plan {
 
+enum class CheckMethod { advancing, dense };
+
 struct CheckOptions {
-  double max_step_mm = 0.05;  // largest travel of any arm point between samples
+  CheckMethod method = CheckMethod::advancing;
+  double max_step_mm = 0.05;  // dense: largest travel of any arm point between samples
+  // advancing: a pair's true smallest clearance is at least min(its reported one,
+  // precise_below_mm) - precision_mm (steps are shortened to keep that), and never below 0 for a
+  // pair reported clear.
+  double precision_mm = 0.05;
+  double precise_below_mm = 1.0;
+  double min_step_s = 1e-6;  // advancing: a shorter step is not proven, its bound is noted
   unsigned threads = 0;       // 0: std::thread::hardware_concurrency()
   bool obstacles = true;      // also check robot-obstacle pairs
   // A pair whose bodies never move (two robots standing still throughout, or a standing robot and
@@ -60,18 +75,18 @@ struct CheckReport {
   std::vector<PairOutcome> obstacle_pairs;
   double start_s = 0;
   double end_s = 0;
-  double step_s = 0;
-  std::size_t samples = 0;
+  double step_s = 0;        // dense: the time step (advancing: 0)
+  std::size_t samples = 0;  // dense: sample instants; advancing: the evaluations of the busiest pair
+  std::size_t pair_evaluations = 0;  // exact clearances computed (both methods)
   std::size_t collided_pairs = 0;  // robot and obstacle pairs that collided at least once
   std::size_t standing_contacts = 0;  // pairs in contact that never move (allow_standing_contacts)
-  std::size_t halvings = 0;           // sample intervals halved to prove a close pair clear
+  std::size_t halvings = 0;           // dense: sample intervals halved to prove a close pair clear
+  std::size_t forced_steps = 0;       // advancing: steps shorter than min_step_s, noted as bounds
   double min_clearance_mm = std::numeric_limits<double>::infinity();  // over the pairs that count
 
   [[nodiscard]] bool ok() const noexcept { return collided_pairs == 0; }
-  // Pair evaluations done (samples x pairs checked).
-  [[nodiscard]] std::size_t evaluations() const noexcept {
-    return samples * (robot_pairs.size() + obstacle_pairs.size());
-  }
+  // Pair evaluations done.
+  [[nodiscard]] std::size_t evaluations() const noexcept { return pair_evaluations; }
 };
 
 class TrajectoryChecker {
@@ -90,11 +105,22 @@ class TrajectoryChecker {
     std::vector<double> half;   // half the segment lengths
     std::vector<double> prev_robot, prev_obstacle;  // per pair: clearance (or a lower bound) at the last sample
     std::size_t halvings = 0;
+    std::size_t evaluations = 0, busiest = 0, forced = 0;  // advancing
     std::vector<AngleCursor> alpha, beta;
     std::vector<PairOutcome> robot_pairs, obstacle_pairs;
   };
   void run(Worker& w, std::span<const RobotTrajectory> trajectories, std::size_t first, std::size_t last,
            const CheckReport& shape, bool obstacles) const;
+  void check_dense(std::span<const RobotTrajectory> trajectories, const CheckOptions& options, double point_speed,
+                   unsigned threads, CheckReport& out);
+  void check_advancing(std::span<const RobotTrajectory> trajectories, const CheckOptions& options, unsigned threads,
+                       CheckReport& out);
+  void summarize(const CheckOptions& options, CheckReport& out) const;
+  template <class Work>
+  void split(std::size_t count, unsigned threads, const Work& work);
+  // Advancing: pairs [first, last) of robot pairs followed by obstacle pairs, written into `out`.
+  void advance(Worker& w, std::span<const RobotTrajectory> trajectories, std::size_t first, std::size_t last,
+               const CheckOptions& options, CheckReport& out) const;
 
   const CollisionModel* model_;
   std::vector<double> speed_;  // per robot: fastest point speed of its segment in this move, mm/s

@@ -10,7 +10,7 @@
 // held there and reported; the rest is re-planned around them. Trajectories keep only the corners
 // of the piecewise-constant speed profile; jagged arms are shortened by certified shortcuts
 // (smooth.hpp), everything is simplified where that stays clear, and the result is verified by the
-// independent checker (dense samples and a proof between them) at the full buffer (flagged robots fall back to their
+// independent checker (checker.hpp: a proof, not a sampling result) at the full buffer (flagged robots fall back to their
 // shortcut, then to their exact trajectories: verify_with_fallbacks).
 #pragma once
 

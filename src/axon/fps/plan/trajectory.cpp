@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 
 namespace axon::fps::plan {
@@ -56,6 +57,19 @@ double AngleCursor::at(double t_s) noexcept {
   if (t_s >= points_.back().t_s) return points_.back().deg;
   while (i_ + 1 < points_.size() && points_[i_ + 1].t_s <= t_s) ++i_;
   return lerp(points_[i_], points_[i_ + 1], t_s);
+}
+
+double AngleCursor::speed() const noexcept {
+  if (points_.empty() || last_t_ < points_.front().t_s || last_t_ >= points_.back().t_s) return 0;
+  const TimedAngle& a = points_[i_];
+  const TimedAngle& b = points_[i_ + 1];
+  return std::abs(b.deg - a.deg) / (b.t_s - a.t_s);
+}
+
+double AngleCursor::next_point() const noexcept {
+  if (points_.empty() || last_t_ >= points_.back().t_s) return std::numeric_limits<double>::infinity();
+  if (last_t_ < points_.front().t_s) return points_.front().t_s;
+  return points_[i_ + 1].t_s;
 }
 
 }  // namespace axon::fps::plan

@@ -45,6 +45,10 @@ class AngleCursor {
   explicit AngleCursor(std::span<const TimedAngle> points) noexcept : points_(points) {}
   // The angle at t_s; t_s must not decrease between calls (else it restarts from the beginning).
   double at(double t_s) noexcept;
+  // After at(t): the arm's |deg/s| from t until next_point() (0 before the first point and after
+  // the last), and the time of that next point (infinity after the last).
+  [[nodiscard]] double speed() const noexcept;
+  [[nodiscard]] double next_point() const noexcept;
 
  private:
   std::span<const TimedAngle> points_;
