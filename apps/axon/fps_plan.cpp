@@ -76,26 +76,17 @@ Loaded load(const PlanArgs& a) {
   return {std::move(plane), std::move(model)};
 }
 
-// A target file's poses in model order; problems parking resolved are logged. `point_fibre`, when
-// given, receives which robots' targets are fibre points (the safe zone's reach check).
-std::vector<plan::Pose> file_poses(const plan::CollisionModel& model, const std::string& file, plan::TargetPolicy policy,
-                                   const char* what, std::vector<std::optional<std::size_t>>* point_fibre = nullptr) {
-  const auto targets = need(plan::load_targets(file));
-  std::string notes;
-  auto poses = plan::target_poses(model, targets, policy, &notes);
-  if (!poses) throw Exception(Error(poses.error().code, fmt::format("{} '{}':\n{}", what, file, poses.error().detail)));
-  if (!notes.empty()) spdlog::warn("{} '{}':\n{}", what, file, notes);
-  if (point_fibre) *point_fibre = plan::point_fibres(model, targets, poses.value());
-  return std::move(poses).value();
-}
-
-// "folded", "random" (with the seed) or a target file resolved against the model.
+// Poses by name (plan::poses_by_name: a target file, or for `named` also "folded" / "random");
+// what parking resolved is logged. `point_fibre`, when given, receives which robots' targets are
+// fibre points (the safe zone's reach check).
 std::vector<plan::Pose> poses_from(const plan::CollisionModel& model, const std::string& spec, std::uint64_t seed,
                                    plan::TargetPolicy policy, const char* what,
-                                   std::vector<std::optional<std::size_t>>* point_fibre = nullptr) {
-  if (spec == "folded") return plan::folded_poses(model);
-  if (spec == "random") return plan::random_poses(model, seed);
-  return file_poses(model, spec, policy, what, point_fibre);
+                                   std::vector<std::optional<std::size_t>>* point_fibre = nullptr, bool named = true) {
+  auto r = named ? plan::poses_by_name(model, spec, seed, policy) : plan::poses_from_file(model, spec, policy);
+  if (!r) throw Exception(Error(r.error().code, fmt::format("{} {}", what, r.error().detail)));
+  if (!r.value().notes.empty()) spdlog::warn("{} '{}':\n{}", what, spec, r.value().notes);
+  if (point_fibre) *point_fibre = std::move(r.value().point_fibre);
+  return std::move(r.value().poses);
 }
 
 plan::PlannerOptions planner_options(const PlanArgs& a) {
@@ -190,7 +181,7 @@ asio::awaitable<int> job_goto_all(const PlanArgs& a, host::Array& array) {
     if (!a.output.empty()) write_file(a.output, plan::plan_to_json(model, p, o.planner, plane.name()));
     spdlog::info("goto-all: {:.1f} s move", p.stats.duration_s);
   };
-  auto targets = file_poses(model, a.targets, policy, "targets", &o.point_fibre);
+  auto targets = poses_from(model, a.targets, 0, policy, "targets", &o.point_fibre, false);
   auto r = co_await host::plan_and_move(array, plane, model, std::move(targets), o);
   const auto done = need(std::move(r));
   if (!done.run) {

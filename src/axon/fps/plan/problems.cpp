@@ -1,5 +1,9 @@
 #include "axon/fps/plan/problems.hpp"
 
+#include "axon/fps/plan/safe_zone.hpp"
+
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <numeric>
 #include <random>
@@ -32,6 +36,31 @@ std::vector<Pose> random_poses(const CollisionModel& model, std::uint64_t seed, 
     }
   }
   return poses;
+}
+
+Result<ProblemPoses> poses_from_file(const CollisionModel& model, const std::string& path, TargetPolicy policy) {
+  AXON_TRY(targets, load_targets(path));
+  ValidationOptions vo;
+  vo.policy = policy;
+  const TargetValidation v = validate_targets(model, targets, vo);
+  if (!v.errors.empty() || (!v.ok() && policy == TargetPolicy::reject))
+    return Error(PlanErrc::bad_target_file, fmt::format("'{}':\n{}", path, v.summary()));
+  ProblemPoses out;
+  out.poses = v.poses();
+  out.notes = v.summary();
+  for (const RobotOutcome& r : v.robots)
+    if (r.status == RobotOutcome::Status::parked) out.parked.push_back(r);
+  out.point_fibre = point_fibres(model, targets, out.poses);
+  return out;
+}
+
+Result<ProblemPoses> poses_by_name(const CollisionModel& model, const std::string& name, std::uint64_t seed,
+                                   TargetPolicy policy) {
+  if (name != "folded" && name != "random") return poses_from_file(model, name, policy);
+  ProblemPoses out;
+  out.poses = name == "folded" ? folded_poses(model) : random_poses(model, seed);
+  out.point_fibre.assign(model.size(), std::nullopt);
+  return out;
 }
 
 }  // namespace axon::fps::plan

@@ -3,8 +3,11 @@
 #pragma once
 
 #include "axon/fps/plan/collision.hpp"
+#include "axon/fps/plan/targets.hpp"
 
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace axon::fps::plan {
@@ -29,5 +32,24 @@ struct RandomPoseOptions {
 // pose so far (which starts at `fallback`) and to the obstacles: a clear configuration,
 // reproducible from the seed.
 std::vector<Pose> random_poses(const CollisionModel& model, std::uint64_t seed, const RandomPoseOptions& options = {});
+
+// A configuration read for a planner problem.
+struct ProblemPoses {
+  std::vector<Pose> poses;  // model order
+  // Per robot, the fibre whose focal-plane point its target is (safe_zone.hpp's point_fibres; all
+  // nullopt for folded and random poses).
+  std::vector<std::optional<std::size_t>> point_fibre;
+  std::string notes;  // what TargetPolicy::park resolved (robots parked and why), empty if nothing
+  std::vector<RobotOutcome> parked;  // those robots: their targets are replaced by the park pose
+};
+
+// A target file (targets.hpp) resolved against the model under `policy` (validate_targets). Errors:
+// the file's (PlanErrc::bad_target_file, located), or the validation's (unknown robots,
+// duplicates; under reject any bad target) with the file named in the detail.
+Result<ProblemPoses> poses_from_file(const CollisionModel& model, const std::string& path, TargetPolicy policy);
+// "folded", "random" (drawn from `seed`) or a target file: how `axon fps plan --from/--to` and
+// bench/fps_plan name a configuration.
+Result<ProblemPoses> poses_by_name(const CollisionModel& model, const std::string& name, std::uint64_t seed,
+                                   TargetPolicy policy);
 
 }  // namespace axon::fps::plan
