@@ -383,6 +383,7 @@ void Stepper::step_robot(std::size_t i) {
     }
 
   Move chosen{};
+  Segment chosen_seg = seg_prev_[i];  // the segment at the chosen move's end (standing: where it is)
   if (!escaping) {
     // Insertion sort: at most eight candidates.
     for (std::size_t a = 1; a < nc; ++a)
@@ -392,6 +393,7 @@ void Stepper::step_robot(std::size_t i) {
       const Segment s1 = m_.robot(i).collision_segment(q);
       if (feasible(i, q, s1, travel(i, cands[k].mv), false, nullptr).ok) {
         chosen = cands[k].mv;
+        chosen_seg = s1;
         break;
       }
     }
@@ -413,6 +415,7 @@ void Stepper::step_robot(std::size_t i) {
       if (score > best) {
         best = score;
         chosen = cands[k].mv;
+        chosen_seg = s1;
       }
     }
     if (--st.escape_left == 0) {
@@ -423,7 +426,7 @@ void Stepper::step_robot(std::size_t i) {
 
   const Pose q = apply(p, chosen, g);
   cur_[i] = q;
-  seg_cur_[i] = m_.robot(i).collision_segment(q);
+  seg_cur_[i] = chosen == Move{} ? m_.robot(i).collision_segment(q) : chosen_seg;
   trav_[i] = travel(i, chosen);
   st.last = chosen;
   if (chosen == Move{} && has_scripts_) hold_or_dodge(i);
