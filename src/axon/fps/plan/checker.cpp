@@ -1,5 +1,7 @@
 #include "axon/fps/plan/checker.hpp"
 
+#include "axon/fps/plan/moving_segment.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -57,24 +59,6 @@ void certify(PairOutcome& o, const Clearance& at, double rate, double t0, double
   certify(o, at, rate, tm, cm, t1, c1, depth + 1, halvings);
 }
 
-// A moving body of a pair: one robot's collision segment along its trajectory, read at increasing
-// times (the advancing method).
-class Body {
- public:
-  Body(const Positioner& robot, const RobotTrajectory& t) : robot_(&robot), alpha_(t.alpha), beta_(t.beta) {}
-  // The segment at t; then rate() and next() hold from t on.
-  Segment at(double t) noexcept { return robot_->collision_segment({alpha_.at(t), beta_.at(t)}); }
-  // How fast any point of the segment can move until next(), mm/s.
-  [[nodiscard]] double rate() const noexcept {
-    return (alpha_.speed() * robot_->reach_mm() + beta_.speed() * robot_->collision_length_mm()) * kRad;
-  }
-  [[nodiscard]] double next() const noexcept { return std::min(alpha_.next_point(), beta_.next_point()); }
-
- private:
-  const Positioner* robot_;
-  AngleCursor alpha_, beta_;
-};
-
 struct Walked {
   std::size_t evaluations = 0;
   std::size_t forced = 0;
@@ -114,7 +98,7 @@ Walked walk(PairOutcome& o, Pair& pair, double start, double end, const CheckOpt
 }
 
 struct RobotPairWalk {
-  Body a, b;
+  MovingSegment a, b;
   double limit;
   double clearance(double t) noexcept { return segment_distance(a.at(t), b.at(t)) - limit; }
   [[nodiscard]] double rate() const noexcept { return a.rate() + b.rate(); }
@@ -122,7 +106,7 @@ struct RobotPairWalk {
 };
 
 struct ObstaclePairWalk {
-  Body a;
+  MovingSegment a;
   Segment obstacle;
   double limit;
   double clearance(double t) noexcept { return segment_distance(a.at(t), obstacle) - limit; }
@@ -150,11 +134,13 @@ void TrajectoryChecker::advance(Worker& w, std::span<const RobotTrajectory> traj
   for (std::size_t k = first; k < last; ++k) {
     if (k < rp.size()) {
       const RobotPair& p = rp[k];
-      checker_detail::RobotPairWalk pair{{m.robot(p.a), trajectories[p.a]}, {m.robot(p.b), trajectories[p.b]}, p.limit_mm};
+      checker_detail::RobotPairWalk pair{{m.robot(p.a), trajectories[p.a].alpha, trajectories[p.a].beta},
+                                         {m.robot(p.b), trajectories[p.b].alpha, trajectories[p.b].beta}, p.limit_mm};
       tally(checker_detail::walk(out.robot_pairs[k], pair, out.start_s, out.end_s, options));
     } else {
       const ObstaclePair& p = op[k - rp.size()];
-      checker_detail::ObstaclePairWalk pair{{m.robot(p.robot), trajectories[p.robot]}, m.obstacles()[p.obstacle].shape, p.limit_mm};
+      checker_detail::ObstaclePairWalk pair{{m.robot(p.robot), trajectories[p.robot].alpha, trajectories[p.robot].beta},
+                                            m.obstacles()[p.obstacle].shape, p.limit_mm};
       tally(checker_detail::walk(out.obstacle_pairs[k - rp.size()], pair, out.start_s, out.end_s, options));
     }
   }

@@ -1,9 +1,11 @@
 #include "axon/fps/plan/smooth.hpp"
 
 #include "axon/fps/plan/distance.hpp"
+#include "axon/fps/plan/moving_segment.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <tuple>
 
 namespace axon::fps::plan {
@@ -16,73 +18,58 @@ class ShortcutCertifier {
  public:
   ShortcutCertifier(const CollisionModel& model, const std::vector<RobotTrajectory>& trajectories,
                     const SmoothOptions& o)
-      : m_(model), traj_(trajectories), o_(o), bound_(model.size(), 0.0) {
-    // Shortcuts never speed an arm up, so bounds from the trajectories as they come hold throughout.
-    for (std::size_t i = 0; i < model.size(); ++i) {
-      const Positioner& r = model.robot(i);
-      bound_[i] = (max_speed(trajectories[i].alpha) * r.reach_mm() +
-                   max_speed(trajectories[i].beta) * r.collision_length_mm()) * kRad;
-    }
-  }
+      : m_(model), traj_(trajectories), o_(o) {}
 
   // Robot i with arm `alpha_arm ? alpha : beta` following `piece` (two or more points, linear in
   // between; the other arm as in its trajectory): clear of everything over the piece's interval?
   bool clear(std::size_t i, bool alpha_arm, std::span<const TimedAngle> piece) const {
-    const Positioner& ri = m_.robot(i);
     const RobotTrajectory& ti = traj_[i];
+    MovingSegment mi(m_.robot(i), alpha_arm ? piece : std::span<const TimedAngle>(ti.alpha),
+                     alpha_arm ? std::span<const TimedAngle>(ti.beta) : piece);
     const double t0 = piece.front().t_s, t1 = piece.back().t_s;
-    auto pose_i = [&](double t) {
-      const double edited = angle_at(piece, t);
-      return alpha_arm ? Pose{edited, angle_at(ti.beta, t)} : Pose{angle_at(ti.alpha, t), edited};
-    };
-    const double vi = (max_speed(piece) * (alpha_arm ? ri.reach_mm() : ri.collision_length_mm()) +
-                       (alpha_arm ? max_speed(ti.beta) * ri.collision_length_mm()
-                                  : max_speed(ti.alpha) * ri.reach_mm())) * kRad;
-    // One body against another that moves at most `v` mm/s faster than the pair can close.
-    auto advance = [&](double v, auto&& clearance_at) {
-      double t = t0;
-      for (;;) {
-        const double c = clearance_at(t);
-        if (!(c >= o_.min_clearance_mm)) return false;
-        if (v <= 0) return true;
-        const double step = (c - o_.min_clearance_mm) / v;
-        if (t + step >= t1) return true;
-        if (step < o_.min_step_s) return false;
-        t += step;
-      }
-    };
     const auto nb = m_.neighbours(i);
     const auto pairs = m_.pairs_of(i);
     const auto all = m_.robot_pairs();
     for (std::size_t k = 0; k < nb.size(); ++k) {
-      const std::size_t j = nb[k];
-      const Positioner& rj = m_.robot(j);
-      const RobotTrajectory& tj = traj_[j];
-      const double limit = all[pairs[k]].limit_mm;
-      const bool ok = advance(vi + bound_[j], [&](double t) {
-        const Pose pj{angle_at(tj.alpha, t), angle_at(tj.beta, t)};
-        return segment_distance(ri.collision_segment(pose_i(t)), rj.collision_segment(pj)) - limit;
-      });
-      if (!ok) return false;
+      const RobotTrajectory& tj = traj_[nb[k]];
+      MovingSegment mj(m_.robot(nb[k]), tj.alpha, tj.beta);
+      if (!advance(t0, t1, mi, &mj, nullptr, all[pairs[k]].limit_mm)) return false;
     }
     const auto obstacles = m_.obstacles();
     const auto opairs = m_.obstacle_pairs();
     for (const std::uint32_t k : m_.obstacle_pairs_of(i)) {
       const ObstaclePair& op = opairs[k];
-      const Segment& ob = obstacles[op.obstacle].shape;
-      const bool ok = advance(vi, [&](double t) {
-        return segment_distance(ri.collision_segment(pose_i(t)), ob) - op.limit_mm;
-      });
-      if (!ok) return false;
+      if (!advance(t0, t1, mi, nullptr, &obstacles[op.obstacle].shape, op.limit_mm)) return false;
     }
     return true;
   }
 
  private:
+  // Robot `mi` against a moving robot `mj` or a fixed segment `ob` from t0 to t1: every evaluation
+  // keeps min_clearance_mm, and the next one is where the clearance could first fall below it
+  // (within the stretch where both bodies keep their speeds).
+  bool advance(double t0, double t1, MovingSegment& mi, MovingSegment* mj, const Segment* ob, double limit) const {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    for (double t = t0;;) {
+      const Segment si = mi.at(t);
+      const double c = (mj ? segment_distance(si, mj->at(t)) : segment_distance(si, *ob)) - limit;
+      if (!(c >= o_.min_clearance_mm)) return false;
+      if (t >= t1) return true;
+      const double v = mi.rate() + (mj ? mj->rate() : 0.0);
+      const double stretch_end = std::min({mi.next(), mj ? mj->next() : kInf, t1});
+      if (v <= 0) {
+        t = stretch_end;
+        continue;
+      }
+      const double step = (c - o_.min_clearance_mm) / v;
+      if (step < o_.min_step_s) return false;
+      t = std::min(t + step, stretch_end);
+    }
+  }
+
   const CollisionModel& m_;
   const std::vector<RobotTrajectory>& traj_;
   SmoothOptions o_;
-  std::vector<double> bound_;  // mm/s: how fast any point of a robot's collision segment moves
 };
 
 }  // namespace

@@ -1,0 +1,34 @@
+// One robot's collision segment along its trajectory, read at increasing times: where it is, how
+// fast any of its points can move until the next trajectory point of either arm, and when that is.
+// The bound under both conservative advancements: the checker's (checker.hpp) and the shortcuts'
+// certificate (smooth.hpp). A point at distance r from an axis turning at w rad/s moves at w * r,
+// so no point of the segment moves faster than alpha speed x reach + beta speed x collision length.
+#pragma once
+
+#include "axon/fps/plan/kinematics.hpp"
+#include "axon/fps/plan/trajectory.hpp"
+
+#include <algorithm>
+#include <span>
+
+namespace axon::fps::plan {
+
+class MovingSegment {
+ public:
+  MovingSegment(const Positioner& robot, std::span<const TimedAngle> alpha, std::span<const TimedAngle> beta) noexcept
+      : robot_(&robot), alpha_(alpha), beta_(beta) {}
+  // The segment at t; then rate() and next() hold from t on. Times going back restart the cursors.
+  Segment at(double t) noexcept { return robot_->collision_segment({alpha_.at(t), beta_.at(t)}); }
+  // How fast any point of the segment can move until next(), mm/s.
+  [[nodiscard]] double rate() const noexcept {
+    return (alpha_.speed() * robot_->reach_mm() + beta_.speed() * robot_->collision_length_mm()) * kRad;
+  }
+  // The next trajectory point of either arm after the last at() (infinity after both ends).
+  [[nodiscard]] double next() const noexcept { return std::min(alpha_.next_point(), beta_.next_point()); }
+
+ private:
+  const Positioner* robot_;
+  AngleCursor alpha_, beta_;
+};
+
+}  // namespace axon::fps::plan
