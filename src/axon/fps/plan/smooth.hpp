@@ -8,11 +8,12 @@
 //
 // The neighbours were planned against the robot's dithering positions, so every shortcut is
 // certified before it is taken, against the *current* trajectories of the robot's neighbours and
-// its obstacles over the interval it changes. Conservative advancement: a point of a collision
-// segment moves at most (alpha speed * reach + beta speed * collision length) (radians, mm), so
-// with clearance c at time t and the pair's bounds summing to V, the clearance stays at least m
-// until t + (c - m) / V; the next evaluation is there. The certificate is exact (no sampling gap),
-// stricter than the dense checker, which still verifies the whole plan afterwards.
+// its obstacles over the interval it changes. Conservative advancement (moving_segment.hpp): a
+// point of a collision segment moves at most (alpha speed * reach + beta speed * collision length)
+// (radians, mm), so with clearance c at time t and the pair's bounds summing to V over the stretch
+// where both keep their speeds, the clearance stays at least m until t + (c - m) / V or the
+// stretch's end; the next evaluation is there. The certificate has no sampling gap; the checker
+// still verifies the whole plan afterwards.
 #pragma once
 
 #include "axon/fps/plan/collision.hpp"
