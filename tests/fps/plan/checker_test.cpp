@@ -399,6 +399,14 @@ TEST(PlanChecker, RejectsBadTrajectories) {
   EXPECT_NE(e.error().detail.find("robot 2"), std::string::npos);
   bad[1].beta.clear();
   EXPECT_EQ(checker.check(bad, {}, r).error(), PlanErrc::bad_trajectory);
+  // Settings under which the advancing method could not move on from a touching pair.
+  for (auto set : {+[](CheckOptions& o) { o.min_step_s = 0; }, +[](CheckOptions& o) { o.precision_mm = 0; },
+                   +[](CheckOptions& o) { o.precision_mm = std::numeric_limits<double>::quiet_NaN(); },
+                   +[](CheckOptions& o) { o.precise_below_mm = -1; }}) {
+    CheckOptions o;
+    set(o);
+    EXPECT_EQ(checker.check(s.traj, o, r).error(), PlanErrc::bad_trajectory);
+  }
 }
 
 TEST(PlanTrajectory, InterpolationAndCursor) {

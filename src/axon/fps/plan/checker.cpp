@@ -155,6 +155,12 @@ Result<void> TrajectoryChecker::check(std::span<const RobotTrajectory> trajector
                       fmt::format("{} trajectories for {} robots", trajectories.size(), n));
   if (!(options.max_step_mm > 0))
     return make_error(PlanErrc::bad_trajectory, fmt::format("max_step_mm must be > 0, not {}", options.max_step_mm));
+  // The advancing method's steps are at least min_step_s long and precision_mm of travel: with
+  // either at 0 (or not a number) a pair touching at 0 clearance would never move on.
+  if (!(options.precision_mm > 0) || !(options.min_step_s > 0) || !(options.precise_below_mm >= 0))
+    return make_error(PlanErrc::bad_trajectory,
+                      fmt::format("precision_mm and min_step_s must be > 0 and precise_below_mm >= 0, not {}, {} and {}",
+                                  options.precision_mm, options.min_step_s, options.precise_below_mm));
 
   // Time span and the fastest-moving point of any robot.
   double start = std::numeric_limits<double>::infinity();
