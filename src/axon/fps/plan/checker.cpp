@@ -97,23 +97,6 @@ Walked walk(PairOutcome& o, Pair& pair, double start, double end, const CheckOpt
   return w;
 }
 
-struct RobotPairWalk {
-  MovingSegment a, b;
-  double limit;
-  double clearance(double t) noexcept { return segment_distance(a.at(t), b.at(t)) - limit; }
-  [[nodiscard]] double rate() const noexcept { return a.rate() + b.rate(); }
-  [[nodiscard]] double next() const noexcept { return std::min(a.next(), b.next()); }
-};
-
-struct ObstaclePairWalk {
-  MovingSegment a;
-  Segment obstacle;
-  double limit;
-  double clearance(double t) noexcept { return segment_distance(a.at(t), obstacle) - limit; }
-  [[nodiscard]] double rate() const noexcept { return a.rate(); }
-  [[nodiscard]] double next() const noexcept { return a.next(); }
-};
-
 }  // namespace checker_detail
 
 using checker_detail::certify;
@@ -134,13 +117,13 @@ void TrajectoryChecker::advance(Worker& w, std::span<const RobotTrajectory> traj
   for (std::size_t k = first; k < last; ++k) {
     if (k < rp.size()) {
       const RobotPair& p = rp[k];
-      checker_detail::RobotPairWalk pair{{m.robot(p.a), trajectories[p.a].alpha, trajectories[p.a].beta},
-                                         {m.robot(p.b), trajectories[p.b].alpha, trajectories[p.b].beta}, p.limit_mm};
+      MovingRobotPair pair{{m.robot(p.a), trajectories[p.a].alpha, trajectories[p.a].beta},
+                           {m.robot(p.b), trajectories[p.b].alpha, trajectories[p.b].beta}, p.limit_mm};
       tally(checker_detail::walk(out.robot_pairs[k], pair, out.start_s, out.end_s, options));
     } else {
       const ObstaclePair& p = op[k - rp.size()];
-      checker_detail::ObstaclePairWalk pair{{m.robot(p.robot), trajectories[p.robot].alpha, trajectories[p.robot].beta},
-                                            m.obstacles()[p.obstacle].shape, p.limit_mm};
+      MovingObstaclePair pair{{m.robot(p.robot), trajectories[p.robot].alpha, trajectories[p.robot].beta},
+                              m.obstacles()[p.obstacle].shape, p.limit_mm};
       tally(checker_detail::walk(out.obstacle_pairs[k - rp.size()], pair, out.start_s, out.end_s, options));
     }
   }

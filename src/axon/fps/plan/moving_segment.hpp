@@ -5,6 +5,7 @@
 // so no point of the segment moves faster than alpha speed x reach + beta speed x collision length.
 #pragma once
 
+#include "axon/fps/plan/distance.hpp"
 #include "axon/fps/plan/kinematics.hpp"
 #include "axon/fps/plan/trajectory.hpp"
 
@@ -29,6 +30,26 @@ class MovingSegment {
  private:
   const Positioner* robot_;
   AngleCursor alpha_, beta_;
+};
+
+// The two bodies a conservative advancement walks: two moving robots, or a moving robot and a
+// fixed segment (an obstacle). clearance(t) reads both at t (distance minus `limit`, both buffers);
+// rate() and next() then hold for the pair from t on.
+struct MovingRobotPair {
+  MovingSegment a, b;
+  double limit;
+  double clearance(double t) noexcept { return segment_distance(a.at(t), b.at(t)) - limit; }
+  [[nodiscard]] double rate() const noexcept { return a.rate() + b.rate(); }
+  [[nodiscard]] double next() const noexcept { return std::min(a.next(), b.next()); }
+};
+
+struct MovingObstaclePair {
+  MovingSegment a;
+  Segment obstacle;
+  double limit;
+  double clearance(double t) noexcept { return segment_distance(a.at(t), obstacle) - limit; }
+  [[nodiscard]] double rate() const noexcept { return a.rate(); }
+  [[nodiscard]] double next() const noexcept { return a.next(); }
 };
 
 }  // namespace axon::fps::plan

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <tuple>
 
 namespace axon::fps::plan {
@@ -32,31 +31,30 @@ class ShortcutCertifier {
     const auto all = m_.robot_pairs();
     for (std::size_t k = 0; k < nb.size(); ++k) {
       const RobotTrajectory& tj = traj_[nb[k]];
-      MovingSegment mj(m_.robot(nb[k]), tj.alpha, tj.beta);
-      if (!advance(t0, t1, mi, &mj, nullptr, all[pairs[k]].limit_mm)) return false;
+      MovingRobotPair pair{mi, {m_.robot(nb[k]), tj.alpha, tj.beta}, all[pairs[k]].limit_mm};
+      if (!advance(t0, t1, pair)) return false;
     }
     const auto obstacles = m_.obstacles();
     const auto opairs = m_.obstacle_pairs();
     for (const std::uint32_t k : m_.obstacle_pairs_of(i)) {
       const ObstaclePair& op = opairs[k];
-      if (!advance(t0, t1, mi, nullptr, &obstacles[op.obstacle].shape, op.limit_mm)) return false;
+      MovingObstaclePair pair{mi, obstacles[op.obstacle].shape, op.limit_mm};
+      if (!advance(t0, t1, pair)) return false;
     }
     return true;
   }
 
  private:
-  // Robot `mi` against a moving robot `mj` or a fixed segment `ob` from t0 to t1: every evaluation
-  // keeps min_clearance_mm, and the next one is where the clearance could first fall below it
-  // (within the stretch where both bodies keep their speeds).
-  bool advance(double t0, double t1, MovingSegment& mi, MovingSegment* mj, const Segment* ob, double limit) const {
-    constexpr double kInf = std::numeric_limits<double>::infinity();
+  // The pair from t0 to t1: every evaluation keeps min_clearance_mm, and the next one is where the
+  // clearance could first fall below it (within the stretch where both bodies keep their speeds).
+  template <class Pair>
+  bool advance(double t0, double t1, Pair& pair) const {
     for (double t = t0;;) {
-      const Segment si = mi.at(t);
-      const double c = (mj ? segment_distance(si, mj->at(t)) : segment_distance(si, *ob)) - limit;
+      const double c = pair.clearance(t);
       if (!(c >= o_.min_clearance_mm)) return false;
       if (t >= t1) return true;
-      const double v = mi.rate() + (mj ? mj->rate() : 0.0);
-      const double stretch_end = std::min({mi.next(), mj ? mj->next() : kInf, t1});
+      const double v = pair.rate();
+      const double stretch_end = std::min(pair.next(), t1);
       if (v <= 0) {
         t = stretch_end;
         continue;
