@@ -40,11 +40,9 @@ std::vector<Pose> random_poses(const CollisionModel& model, std::uint64_t seed, 
 
 Result<ProblemPoses> poses_from_file(const CollisionModel& model, const std::string& path, TargetPolicy policy) {
   AXON_TRY(targets, load_targets(path));
-  ValidationOptions vo;
-  vo.policy = policy;
-  const TargetValidation v = validate_targets(model, targets, vo);
-  if (!v.errors.empty() || (!v.ok() && policy == TargetPolicy::reject))
-    return Error(PlanErrc::bad_target_file, fmt::format("'{}':\n{}", path, v.summary()));
+  auto usable = usable_targets(model, targets, policy);
+  if (!usable) return Error(usable.error().code, fmt::format("'{}':\n{}", path, usable.error().detail));
+  const TargetValidation& v = usable.value();
   ProblemPoses out;
   out.poses = v.poses();
   out.notes = v.summary();

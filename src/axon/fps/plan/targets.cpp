@@ -338,12 +338,17 @@ TargetValidation validate_targets(const CollisionModel& model, std::span<const T
   return v;
 }
 
-Result<std::vector<Pose>> target_poses(const CollisionModel& model, std::span<const Target> targets, TargetPolicy policy,
-                                       std::string* notes) {
+Result<TargetValidation> usable_targets(const CollisionModel& model, std::span<const Target> targets, TargetPolicy policy) {
   ValidationOptions vo;
   vo.policy = policy;
-  const auto v = validate_targets(model, targets, vo);
+  TargetValidation v = validate_targets(model, targets, vo);
   if (!v.errors.empty() || (!v.ok() && policy == TargetPolicy::reject)) return Error(PlanErrc::bad_target_file, v.summary());
+  return v;
+}
+
+Result<std::vector<Pose>> target_poses(const CollisionModel& model, std::span<const Target> targets, TargetPolicy policy,
+                                       std::string* notes) {
+  AXON_TRY(v, usable_targets(model, targets, policy));
   if (notes) *notes = v.summary();
   return v.poses();
 }

@@ -68,7 +68,12 @@ struct TargetValidation {
 TargetValidation validate_targets(const CollisionModel& model, std::span<const Target> targets,
                                   const ValidationOptions& options = {});
 
-// The poses of validated targets, in model order: what a planner takes. Errors
+// The validation under `policy` when its result can be planned: errors (PlanErrc::bad_target_file,
+// the validation summary as detail) for unknown robots or duplicates, and under
+// TargetPolicy::reject for any bad target.
+Result<TargetValidation> usable_targets(const CollisionModel& model, std::span<const Target> targets, TargetPolicy policy);
+
+// The poses of validated targets (usable_targets), in model order: what a planner takes. Errors
 // (PlanErrc::bad_target_file, the validation summary as detail): unknown robots or duplicates, and
 // under TargetPolicy::reject any bad target. `notes`, when given, receives what parking resolved
 // (empty when nothing).
