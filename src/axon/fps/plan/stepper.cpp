@@ -383,7 +383,7 @@ void Stepper::step_robot(std::size_t i) {
     }
 
   Move chosen{};
-  Segment chosen_seg = seg_prev_[i];  // the segment at the chosen move's end (standing: where it is)
+  Segment chosen_seg{};  // the segment at the chosen move's end (set with `chosen`)
   if (!escaping) {
     // Insertion sort: at most eight candidates.
     for (std::size_t a = 1; a < nc; ++a)
