@@ -61,6 +61,7 @@ struct ServeArgs {
   std::vector<std::string> stroke_ends;  // [ARM.]AXIS=MIN:MAX [deg]
   bool no_stroke_ends = false, no_continuity_check = false, no_following_error_check = false;
   double duration_s = 0;
+  bool until_controller_ends = false;
   double status_interval_s = 1.0;
   double stop_timeout_s = 5.0;
   bool json = false;
@@ -132,6 +133,7 @@ apps::ServeOptions serve_options(const ServeArgs& o) {
   s.moni = o.moni < 0 ? 0 : o.moni;
   s.csv_rotation = o.csv_rotation.limits();
   s.duration_s = o.duration_s;
+  s.until_controller_ends = o.until_controller_ends;
   s.stop_timeout_s = o.stop_timeout_s;
   s.status_interval_s = o.status_interval_s;
   return s;
@@ -331,6 +333,7 @@ void add_serve(CLI::App* c4g, GlobalOptions& global) {
   s->add_flag("--no-continuity-check", o->no_continuity_check, "Safety: do not check the continuity of commanded positions");
   s->add_flag("--no-following-error-check", o->no_following_error_check, "Safety: do not check the following error in modes 1, 2, 4 and 5");
   s->add_option("--duration", o->duration_s, "stop after this many seconds (default: until Ctrl-C or the app finishes)")->check(non_negative());
+  s->add_flag("--until-controller-ends", o->until_controller_ends, "a finished app does not end the run: answer the rest of the robot program until the controller ends the exchange (504) or falls silent");
   s->add_option("--status-interval", o->status_interval_s, "seconds between status lines (0: none; default 1)")->check(non_negative());
   s->add_option("--stop-timeout", o->stop_timeout_s, "seconds to wait for mode 0 when stopping before drive off (default 5)")->check(non_negative());
   s->add_flag("--json", o->json, "print the final report as one JSON document on stdout (the other lines go to stderr)");

@@ -13,7 +13,9 @@ run them:
      has; the server's /metrics has it per axis;
   5. once the program ended, the simulator page shows the program completed and the exchange over,
      its /metrics passes `promtool check metrics` and has the axon_c4g_sim_* families, and the
-     cyclic packets it counts are those the server counted.
+     cyclic packets it counts are those the server counted. The program waits 0.3 s in mode 0 after
+     the PC's part before it exits open: the server answers it to its end (--until-controller-ends);
+     a server that stopped when its app finished would leave those packets unanswered.
 The simulator takes the lenient reply window of one period (--lenient-timing): the subject is the
 pages, not the latency of a loaded test machine. Skips only when Chromium cannot start at all."""
 import json
@@ -36,6 +38,7 @@ steps:
   - delay: 1.5
   - go_open: {type: A, mode: 4, arms: [1]}
   - wait_for_pc: {timeout: 40}
+  - delay: 0.3
   - exit_open
 """
 # A relative trajectory of 8 s: joint 1 out by 12 degrees and back, long enough to watch it move.
@@ -56,7 +59,7 @@ def start_server(tmp):
     with open(os.path.join(tmp, 'traj.csv'), 'w') as f:
         f.write(TRAJECTORY)
     serve, lines = start_program([AXON, 'c4g', 'serve', '--listen', '127.0.0.1:0', '--app', 'stream', '--file',
-                                  os.path.join(tmp, 'traj.csv'), '--mode', '4', '--relative', '--status-interval', '0',
+                                  os.path.join(tmp, 'traj.csv'), '--mode', '4', '--relative', '--until-controller-ends', '--status-interval', '0',
                                   '--rt-priority', '10', '--http', '127.0.0.1:0', '--http-linger', '60'],
                                  'listening http ', stderr=open(os.path.join(tmp, 'serve.err'), 'w'))
     drain(serve)
@@ -99,7 +102,7 @@ def page_joint1(driver):
 def check_label_and_program(driver):
     assert page(driver, "document.getElementById('sim-banner').textContent") == 'simulator'
     steps = page(driver, "Array.from(document.querySelectorAll('#program li')).map((li) => li.textContent)")
-    assert len(steps) == 5 and steps[2].startswith('go_open'), steps
+    assert len(steps) == 6 and steps[2].startswith('go_open'), steps
     print('page: labelled simulator, %d program steps' % len(steps))
 
 
