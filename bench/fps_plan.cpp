@@ -52,6 +52,7 @@ constexpr double kGoalRandomRatio = 1.5;
 constexpr const char* kUsage =
     "usage: fps_plan [--layout default|benchtop|FILE|DIR] [--problem [FROM,]TO ...] [--problems N] [--seed S]\n"
     "                [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K] [--local-retries N]\n"
+    "                [--tail-retries N] [--tail-tries N] [--tail-rings R] [--tail-quantile Q] [--tail-slack S]\n"
     "                [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--stop-avoid DEG] [--fold-stop-gap DEG]\n"
     "                [--give-up N] [--stall S] [--smooth-points N] [--smooth-clearance MM]\n"
     "  FROM, TO: folded, random or a target file (YAML/CSV); TO alone starts from folded\n";
@@ -88,6 +89,11 @@ bool set_planner_option(PlannerOptions& o, const std::string& key, const char* v
   else if (key == "--relax-after") o.relax_after = std::atoi(v);
   else if (key == "--local-retries") o.local_retries = std::atoi(v);
   else if (key == "--local-rings") o.local_rings = std::atoi(v);
+  else if (key == "--tail-retries") o.tail_retries = std::atoi(v);
+  else if (key == "--tail-quantile") o.tail_quantile = std::atof(v);
+  else if (key == "--tail-slack") o.tail_slack_s = std::atof(v);
+  else if (key == "--tail-rings") o.tail_rings = std::atoi(v);
+  else if (key == "--tail-tries") o.tail_tries_per_cluster = std::atoi(v);
   else if (key == "--fold-spread") o.fold_spread_deg = std::atof(v);
   else if (key == "--stop-avoid") o.stop_avoid_deg = std::atof(v);
   else if (key == "--fold-stop-gap") o.fold_stop_gap_deg = std::atof(v);

@@ -1,5 +1,6 @@
 #include "axon/fps/plan/phases.hpp"
 
+#include "axon/fps/plan/half.hpp"
 #include "axon/fps/plan/smooth.hpp"
 #include "axon/fps/plan/untangle.hpp"
 
@@ -8,7 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <random>
 #include <span>
 #include <string>
 #include <thread>
@@ -29,13 +29,6 @@ std::size_t firmware_points(const std::vector<TimedAngle>& pts) { return pts.emp
 // The seed of a run: 2s + offset, plus the round's stride.
 std::uint64_t run_seed(std::uint64_t seed, std::uint64_t offset, int round) {
   return seed * 2 + offset + static_cast<std::uint64_t>(round) * kRoundSeedStride;
-}
-
-// The engine's next seed for a re-run (a 64-bit linear congruential step).
-std::uint64_t next_seed(std::uint64_t seed) { return seed * 6364136223846793005ULL + 1442695040888963407ULL; }
-
-std::size_t count_unreached(const StepperResult& r) {
-  return static_cast<std::size_t>(std::count(r.reached.begin(), r.reached.end(), false));
 }
 
 // The A half (forwards) and the B half reversed, joined at the fold: B's points mirrored in time
@@ -66,133 +59,6 @@ void drop_still_points(std::vector<TimedAngle>& pts) {
   }
   while (out.size() >= 2 && out.back().deg == out[out.size() - 2].deg) out.pop_back();
   pts = std::move(out);
-}
-
-// The patch of a local repair: the stuck robots and `rings` rings of neighbours around them (in),
-// and the robots bordering it (border).
-void repair_patch(const CollisionModel& model, const StepperResult& best, int rings, std::vector<bool>& in,
-                  std::vector<bool>& border, std::vector<std::uint32_t>& first) {
-  const std::size_t n = model.size();
-  in.assign(n, false);
-  border.assign(n, false);
-  first.clear();
-  for (std::size_t i = 0; i < n; ++i)
-    if (!best.reached[i]) {
-      in[i] = true;
-      first.push_back(static_cast<std::uint32_t>(i));
-    }
-  for (int ring = 0; ring < rings; ++ring) {
-    std::vector<bool> next = in;
-    for (std::size_t i = 0; i < n; ++i)
-      if (in[i])
-        for (const std::uint32_t j : model.neighbours(i)) next[j] = true;
-    in = std::move(next);
-  }
-  for (std::size_t i = 0; i < n; ++i)
-    if (in[i])
-      for (const std::uint32_t j : model.neighbours(i))
-        if (!in[j]) border[j] = true;
-}
-
-// The robots of one local repair try: the patch planned again (a stuck robot's fold alpha drawn
-// within fold_spread of its start from the second try on), the border following its paths of
-// `best` (scripted), everyone else standing at its start.
-std::vector<StepperRobot> repair_robots(const CollisionModel& model, const std::vector<StepperRobot>& robots,
-                                        const StepperResult& best, const std::vector<bool>& in,
-                                        const std::vector<bool>& border, int attempt, double fold_spread,
-                                        std::uint64_t seed) {
-  const std::size_t n = robots.size();
-  std::vector<StepperRobot> sub(n);
-  std::mt19937_64 rng(seed);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (robots[i].frozen || in[i]) {
-      sub[i] = robots[i];
-      if (!robots[i].frozen && !best.reached[i] && attempt >= 1 && fold_spread > 0) {
-        const AngleLimits& l = model.robot(i).limits();
-        std::uniform_real_distribution<double> d(-fold_spread, fold_spread);
-        sub[i].goal.alpha_deg = std::clamp(robots[i].start.alpha_deg + d(rng), l.alpha_min_deg, l.alpha_max_deg);
-      }
-    } else if (border[i]) {
-      sub[i] = {robots[i].start, robots[i].goal, false, &best.paths[i]};
-    } else {
-      sub[i] = {robots[i].start, robots[i].start, true};
-    }
-  }
-  return sub;
-}
-
-// Local repair of a half: the stuck robots and their neighbourhood planned again with new seeds
-// (repair_patch, repair_robots). A run replaces the patch's paths in `best` when it is clean (no
-// scripted robot run into) and leaves fewer of the patch stuck.
-void repair_locally(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperResult& best,
-                    StepperOptions so, const PlannerOptions& o, std::size_t& runs) {
-  const std::size_t n = robots.size();
-  auto stuck_in = [&](const StepperResult& r, const std::vector<bool>& in) {
-    std::size_t c = 0;
-    for (std::size_t i = 0; i < n; ++i) c += (in[i] && !r.reached[i]) ? 1 : 0;
-    return c;
-  };
-  std::vector<bool> in, border;
-  for (int k = 0; k < o.local_retries && count_unreached(best) > 0; ++k) {
-    // Recomputed every try: the patch grows when a repair leaves robots stuck elsewhere.
-    repair_patch(model, best, o.local_rings, in, border, so.first);
-    const std::vector<StepperRobot> sub = repair_robots(model, robots, best, in, border, k, o.fold_spread_deg, so.seed);
-    so.seed = next_seed(so.seed);
-    StepperResult r = drive_to_goals(model, sub, so);
-    ++runs;
-    best.escapes += r.escapes;
-    if (r.violations > 0 || stuck_in(r, in) >= stuck_in(best, in)) continue;
-    double duration = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (in[i] && !robots[i].frozen) {
-        robots[i].goal = sub[i].goal;
-        best.paths[i] = std::move(r.paths[i]);
-        best.end[i] = r.end[i];
-        best.reached[i] = r.reached[i];
-        best.blockers[i] = std::move(r.blockers[i]);
-      }
-      duration = std::max({duration, best.paths[i].alpha.back().t_s, best.paths[i].beta.back().t_s});
-    }
-    best.duration_s = duration;
-  }
-}
-
-// One half, re-run while robots get stuck (half_retries): each re-run puts the robots stuck so far
-// in front (they step first, the others yield) with a new seed; from the relax_after-th on, a
-// stuck robot also stops turning alpha in this half (goal alpha = start alpha: a pure beta fold).
-// The run with the fewest stuck (then the shortest) is kept, and `robots` gets its goals; then
-// local repairs (local_retries) and the untangle for the robots still stuck.
-StepperResult drive_half(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperOptions so,
-                         const PlannerOptions& o, std::size_t& runs) {
-  StepperResult best = drive_to_goals(model, robots, so);
-  ++runs;
-  std::vector<StepperRobot> best_robots = robots;
-  std::vector<bool> listed(robots.size(), false);
-  for (int k = 0; k < o.half_retries && count_unreached(best) > 0; ++k) {
-    for (std::size_t i = 0; i < robots.size(); ++i) {
-      if (best.reached[i]) continue;
-      if (!listed[i]) {
-        listed[i] = true;
-        so.first.push_back(static_cast<std::uint32_t>(i));
-      }
-      if (k >= o.relax_after) robots[i].goal.alpha_deg = robots[i].start.alpha_deg;
-    }
-    so.seed = next_seed(so.seed);
-    StepperResult r = drive_to_goals(model, robots, so);
-    ++runs;
-    const std::size_t a = count_unreached(r), b = count_unreached(best);
-    if (a < b || (a == b && r.duration_s < best.duration_s)) {
-      best = std::move(r);
-      best_robots = robots;
-    }
-  }
-  robots = std::move(best_robots);
-  if (o.local_retries > 0 && count_unreached(best) > 0) {
-    so.seed ^= 0x9e3779b97f4a7c15ULL;  // the local repairs draw from a seed of their own
-    repair_locally(model, robots, best, so, o, runs);
-  }
-  if (o.untangle && count_unreached(best) > 0) untangle_to_fold(model, robots, best, so);
-  return best;
 }
 
 // Where robots stand still (frozen or held) and aim while the problem is prepared.
@@ -512,18 +378,18 @@ void run_halves(const Context& ctx, const Work& w, Folds& f, int round, Search& 
   const auto t0 = Clock::now();
   std::size_t runs_a = 0, runs_b = 0;
   if (o.parallel) {
-    std::thread worker([&] { s.a = detail::drive_half(ctx.model, f.a, sa, o, runs_a); });
-    s.b = detail::drive_half(ctx.model, f.b, sb, o, runs_b);
+    std::thread worker([&] { s.a = half::drive_half(ctx.model, f.a, sa, o, runs_a); });
+    s.b = half::drive_half(ctx.model, f.b, sb, o, runs_b);
     worker.join();
   } else {
-    s.a = detail::drive_half(ctx.model, f.a, sa, o, runs_a);
-    s.b = detail::drive_half(ctx.model, f.b, sb, o, runs_b);
+    s.a = half::drive_half(ctx.model, f.a, sa, o, runs_a);
+    s.b = half::drive_half(ctx.model, f.b, sb, o, runs_b);
   }
   // Folds B gave up: one more A run turns those robots to the target alpha, so that they need no
   // middle phase (unless A gives the turn up too: then A's fold is relaxed as well).
   if (detail::move_given_up_folds(ctx, w, f)) {
     sa.seed += kExtraASeedStep;
-    s.a = detail::drive_half(ctx.model, f.a, sa, o, runs_a);
+    s.a = half::drive_half(ctx.model, f.a, sa, o, runs_a);
     for (std::size_t i = 0; i < ctx.size(); ++i)
       if (!w.still[i] && f.a[i].goal.alpha_deg == ctx.request.current[i].alpha_deg &&
           f.b[i].goal.alpha_deg != f.a[i].goal.alpha_deg)

@@ -53,6 +53,11 @@ struct PlannerOptions {
   int relax_after = 8;            // from this retry on, stuck robots fold without turning alpha (8: never)
   int local_retries = 24;         // then re-plans of only the stuck robots' neighbourhood (new seeds)
   int local_rings = 2;            // neighbour rings around the stuck robots re-planned with them
+  int tail_retries = 32;          // then re-plans of the last robots' neighbourhood (new seeds), kept when they arrive earlier
+  int tail_tries_per_cluster = 12; // tries in a row that bring nothing end them
+  double tail_quantile = 0.9;     // late: arriving more than tail_slack_s after this quantile of the arrivals
+  double tail_slack_s = 3.0;
+  int tail_rings = 1;             // neighbour rings around the late robots re-planned with them
   double fold_spread_deg = 90;    // local re-plans: a stuck robot's fold alpha drawn within this of its start
   double stop_avoid_deg = 0;      // engine escapes keep away from the alpha stops while unfolded (0: off)
   double fold_stop_gap_deg = 0;   // fold alphas kept this far from the alpha stops (0: off)

@@ -1,0 +1,45 @@
+// One half of a plan (A: from the current poses to the folds; B: from the targets to the folds) as
+// engine runs: the first run, re-runs while robots get stuck, local repairs of the stuck robots'
+// neighbourhood, the untangle, and the tail (the neighbourhood of the robots that arrive last
+// planned again until they arrive earlier). Every step keeps a run only when no scripted robot was
+// run into, so what drive_half returns is as certified as a single engine run.
+#pragma once
+
+#include "axon/fps/plan/collision.hpp"
+#include "axon/fps/plan/planner.hpp"
+#include "axon/fps/plan/stepper.hpp"
+
+#include <cstddef>
+#include <vector>
+
+namespace axon::fps::plan::half {
+
+// The half: re-run while robots get stuck (options.half_retries; those stuck so far step first,
+// from relax_after on they keep their start alpha), the run with the fewest stuck (then the
+// shortest) kept and `robots` given its goals; then repair_locally, the untangle (options.untangle)
+// and shorten_tail. `runs` counts the engine runs.
+StepperResult drive_half(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperOptions so,
+                         const PlannerOptions& o, std::size_t& runs);
+
+// The stuck robots and options.local_rings rings of neighbours planned again with new seeds (the
+// ring around them follows its paths of `best`, scripted); a run replaces the patch's paths in
+// `best` when it is clean and leaves fewer of the patch stuck. options.local_retries runs at most.
+void repair_locally(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperResult& best,
+                    StepperOptions so, const PlannerOptions& o, std::size_t& runs);
+
+// The robots that arrive late in `best`: more than options.tail_slack_s after the
+// options.tail_quantile of the moving robots' arrivals, and more than tail_slack_s after their own
+// straight move would (a re-plan cannot bring them in before that). Robots left short are not late.
+std::vector<bool> late_robots(const std::vector<StepperRobot>& robots, const StepperResult& best,
+                              const PlannerOptions& o, const StepperOptions& so);
+
+// The tail: the late robots around the last one and options.tail_rings rings of neighbours planned
+// again (late robots first, a new seed per try; every other try they turn less alpha here, leaving
+// the rest to the middle phase, and must then win more than the middle can lose). A try is kept
+// when it is clean, leaves no more of the patch short and the patch's last arrival comes at least
+// half a step earlier. Ends when nobody is late, after options.tail_tries_per_cluster fruitless
+// tries in a row, or after options.tail_retries runs.
+void shorten_tail(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperResult& best,
+                  StepperOptions so, const PlannerOptions& o, std::size_t& runs);
+
+}  // namespace axon::fps::plan::half
