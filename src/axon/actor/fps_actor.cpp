@@ -1,4 +1,5 @@
 #include "axon/actor/fps_actor.hpp"
+#include "axon/core/clock.hpp"
 #include "axon/actor/schemas.hpp"
 #include "axon/fps/plan/arm_name.hpp"
 
@@ -31,8 +32,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using json = nlohmann::json;
-
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 std::optional<double> number(const std::string& s) {
   double v = 0;
@@ -152,7 +151,7 @@ struct FpsActor::Impl {
   }
 
   static json progress_json(const Move& m) {
-    return json{{"command_id", m.command->id().command_id}, {"robots", m.robots}, {"elapsed_s", seconds_since(m.started)}};
+    return json{{"command_id", m.command->id().command_id}, {"robots", m.robots}, {"elapsed_s", core::seconds_since(m.started)}};
   }
 
   // What a command does with the buses, told to FpsActorOptions::on_bus_use for as long as the

@@ -15,6 +15,8 @@ using WallTime = std::chrono::nanoseconds;
 
 // The process's monotonic time (std::chrono::steady_clock), for code that measures without a Clock.
 inline TimePoint steady_now() noexcept { return std::chrono::steady_clock::now(); }
+// Seconds of the monotonic clock since `t0`.
+inline double seconds_since(TimePoint t0) noexcept { return std::chrono::duration<double>(steady_now() - t0).count(); }
 
 class Clock {
  public:

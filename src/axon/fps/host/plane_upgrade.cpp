@@ -1,4 +1,5 @@
 #include "axon/fps/host/plane_upgrade.hpp"
+#include "axon/core/clock.hpp"
 
 #include "axon/core/wakeup.hpp"
 #include "axon/fps/host/array.hpp"
@@ -82,8 +83,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using Versions = std::map<std::uint16_t, Result<FirmwareVersion>>;
-
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 std::string describe(const Result<FirmwareVersion>& v) {
   if (!v) return v.error().message();
@@ -187,7 +186,7 @@ asio::awaitable<void> upgrade_sextant(Run& run, int sextant, std::vector<std::ui
   prog.total = ids.size();
   auto finish = [&] {
     prog.finished = true;
-    prog.seconds = seconds_since(started);
+    prog.seconds = core::seconds_since(started);
     prog.done = 0;
     prog.failed = 0;
     for (auto id : ids) {
@@ -283,7 +282,7 @@ asio::awaitable<void> upgrade_sextant(Run& run, int sextant, std::vector<std::ui
         now.bytes += bytes_of(n, size);
         now.done += n == p.chunks_total ? 1 : 0;
       }
-      now.seconds = seconds_since(started);
+      now.seconds = core::seconds_since(started);
       o.progress(now);
     };
     for (auto id : pending) ++run.robot(id).attempts;

@@ -1,4 +1,5 @@
 #include "axon/fps/host/troubleshoot.hpp"
+#include "axon/core/clock.hpp"
 #include "axon/fps/plan/arm_name.hpp"
 
 #include "axon/fps/host/concurrent.hpp"
@@ -28,10 +29,6 @@ char arm_letter(Arm a) noexcept { return a == Arm::alpha ? 'a' : 'b'; }
 
 std::string now_utc() {
   return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", std::chrono::floor<std::chrono::seconds>(std::chrono::system_clock::now()));
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 double median(std::vector<double> v) {
@@ -235,7 +232,7 @@ asio::awaitable<FrictionFinding> measure_arm(Array& array, const plan::Collision
       point.eta_s += m.value();
     }
     if (!f.problem.empty()) break;
-    point.move_s = seconds_since(t0);
+    point.move_s = core::seconds_since(t0);
     point.readings = static_cast<int>(currents.size());
     if (currents.empty()) continue;
     point.current_percent = median(currents);

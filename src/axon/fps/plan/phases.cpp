@@ -1,4 +1,5 @@
 #include "axon/fps/plan/phases.hpp"
+#include "axon/core/clock.hpp"
 
 #include "axon/fps/plan/half.hpp"
 #include "axon/fps/plan/smooth.hpp"
@@ -18,7 +19,6 @@
 namespace axon::fps::plan::phases::detail {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 bool finite(Pose p) { return std::isfinite(p.alpha_deg) && std::isfinite(p.beta_deg); }
 
@@ -251,7 +251,6 @@ bool simplify_robot(const PlannerOptions& o, const RobotTrajectory& base, RobotT
 namespace axon::fps::plan::phases {
 
 using detail::Clock;
-using detail::seconds_since;
 
 double Context::fold_beta(std::size_t i) const {
   const AngleLimits& l = model.robot(i).limits();
@@ -395,7 +394,7 @@ void run_halves(const Context& ctx, const Work& w, Folds& f, int round, Search& 
           f.b[i].goal.alpha_deg != f.a[i].goal.alpha_deg)
         f.relax_a[i] = true;
   }
-  s.search_s += seconds_since(t0);
+  s.search_s += core::seconds_since(t0);
 }
 
 bool take_stuck_robots(const Context& ctx, Work& w, const Search& s) {
@@ -428,7 +427,7 @@ bool run_middle(const Context& ctx, Work& w, Folds& f, int round, Search& s) {
   sm.seed = detail::run_seed(ctx.options.seed, kMiddleSeed, round);
   const auto t0 = Clock::now();
   s.middle = drive_to_goals(ctx.model, fm, sm);
-  s.search_s += seconds_since(t0);
+  s.search_s += core::seconds_since(t0);
   bool changed = false;
   for (std::size_t i = 0; i < ctx.size(); ++i)
     if (!s.middle.reached[i]) {
@@ -455,7 +454,7 @@ Result<void> search_rounds(const Context& ctx, Work& w, Search& s) {
       return make_error(PlanErrc::robot_collision,
                         fmt::format("planner did not settle after {} rounds: robots keep blocking each other", max_rounds));
     settle_targets(ctx, w);
-    w.plan.stats.setup_s = seconds_since(ctx.started);
+    w.plan.stats.setup_s = core::seconds_since(ctx.started);
   }
 }
 
@@ -477,7 +476,7 @@ Finish finish_parked(const Context& ctx, Work& w, Search& s) {
     sc.seed = ctx.options.seed * 2 + kFinishSeed + static_cast<std::uint64_t>(pass);
     const auto t0 = Clock::now();
     fin.run = drive_to_goals(ctx.model, fc, sc);
-    s.search_s += seconds_since(t0);
+    s.search_s += core::seconds_since(t0);
     w.plan.stats.escapes += fin.run.escapes;
     bool dropped = false;
     for (std::size_t i = 0; i < n; ++i)
@@ -530,7 +529,7 @@ Layers smooth_and_simplify(const Context& ctx, Work& w) {
     sm.min_clearance_mm = o.smooth_clearance_mm;
     const auto t0 = Clock::now();
     smooth_arms(ctx.model, L.plans.front(), sm, L.smoothed);
-    w.plan.stats.smooth_s = seconds_since(t0);
+    w.plan.stats.smooth_s = core::seconds_since(t0);
     if (detail::any_of(L.smoothed)) L.plans.push_back(L.plans.front());
   }
   L.plans.push_back(w.plan.trajectories);  // exact
@@ -559,7 +558,7 @@ Result<void> verify_layers(const Context& ctx, Work& w, Layers& layers) {
     layers.simplified[i] = layers.simplified[i] && layers.level[i] == 0;
     layers.smoothed[i] = layers.smoothed[i] && layers.level[i] < exact_level;
   }
-  w.plan.stats.check_s = seconds_since(t0);
+  w.plan.stats.check_s = core::seconds_since(t0);
   return ok();
 }
 
