@@ -20,7 +20,10 @@ cmake --build "$work/examples" -j "$(nproc)" >"$work/build.log" || { tail -50 "$
 count=$(ctest --test-dir "$work/examples" -N | sed -n 's/^Total Tests: //p')
 echo "examples built against the installed package: $count"
 [ "$count" -ge 1 ]
-ctest --test-dir "$work/examples" --output-on-failure -j 2
+# One at a time: the c4g example keeps the manual's 500 us reply window, and beside another example
+# and a neighbouring test it missed it ten times in a row (example.c4g_control_law, "10 late",
+# when the suite's unit and integration tests were run as two ctest passes here).
+ctest --test-dir "$work/examples" --output-on-failure -j 1
 
 # A component that does not exist is refused by name.
 mkdir -p "$work/bad"
