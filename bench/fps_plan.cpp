@@ -24,6 +24,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -130,6 +131,7 @@ struct Outcome {
   bool from_lattice = false;
   bool solved = false;
   double plan_s = 0, search_s = 0, check_s = 0, move_s = 0, min_clearance_mm = 0;
+  double bound_s = 0;  // the slowest reached robot's straight move at full speed: no plan is shorter
   std::size_t median_points = 0, max_points = 0;
 };
 
@@ -153,6 +155,18 @@ std::string why_not(const CollisionModel& model, const Plan& p, const std::vecto
     out += ids.size() > kShown ? fmt::format(" and {} more)", ids.size() - kShown) : std::string(")");
   }
   return out;
+}
+
+// The move no plan can beat: the robot whose straight move from its start to its target, each arm
+// at full speed, takes longest (robots that end at their target only).
+double straight_bound(const PlanRequest& req, const Plan& p, const SpeedLimits& v) {
+  double t = 0;
+  for (std::size_t i = 0; i < p.robots.size(); ++i) {
+    if (p.robots[i].status != RobotPlan::Status::reached) continue;
+    t = std::max({t, std::abs(req.target[i].alpha_deg - req.current[i].alpha_deg) / v.alpha_deg_s,
+                  std::abs(req.target[i].beta_deg - req.current[i].beta_deg) / v.beta_deg_s});
+  }
+  return t;
 }
 
 // Plans one problem and prints its row; nullopt when it could not be set up (bad file, error).
@@ -179,10 +193,11 @@ std::optional<Outcome> run_problem(const CollisionModel& model, const Problem& p
   const Plan& p = r.value();
   const auto& parked = to.value().parked;
   Outcome o{pb.from == "folded", p.ok() && p.verified && parked.empty(), p.stats.plan_s, p.stats.search_s, p.stats.check_s,
-            p.stats.duration_s, p.check.min_clearance_mm, p.stats.median_points, p.stats.max_points};
-  fmt::print("{:>3} {:>6} {:>8.3f} {:>8.3f} {:>8.3f} {:>5} {:>5} {:>7.1f} {:>8.3f} {:>5} {:>6} {:>6}  {}\n", k,
+            p.stats.duration_s, p.check.min_clearance_mm, straight_bound(req, p, options.speed), p.stats.median_points,
+            p.stats.max_points};
+  fmt::print("{:>3} {:>6} {:>8.3f} {:>8.3f} {:>8.3f} {:>5} {:>5} {:>7.1f} {:>7.1f} {:>8.3f} {:>5} {:>6} {:>6}  {}\n", k,
              o.solved ? "yes" : "no", o.plan_s, o.search_s, o.check_s, o.median_points, o.max_points, o.move_s,
-             o.min_clearance_mm, p.stats.rounds, p.stats.escapes, p.not_reached + parked.size(), name);
+             o.bound_s, o.min_clearance_mm, p.stats.rounds, p.stats.escapes, p.not_reached + parked.size(), name);
   if (p.not_reached || !parked.empty()) fmt::print("      not solved:{}\n", why_not(model, p, parked));
   if (!p.verified) fmt::print("      NOT verified: {} pairs in contact\n", p.check.collided_pairs);
   std::fflush(stdout);
@@ -191,7 +206,7 @@ std::optional<Outcome> run_problem(const CollisionModel& model, const Problem& p
 
 void print_summary(const std::vector<Outcome>& done, std::size_t asked) {
   std::size_t solved = 0, max_points = 0;
-  std::vector<double> plan, search, check, points, moves, lattice_moves, random_moves;
+  std::vector<double> plan, search, check, points, moves, lattice_moves, random_moves, bounds, over_bound;
   double min_clearance = 1e300;
   for (const Outcome& o : done) {
     solved += o.solved ? 1 : 0;
@@ -200,6 +215,8 @@ void print_summary(const std::vector<Outcome>& done, std::size_t asked) {
     check.push_back(o.check_s);
     points.push_back(static_cast<double>(o.median_points));
     moves.push_back(o.move_s);
+    bounds.push_back(o.bound_s);
+    if (o.bound_s > 0) over_bound.push_back(o.move_s / o.bound_s);
     (o.from_lattice ? lattice_moves : random_moves).push_back(o.move_s);
     max_points = std::max(max_points, o.max_points);
     min_clearance = std::min(min_clearance, o.min_clearance_mm);
@@ -218,14 +235,17 @@ void print_summary(const std::vector<Outcome>& done, std::size_t asked) {
              met(max_points <= kGoalMaxPoints));
   fmt::print("{:<34} {:>10.1f} {:>10.0f} {:>10.0f}  {}\n", "median move, s", median(moves), kGoalMoveS, kRefMoveS,
              met(median(moves) <= kGoalMoveS));
+  fmt::print("{:<34} {:>10.1f}\n", "  straight-move bound, median, s", median(bounds));
+  fmt::print("{:<34} {:>10.2f}\n", "  move / bound, median", median(over_bound));
   if (ratio > 0)
     fmt::print("{:<34} {:>10.2f} {:>10.1f} {:>10}  {}\n", "median move random / lattice starts", ratio, kGoalRandomRatio,
                "", met(ratio <= kGoalRandomRatio));
   fmt::print("BENCH fps_plan problems={} solved={} success={:.2f} median_s={:.3f} median_search_s={:.3f} "
              "median_check_s={:.3f} median_points={} max_points={} move_s={:.1f} move_lattice_s={:.1f} "
-             "move_random_s={:.1f} random_ratio={:.2f} min_clearance_mm={:.4f} ref_median_s={} ref_move_s={} ratio={:.1f}\n",
+             "move_random_s={:.1f} random_ratio={:.2f} bound_s={:.1f} move_over_bound={:.2f} min_clearance_mm={:.4f} "
+             "ref_median_s={} ref_move_s={} ratio={:.1f}\n",
              asked, solved, success, median(plan), median(search), median(check), median(points), max_points,
-             median(moves), median(lattice_moves), median(random_moves), ratio, done.empty() ? 0.0 : min_clearance,
+             median(moves), median(lattice_moves), median(random_moves), ratio, median(bounds), median(over_bound), done.empty() ? 0.0 : min_clearance,
              kRefMedianS, kRefMoveS, median(plan) > 0 ? kRefMedianS / median(plan) : 0.0);
 }
 
@@ -251,8 +271,8 @@ int main(int argc, char** argv) {
   fmt::print("fps_plan: layout {}: {} robots, {} fiducials, {} obstacles, {} neighbour pairs; speed {} / {} deg/s, step {} deg\n",
              plane.value().name(), m.size(), plane.value().fiducials().size(), m.obstacles().size(), m.robot_pairs().size(),
              a.options.speed.alpha_deg_s, a.options.speed.beta_deg_s, a.options.step_deg);
-  fmt::print("{:>3} {:>6} {:>8} {:>8} {:>8} {:>5} {:>5} {:>7} {:>8} {:>5} {:>6} {:>6}  {}\n", "#", "solved", "plan_s",
-             "engine_s", "check_s", "p_med", "p_max", "move_s", "min_clr", "rounds", "escape", "unsolv", "problem");
+  fmt::print("{:>3} {:>6} {:>8} {:>8} {:>8} {:>5} {:>5} {:>7} {:>7} {:>8} {:>5} {:>6} {:>6}  {}\n", "#", "solved", "plan_s",
+             "engine_s", "check_s", "p_med", "p_max", "move_s", "bound_s", "min_clr", "rounds", "escape", "unsolv", "problem");
   std::vector<Outcome> done;
   for (std::size_t k = 0; k < a.problems.size(); ++k)
     if (auto o = run_problem(m, a.problems[k], k, a)) done.push_back(*o);
