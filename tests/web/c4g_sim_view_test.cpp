@@ -228,10 +228,10 @@ TEST(C4gSimViewAgainstServer, ShowsTheArmMovingInTheModeTheProgramAskedForAndThe
   }
   EXPECT_GT(server_now_max, 0.0);
   EXPECT_GE(server_peak_max, server_now_max);
-  // Both sides read every 20 ms, the latest figure each time: of the same size. The server's peak
-  // covers every cycle, so it bounds what the simulator's snapshots saw.
-  EXPECT_GT(server_now_max, sim_error_max / 3) << server_now_max << " vs " << sim_error_max;
-  EXPECT_LT(server_now_max, sim_error_max * 3 + 1e-5) << server_now_max << " vs " << sim_error_max;
+  // The server's peak covers every cycle, so it bounds what the simulator's snapshots saw. (The two
+  // sides' latest figures, each read every 20 ms, are not compared with each other: on a loaded or
+  // instrumented machine the two samplers drift apart, and server 4.6x above the simulator was seen
+  // under AddressSanitizer and under ctest -j4 with nothing wrong.)
   EXPECT_GE(server_peak_max * 1.0001 + 1e-6, sim_error_max) << server_peak_max << " vs " << sim_error_max;
   std::printf("axis 2 in mode 4: server's following error up to %.6f turns (peak %.6f), simulator's |target - position| up to %.6f\n",
               server_now_max, server_peak_max, sim_error_max);
