@@ -163,8 +163,7 @@ double straight_bound(const PlanRequest& req, const Plan& p, const SpeedLimits& 
   double t = 0;
   for (std::size_t i = 0; i < p.robots.size(); ++i) {
     if (p.robots[i].status != RobotPlan::Status::reached) continue;
-    t = std::max({t, std::abs(req.target[i].alpha_deg - req.current[i].alpha_deg) / v.alpha_deg_s,
-                  std::abs(req.target[i].beta_deg - req.current[i].beta_deg) / v.beta_deg_s});
+    t = std::max(t, straight_move_s(req.current[i], req.target[i], v));
   }
   return t;
 }

@@ -64,15 +64,14 @@ TEST(PlanHalf, LateRobotsArriveWellAfterTheOthersAndCouldArriveEarlier) {
   StepperResult best = arriving(row.robots, arrive);
   best.reached[12] = false;
   const PlannerOptions o;
-  const StepperOptions so;
-  const std::vector<bool> late = half::late_robots(row.robots, best, o, so);
+  const std::vector<bool> late = half::late_robots(row.robots, best, o);
   for (std::size_t i = 0; i < late.size(); ++i) EXPECT_EQ(late[i], i == 10) << "robot " << i;
 
   // Nobody is late when everyone arrives together, and when nobody moves.
-  const std::vector<bool> together = half::late_robots(row.robots, arriving(row.robots, std::vector<double>(30, 5.0)), o, so);
+  const std::vector<bool> together = half::late_robots(row.robots, arriving(row.robots, std::vector<double>(30, 5.0)), o);
   EXPECT_EQ(std::count(together.begin(), together.end(), true), 0);
   const Row still(std::vector<double>(3, 0.0));
-  const std::vector<bool> nobody = half::late_robots(still.robots, arriving(still.robots, {0, 0, 0}), o, so);
+  const std::vector<bool> nobody = half::late_robots(still.robots, arriving(still.robots, {0, 0, 0}), o);
   EXPECT_EQ(std::count(nobody.begin(), nobody.end(), true), 0);
 }
 
@@ -125,7 +124,7 @@ TEST(PlanHalf, TheTailNeverLengthensAHalfNorLeavesMoreShortAndStaysContactFree) 
     std::vector<StepperRobot> robots_off = f.a, robots_on = f.a;
     std::size_t runs = 0;
     const StepperResult a = half::drive_half(model, robots_off, so, off, runs);
-    const std::vector<bool> late = half::late_robots(robots_off, a, on, so);
+    const std::vector<bool> late = half::late_robots(robots_off, a, on);
     if (std::count(late.begin(), late.end(), true) == 0) continue;
     ++late_seen;
     const StepperResult b = half::drive_half(model, robots_on, so, on, runs);

@@ -142,8 +142,7 @@ void repair_locally(const CollisionModel& model, std::vector<StepperRobot>& robo
   }
 }
 
-std::vector<bool> late_robots(const std::vector<StepperRobot>& robots, const StepperResult& best, const PlannerOptions& o,
-                              const StepperOptions& so) {
+std::vector<bool> late_robots(const std::vector<StepperRobot>& robots, const StepperResult& best, const PlannerOptions& o) {
   std::vector<double> times;
   for (std::size_t i = 0; i < robots.size(); ++i)
     if (!robots[i].frozen && robots[i].start != robots[i].goal) times.push_back(arrival(best.paths[i]));
@@ -155,10 +154,7 @@ std::vector<bool> late_robots(const std::vector<StepperRobot>& robots, const Ste
   for (std::size_t i = 0; i < robots.size(); ++i) {
     if (robots[i].frozen || !best.reached[i]) continue;
     // No re-plan brings a robot in before its own straight move would.
-    const Pose& a = robots[i].start;
-    const Pose& g = robots[i].goal;
-    const double own = so.dt_s * std::max(std::abs(g.alpha_deg - a.alpha_deg) / so.alpha_step_deg,
-                                          std::abs(g.beta_deg - a.beta_deg) / so.beta_step_deg);
+    const double own = straight_move_s(robots[i].start, robots[i].goal, o.speed);
     const double t = arrival(best.paths[i]);
     late[i] = t > limit && t > own + o.tail_slack_s;
   }
@@ -177,7 +173,7 @@ void shorten_tail(const CollisionModel& model, std::vector<StepperRobot>& robots
   };
   int fruitless = 0;
   for (int k = 0; k < o.tail_retries && fruitless < o.tail_tries_per_cluster; ++k) {
-    const std::vector<bool> late = late_robots(robots, best, o, so);
+    const std::vector<bool> late = late_robots(robots, best, o);
     std::size_t last = n;
     for (std::size_t i = 0; i < n; ++i)
       if (late[i] && (last == n || arrival(best.paths[i]) > arrival(best.paths[last]))) last = i;
@@ -239,12 +235,12 @@ StepperResult drive_half(const CollisionModel& model, std::vector<StepperRobot>&
   }
   robots = std::move(best_robots);
   if (o.local_retries > 0 && count_unreached(best) > 0) {
-    so.seed ^= 0x9e3779b97f4a7c15ULL;  // the local repairs draw from a seed of their own
+    so.seed ^= kLocalRepairSeedSalt;
     repair_locally(model, robots, best, so, o, runs);
   }
   if (o.untangle && count_unreached(best) > 0) untangle_to_fold(model, robots, best, so);
   if (o.tail_retries > 0) {
-    so.seed ^= 0x7f4a7c159e3779b9ULL;  // and the tail's of its own
+    so.seed ^= kTailSeedSalt;
     shorten_tail(model, robots, best, so, o, runs);
   }
   return best;

@@ -10,9 +10,14 @@
 #include "axon/fps/plan/stepper.hpp"
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace axon::fps::plan::half {
+
+// The local repairs and the tail draw from seeds of their own: the half's seed with these mixed in.
+inline constexpr std::uint64_t kLocalRepairSeedSalt = 0x9e3779b97f4a7c15ULL;
+inline constexpr std::uint64_t kTailSeedSalt = 0x7f4a7c159e3779b9ULL;
 
 // The half: re-run while robots get stuck (options.half_retries; those stuck so far step first,
 // from relax_after on they keep their start alpha), the run with the fewest stuck (then the
@@ -31,7 +36,7 @@ void repair_locally(const CollisionModel& model, std::vector<StepperRobot>& robo
 // options.tail_quantile of the moving robots' arrivals, and more than tail_slack_s after their own
 // straight move would (a re-plan cannot bring them in before that). Robots left short are not late.
 std::vector<bool> late_robots(const std::vector<StepperRobot>& robots, const StepperResult& best,
-                              const PlannerOptions& o, const StepperOptions& so);
+                              const PlannerOptions& o);
 
 // The tail: the late robots around the last one and options.tail_rings rings of neighbours planned
 // again (late robots first, a new seed per try; every other try they turn less alpha here, leaving

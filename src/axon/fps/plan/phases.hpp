@@ -34,6 +34,7 @@ inline constexpr std::uint64_t kMiddleSeed = 77;         // the middle phase run
 inline constexpr std::uint64_t kFinishSeed = 99;         // finish pass k runs on 2s+99+k
 inline constexpr std::uint64_t kRoundSeedStride = 7919;  // each search round adds this prime to A, B and middle seeds
 inline constexpr std::uint64_t kExtraASeedStep = 104729; // the extra A run (folds B gave up) adds this prime to A's seed
+// (within a half, the local repairs and the tail mix half::kLocalRepairSeedSalt and kTailSeedSalt in)
 
 // Guards of the loops.
 inline constexpr std::size_t kSettleChangesPerRobot = 4;  // settle_targets: at most 4n+4 contacts resolved (a robot ...

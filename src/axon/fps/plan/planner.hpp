@@ -19,6 +19,8 @@
 #include "axon/fps/plan/safe_zone.hpp"
 #include "axon/fps/plan/trajectory.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -39,6 +41,12 @@ struct SpeedLimits {
     return {deg_s, deg_s};
   }
 };
+
+// The time of the straight move from `a` to `b`, each arm at full speed (the slower arm sets it):
+// no plan brings a robot in earlier.
+inline double straight_move_s(const Pose& a, const Pose& b, const SpeedLimits& v) noexcept {
+  return std::max(std::abs(b.alpha_deg - a.alpha_deg) / v.alpha_deg_s, std::abs(b.beta_deg - a.beta_deg) / v.beta_deg_s);
+}
 
 struct PlannerOptions {
   SpeedLimits speed{};
