@@ -11,10 +11,11 @@
 // Per problem: solved (every robot reaches its target and the checker proves the move clear at the
 // full buffer), or why not (robots parked or held, with their reasons); end-to-end planning time,
 // the engine's and the verification's shares; points per arm sent to the firmware (median, max);
-// move duration; smallest clearance (the checker's). The summary compares with issue 16's goals
-// (end-to-end <= 0.25 s median, <= 40 points per arm, median move <= 30 s, moves from random starts
-// <= 1.5x those from the lattice) and with the reference planner's recorded figures (it cannot run
-// here: ratio = its 28 s / our median).
+// move duration and how much of it the halves overlap (B started before A ended); smallest clearance
+// (the checker's). The summary compares with issue 16's goals (end-to-end <= 0.25 s median, <= 40
+// points per arm, median move <= 30 s, moves from random starts <= 1.5x those from the lattice)
+// and with the reference planner's recorded figures (it cannot run here: ratio = its 28 s / our
+// median).
 #include "axon/fps/layout/layout_name.hpp"
 #include "axon/fps/plan/layout_model.hpp"
 #include "axon/fps/plan/planner.hpp"
@@ -54,8 +55,8 @@ constexpr const char* kUsage =
     "usage: fps_plan [--layout default|benchtop|FILE|DIR] [--problem [FROM,]TO ...] [--problems N] [--seed S]\n"
     "                [--step DEG] [--speed DEG_S] [--half-retries N] [--relax-after K] [--local-retries N]\n"
     "                [--tail-retries N] [--tail-tries N] [--tail-rings R] [--tail-quantile Q] [--tail-slack S]\n"
-    "                [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--stop-avoid DEG] [--fold-stop-gap DEG]\n"
-    "                [--give-up N] [--stall S] [--smooth-points N] [--smooth-clearance MM]\n"
+    "                [--local-rings R] [--fold-spread DEG] [--untangle 0|1] [--overlap 0|1] [--stop-avoid DEG]\n"
+    "                [--fold-stop-gap DEG] [--give-up N] [--stall S] [--smooth-points N] [--smooth-clearance MM]\n"
     "  FROM, TO: folded, random or a target file (YAML/CSV); TO alone starts from folded\n";
 
 double median(std::vector<double> v) {
@@ -101,6 +102,7 @@ bool set_planner_option(PlannerOptions& o, const std::string& key, const char* v
   else if (key == "--stall") o.stall_s = std::atof(v);
   else if (key == "--give-up") o.give_up_after = std::atoi(v);
   else if (key == "--untangle") o.untangle = std::atoi(v) != 0;
+  else if (key == "--overlap") o.overlap_halves = std::atoi(v) != 0;
   else if (key == "--smooth-points") o.smooth_points = static_cast<std::size_t>(std::atoi(v));
   else if (key == "--smooth-clearance") o.smooth_clearance_mm = std::atof(v);
   else if (key == "--speed") o.speed = {std::atof(v), std::atof(v)};
@@ -194,9 +196,9 @@ std::optional<Outcome> run_problem(const CollisionModel& model, const Problem& p
   Outcome o{pb.from == "folded", p.ok() && p.verified && parked.empty(), p.stats.plan_s, p.stats.search_s, p.stats.check_s,
             p.stats.duration_s, p.check.min_clearance_mm, straight_bound(req, p, options.speed), p.stats.median_points,
             p.stats.max_points};
-  fmt::print("{:>3} {:>6} {:>8.3f} {:>8.3f} {:>8.3f} {:>5} {:>5} {:>7.1f} {:>7.1f} {:>8.3f} {:>5} {:>6} {:>6}  {}\n", k,
-             o.solved ? "yes" : "no", o.plan_s, o.search_s, o.check_s, o.median_points, o.max_points, o.move_s,
-             o.bound_s, o.min_clearance_mm, p.stats.rounds, p.stats.escapes, p.not_reached + parked.size(), name);
+  fmt::print("{:>3} {:>6} {:>8.3f} {:>8.3f} {:>8.3f} {:>5} {:>5} {:>7.1f} {:>7.1f} {:>7.1f} {:>8.3f} {:>5} {:>6} {:>6}  {}\n",
+             k, o.solved ? "yes" : "no", o.plan_s, o.search_s, o.check_s, o.median_points, o.max_points, o.move_s,
+             p.stats.overlap_s, o.bound_s, o.min_clearance_mm, p.stats.rounds, p.stats.escapes, p.not_reached + parked.size(), name);
   if (p.not_reached || !parked.empty()) fmt::print("      not solved:{}\n", why_not(model, p, parked));
   if (!p.verified) fmt::print("      NOT verified: {} pairs in contact\n", p.check.collided_pairs);
   std::fflush(stdout);
@@ -270,8 +272,9 @@ int main(int argc, char** argv) {
   fmt::print("fps_plan: layout {}: {} robots, {} fiducials, {} obstacles, {} neighbour pairs; speed {} / {} deg/s, step {} deg\n",
              plane.value().name(), m.size(), plane.value().fiducials().size(), m.obstacles().size(), m.robot_pairs().size(),
              a.options.speed.alpha_deg_s, a.options.speed.beta_deg_s, a.options.step_deg);
-  fmt::print("{:>3} {:>6} {:>8} {:>8} {:>8} {:>5} {:>5} {:>7} {:>7} {:>8} {:>5} {:>6} {:>6}  {}\n", "#", "solved", "plan_s",
-             "engine_s", "check_s", "p_med", "p_max", "move_s", "bound_s", "min_clr", "rounds", "escape", "unsolv", "problem");
+  fmt::print("{:>3} {:>6} {:>8} {:>8} {:>8} {:>5} {:>5} {:>7} {:>7} {:>7} {:>8} {:>5} {:>6} {:>6}  {}\n", "#", "solved",
+             "plan_s", "engine_s", "check_s", "p_med", "p_max", "move_s", "overlap", "bound_s", "min_clr", "rounds", "escape",
+             "unsolv", "problem");
   std::vector<Outcome> done;
   for (std::size_t k = 0; k < a.problems.size(); ++k)
     if (auto o = run_problem(m, a.problems[k], k, a)) done.push_back(*o);

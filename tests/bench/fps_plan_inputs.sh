@@ -25,8 +25,8 @@ grep -A2 -E '^  0 ' "$TMP/out" | grep -qE 'target parked: .*guide camera 2.*\(ro
   || fail "problem 0: the parked robot's reason is missing"
 for k in 1 2; do
   row=$(grep -E "^  $k " "$TMP/out") || fail "no row for problem $k"
-  # solved, plan_s engine_s check_s p_med p_max move_s bound_s min_clr: numbers
-  awk '{ for (i = 3; i <= 10; ++i) if ($i !~ /^[0-9.]+$/) exit 1 }' <<<"$row" || fail "problem $k: figures: $row"
+  # solved, plan_s engine_s check_s p_med p_max move_s overlap bound_s min_clr: numbers
+  awk '{ for (i = 3; i <= 11; ++i) if ($i !~ /^[0-9.]+$/) exit 1 }' <<<"$row" || fail "problem $k: figures: $row"
 done
 bench=$(grep '^BENCH fps_plan ' "$TMP/out") || fail "no BENCH line"
 for key in problems=3 solved= median_s= median_search_s= median_check_s= max_points= move_s= move_lattice_s= \

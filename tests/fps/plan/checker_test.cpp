@@ -434,5 +434,26 @@ TEST(PlanTrajectory, InterpolationAndCursor) {
   EXPECT_EQ(c.next_point(), std::numeric_limits<double>::infinity());
 }
 
+TEST(PlanTrajectory, EndTimeAndWindow) {
+  const RobotTrajectory t{{{0, 10}, {3, 30}, {4, 0}}, {{0, 100}, {6, 160}}};
+  EXPECT_EQ(end_time(t), 6.0);
+  EXPECT_EQ(end_time(RobotTrajectory::hold({1, 2})), 0.0);
+  // 2..5 s: the ends interpolated, the points in between kept, times from 0.
+  const RobotTrajectory w = window(t, 2, 5);
+  auto pairs = [](const std::vector<TimedAngle>& arm) {
+    std::vector<std::pair<double, double>> out;
+    for (const auto& p : arm) out.emplace_back(p.t_s, p.deg);
+    return out;
+  };
+  using P = std::vector<std::pair<double, double>>;
+  EXPECT_DOUBLE_EQ(w.alpha.front().deg, angle_at(t.alpha, 2));
+  EXPECT_EQ(pairs({w.alpha.begin() + 1, w.alpha.end()}), (P{{1, 30}, {2, 0}, {3, 0}}));
+  EXPECT_EQ(pairs(w.beta), (P{{0, 120}, {3, 150}}));
+  EXPECT_TRUE(validate(w));
+  // A window on a point keeps no duplicate time.
+  const RobotTrajectory on = window(t, 3, 4);
+  EXPECT_EQ(pairs(on.alpha), (P{{0, 30}, {1, 0}}));
+}
+
 }  // namespace
 }  // namespace axon::fps::plan

@@ -428,6 +428,89 @@ TEST(PlanPhases, JoinHalvesPlaysBBackwardsAfterAAndTheMiddle) {
   EXPECT_EQ(w2.plan.not_reached, 0u);
 }
 
+TEST(PlanPhases, OverlapStartsBAsEarlyAsEveryRobotsOwnHalvesAllow) {
+  // Two robots far apart: robot 0 is folded after 1 s of A and needs all of B's 3 s; robot 1 folds
+  // until A's end at 4 s and leaves its fold 2 s into B. B can start 2 s early (robot 1's wait);
+  // robot 0 alone would allow 3 s.
+  const auto m = build({robot_at(1, 0, 0), robot_at(2, 100, 0)});
+  PlanRequest req;
+  req.current = {{10, 100}, {20, 100}};
+  req.target = {{50, 90}, {60, 120}};
+  const PlannerOptions o{};
+  const Context ctx = make_context(m, req, o);
+  Search s;
+  s.a = standing({{10, 180}, {20, 180}});
+  s.a.paths[0].beta = {{0, 100}, {1, 180}};
+  s.a.paths[1].beta = {{0, 100}, {4, 180}};
+  s.a.duration_s = 4;
+  s.b = standing({{50, 180}, {60, 180}});
+  s.b.paths[0] = {{{0, 50}, {3, 10}}, {{0, 90}, {3, 180}}};
+  s.b.paths[1].beta = {{0, 120}, {1, 180}};
+  s.b.duration_s = 3;
+  std::size_t checks = 0;
+  double check_s = 0;
+  EXPECT_DOUBLE_EQ(overlap_shift(ctx, s, 4, 3, checks, check_s), 2.0);
+  EXPECT_EQ(checks, 1u);
+
+  Work w = prepare(ctx);
+  join_halves(ctx, w, s, Finish{{}, {false, false}, false});
+  EXPECT_DOUBLE_EQ(w.plan.stats.overlap_s, 2.0);
+  // B from 2 s on: robot 0 leaves its fold right away, robot 1 at 4 s, as it arrived.
+  EXPECT_EQ(pts(w.plan.trajectories[0].alpha), pts({{0, 10}, {2, 10}, {5, 50}}));
+  EXPECT_EQ(pts(w.plan.trajectories[1].beta), pts({{0, 100}, {4, 180}, {5, 120}}));
+
+  // Off: B starts at A's end.
+  PlannerOptions off;
+  off.overlap_halves = false;
+  const Context ctx_off = make_context(m, req, off);
+  EXPECT_EQ(overlap_shift(ctx_off, s, 4, 3, checks, check_s), 0.0);
+}
+
+TEST(PlanPhases, OverlapIsRefusedWhereARobotStillInAAndOneAlreadyInBWouldTouch) {
+  // Robot 0 waits at its start until 4 s of A, then folds; robot 1 starts folded and unfolds
+  // towards it in B over 5 s. Each half is clear; started together, robot 1 sweeps into robot 0
+  // while it still waits.
+  const CollisionModel m = test::two_robots();
+  const Pose s0{165, 0}, f0{165, 180}, f1{180, 180}, t1{180, 45};
+  ASSERT_GT(static_clearance(m, {s0, f1}), 0);
+  ASSERT_GT(static_clearance(m, {f0, t1}), 0);
+  PlanRequest req;
+  req.current = {s0, f1};
+  req.target = {f0, t1};
+  const PlannerOptions o{};
+  const Context ctx = make_context(m, req, o);
+  Search s;
+  s.a = standing({f0, f1});
+  s.a.paths[0].beta = {{0, 0}, {4, 0}, {5, 180}};
+  s.a.duration_s = 5;
+  s.b = standing({f0, f1});
+  s.b.paths[1].beta = {{0, 45}, {5, 180}};
+  s.b.duration_s = 5;
+  // The most the robots' own halves allow, 5 s, would collide: the checker says so on its own.
+  TrajectoryChecker checker(m);
+  CheckReport r;
+  const std::vector<RobotTrajectory> together{s.a.paths[0], {{{0, 180}}, {{0, 180}, {5, 45}}}};
+  ASSERT_TRUE(checker.check(together, CheckOptions{}, r));
+  ASSERT_FALSE(r.ok());
+  for (const auto* half : {&s.a.paths, &s.b.paths}) {  // each half on its own is clear
+    ASSERT_TRUE(checker.check(*half, CheckOptions{}, r));
+    ASSERT_TRUE(r.ok());
+  }
+
+  std::size_t checks = 0;
+  double check_s = 0;
+  const double shift = overlap_shift(ctx, s, 5, 5, checks, check_s);
+  EXPECT_LT(shift, 5.0);
+  EXPECT_GT(checks, 1u);
+  Work w = prepare(ctx);
+  join_halves(ctx, w, s, Finish{{}, {false, false}, false});
+  EXPECT_EQ(w.plan.stats.overlap_s, shift);
+  const auto checked = checker.check(w.plan.trajectories, CheckOptions{}, r);
+  ASSERT_TRUE(checked) << checked.error().message();
+  EXPECT_TRUE(r.ok()) << r.collided_pairs << " pairs collided";
+  EXPECT_DOUBLE_EQ(end_time(w.plan.trajectories[1]), 10.0 - shift);
+}
+
 TEST(PlanPhases, SmoothAndSimplifyBuildsTheLayersAndFitsTheFirmwareLimit) {
   const auto m = build({robot_at(1, 0, 0), robot_at(2, 100, 0)});
   PlanRequest req;

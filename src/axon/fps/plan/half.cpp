@@ -53,9 +53,6 @@ std::vector<bool> unreached(const StepperResult& r) {
   return out;
 }
 
-// When robot i's path ends (it stands at its end from then on).
-double arrival(const RobotTrajectory& t) { return std::max(t.alpha.back().t_s, t.beta.back().t_s); }
-
 // A repair's paths of the patch replace best's; best's duration follows.
 void take_patch(std::vector<StepperRobot>& robots, const std::vector<StepperRobot>& sub, const std::vector<bool>& in,
                 StepperResult& r, StepperResult& best) {
@@ -68,7 +65,7 @@ void take_patch(std::vector<StepperRobot>& robots, const std::vector<StepperRobo
       best.reached[i] = r.reached[i];
       best.blockers[i] = std::move(r.blockers[i]);
     }
-    duration = std::max(duration, arrival(best.paths[i]));
+    duration = std::max(duration, end_time(best.paths[i]));
   }
   best.duration_s = duration;
 }
@@ -145,7 +142,7 @@ void repair_locally(const CollisionModel& model, std::vector<StepperRobot>& robo
 std::vector<bool> late_robots(const std::vector<StepperRobot>& robots, const StepperResult& best, const PlannerOptions& o) {
   std::vector<double> times;
   for (std::size_t i = 0; i < robots.size(); ++i)
-    if (!robots[i].frozen && robots[i].start != robots[i].goal) times.push_back(arrival(best.paths[i]));
+    if (!robots[i].frozen && robots[i].start != robots[i].goal) times.push_back(end_time(best.paths[i]));
   std::vector<bool> late(robots.size(), false);
   if (times.empty()) return late;
   const auto at = static_cast<std::size_t>(std::clamp(o.tail_quantile, 0.0, 1.0) * static_cast<double>(times.size() - 1));
@@ -155,7 +152,7 @@ std::vector<bool> late_robots(const std::vector<StepperRobot>& robots, const Ste
     if (robots[i].frozen || !best.reached[i]) continue;
     // No re-plan brings a robot in before its own straight move would.
     const double own = straight_move_s(robots[i].start, robots[i].goal, o.speed);
-    const double t = arrival(best.paths[i]);
+    const double t = end_time(best.paths[i]);
     late[i] = t > limit && t > own + o.tail_slack_s;
   }
   return late;
@@ -168,7 +165,7 @@ void shorten_tail(const CollisionModel& model, std::vector<StepperRobot>& robots
   auto patch_end = [&](const StepperResult& r) {
     double t = 0;
     for (std::size_t i = 0; i < n; ++i)
-      if (in[i]) t = std::max(t, arrival(r.paths[i]));
+      if (in[i]) t = std::max(t, end_time(r.paths[i]));
     return t;
   };
   int fruitless = 0;
@@ -176,7 +173,7 @@ void shorten_tail(const CollisionModel& model, std::vector<StepperRobot>& robots
     const std::vector<bool> late = late_robots(robots, best, o);
     std::size_t last = n;
     for (std::size_t i = 0; i < n; ++i)
-      if (late[i] && (last == n || arrival(best.paths[i]) > arrival(best.paths[last]))) last = i;
+      if (late[i] && (last == n || end_time(best.paths[i]) > end_time(best.paths[last]))) last = i;
     if (last == n) return;
     const std::vector<bool> cluster = late_cluster(model, late, last);
     repair_patch(model, cluster, o.tail_rings, in, border, so.first);

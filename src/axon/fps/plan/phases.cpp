@@ -49,6 +49,24 @@ std::vector<TimedAngle> join(const std::vector<TimedAngle>& a, double ta, const 
   return out;
 }
 
+// Every robot's A (with the middle) and reversed B, B from `tb_start` on.
+std::vector<RobotTrajectory> joined_paths(const Search& s, double tb_start, double tb) {
+  std::vector<RobotTrajectory> out(s.a.paths.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i].alpha = join(s.a.paths[i].alpha, tb_start, s.b.paths[i].alpha, tb);
+    out[i].beta = join(s.a.paths[i].beta, tb_start, s.b.paths[i].beta, tb);
+  }
+  return out;
+}
+
+// The largest shift of reversed B before `ta` that moves no robot in B before it has arrived in A.
+double most_shift(const Search& s, double ta, double tb) {
+  double most = ta;
+  for (std::size_t i = 0; i < s.a.paths.size(); ++i)
+    most = std::min(most, ta - end_time(s.a.paths[i]) + (tb - end_time(s.b.paths[i])));
+  return std::max(0.0, most);
+}
+
 // Removes the inner points of every run of equal angles, and a last point that only repeats the
 // one before it (the arm keeps its last angle anyway).
 void drop_still_points(std::vector<TimedAngle>& pts) {
@@ -492,18 +510,42 @@ Finish finish_parked(const Context& ctx, Work& w, Search& s) {
   return fin;
 }
 
+double overlap_shift(const Context& ctx, const Search& s, double ta, double tb, std::size_t& checks, double& check_s) {
+  const double most = ctx.options.overlap_halves ? detail::most_shift(s, ta, tb) : 0.0;
+  if (most < ctx.engine.dt_s) return 0;
+  const auto t0 = Clock::now();
+  TrajectoryChecker checker(ctx.model);
+  CheckOptions check = ctx.options.check;
+  check.allow_standing_contacts = true;  // robots held where they started in contact
+  CheckReport report;
+  std::vector<RobotTrajectory> overlap(ctx.size());
+  double taken = 0;
+  for (const double part : {1.0, 0.75, 0.5, 0.25}) {
+    const double shift = most * part;
+    const std::vector<RobotTrajectory> joined = detail::joined_paths(s, ta - shift, tb);
+    for (std::size_t i = 0; i < joined.size(); ++i) overlap[i] = window(joined[i], ta - shift, ta);
+    ++checks;
+    if (checker.check(overlap, check, report) && report.ok()) {
+      taken = shift;
+      break;
+    }
+  }
+  check_s += core::seconds_since(t0);
+  return taken;
+}
+
 void join_halves(const Context& ctx, Work& w, Search& s, const Finish& fin) {
   const std::size_t n = ctx.size();
   const double ta0 = s.a.duration_s, tb = s.b.duration_s;
   const double tm = s.middle.paths.empty() ? 0.0 : s.middle.duration_s;
   if (!s.middle.paths.empty()) detail::append_middle(s);
-  const double ta = ta0 + tm;
+  const double shift = overlap_shift(ctx, s, ta0 + tm, tb, w.plan.stats.checks, w.plan.stats.check_s);
+  const double ta = ta0 + tm - shift;
   w.plan.stats.middle_s = tm;
-  w.plan.trajectories.resize(n);
+  w.plan.stats.overlap_s = shift;
+  w.plan.trajectories = detail::joined_paths(s, ta, tb);
   for (std::size_t i = 0; i < n; ++i) {
     RobotTrajectory& t = w.plan.trajectories[i];
-    t.alpha = detail::join(s.a.paths[i].alpha, ta, s.b.paths[i].alpha, tb);
-    t.beta = detail::join(s.a.paths[i].beta, ta, s.b.paths[i].beta, tb);
     if (fin.any && fin.in[i]) {
       detail::append_finish(t, fin.run.paths[i], ta + tb);
       w.plan.robots[i] = {RobotPlan::Status::reached, {}, {}, {}};
@@ -548,7 +590,7 @@ Result<void> verify_layers(const Context& ctx, Work& w, Layers& layers) {
     CheckOptions check = ctx.options.check;
     check.allow_standing_contacts = true;  // robots held where they started in contact
     AXON_TRY(checks, verify_with_fallbacks(ctx.model, layers.plans, check, w.plan.trajectories, layers.level, w.plan.check));
-    w.plan.stats.checks = checks;
+    w.plan.stats.checks += checks;
     w.plan.verified = w.plan.check.ok();
   } else {
     w.plan.trajectories = layers.plans.front();
@@ -558,7 +600,7 @@ Result<void> verify_layers(const Context& ctx, Work& w, Layers& layers) {
     layers.simplified[i] = layers.simplified[i] && layers.level[i] == 0;
     layers.smoothed[i] = layers.smoothed[i] && layers.level[i] < exact_level;
   }
-  w.plan.stats.check_s = core::seconds_since(t0);
+  w.plan.stats.check_s += core::seconds_since(t0);
   return ok();
 }
 
@@ -577,7 +619,7 @@ void collect_stats(Work& w, const Layers& layers) {
     }
     st.max_alpha_speed = std::max(st.max_alpha_speed, max_speed(t.alpha));
     st.max_beta_speed = std::max(st.max_beta_speed, max_speed(t.beta));
-    st.duration_s = std::max({st.duration_s, t.alpha.back().t_s, t.beta.back().t_s});
+    st.duration_s = std::max(st.duration_s, end_time(t));
   }
   if (!counts.empty()) {
     std::nth_element(counts.begin(), counts.begin() + static_cast<std::ptrdiff_t>(counts.size() / 2), counts.end());

@@ -141,8 +141,18 @@ struct Finish {
 };
 Finish finish_parked(const Context& ctx, Work& w, Search& s);
 
-// Per robot: A, the middle phase appended to it, B reversed, then the finish; still points
-// dropped. Fills the plan's trajectories, every robot's end, not_reached, middle_s and search_s.
+// How much earlier than at `ta` (the end of A and the middle, appended to s.a) reversed B (tb
+// long) can start. The most any robot allows: B may not move it before it has arrived in A, so
+// the smallest over the robots of the time from its A arrival to ta plus its B departure. Whether
+// robots still in A and robots already in B pass each other clear is proven by the checker on the
+// overlap window (the full buffer; before and after it the engine's certificates hold): the first
+// of that shift, 3/4, 1/2 and 1/4 of it that checks clear is taken, else 0 (and 0 when
+// options.overlap_halves is off). `checks` counts the checker runs, `check_s` their time.
+double overlap_shift(const Context& ctx, const Search& s, double ta, double tb, std::size_t& checks, double& check_s);
+
+// Per robot: A, the middle phase appended to it, B reversed (from ta minus overlap_shift on), then
+// the finish; still points dropped. Fills the plan's trajectories, every robot's end, not_reached,
+// middle_s, overlap_s and search_s.
 void join_halves(const Context& ctx, Work& w, Search& s, const Finish& fin);
 
 // The layers verify_layers falls back through, most processed first: simplified, smoothed (only

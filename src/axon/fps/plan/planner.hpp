@@ -78,6 +78,9 @@ struct PlannerOptions {
   bool verify = true;             // run the checker on the result
   CheckOptions check{};           // the checker's settings (full buffer)
   bool parallel = true;           // plan both halves on two threads
+  // B starts before A has ended, as early as every robot's own A and B allow, where the checker
+  // proves the overlap clear at the full buffer (phases::overlap_shift).
+  bool overlap_halves = true;
   // The targets' check against the robots' safe zones (spec section 11, safe_zone.hpp), reported
   // in Plan::safe_zone; it changes nothing in the plan (nullopt: not checked).
   std::optional<SafeZoneOptions> safe_zone = SafeZoneOptions{};
@@ -115,6 +118,7 @@ struct PlanStats {
   std::size_t checks = 0;        // checker runs (1 + fallback passes)
   double duration_s = 0;         // the move
   double middle_s = 0;           // of which the middle phase (folded robots turning alpha)
+  double overlap_s = 0;          // B started this much before A and the middle ended (overlap_halves)
   std::size_t rounds = 0;        // engine rounds (1 + re-plans)
   std::size_t escapes = 0;       // escape episodes (deadlock nudges)
   std::size_t simplified = 0;    // robots whose simplified trajectories were kept

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <utility>
 #include <cmath>
 
 namespace axon::fps::plan {
@@ -40,6 +41,21 @@ double angle_at(std::span<const TimedAngle> points, double t_s) noexcept {
   const auto it = std::upper_bound(points.begin(), points.end(), t_s,
                                    [](double t, const TimedAngle& p) { return t < p.t_s; });
   return lerp(*(it - 1), *it, t_s);
+}
+
+double end_time(const RobotTrajectory& t) noexcept {
+  return std::max(t.alpha.empty() ? 0.0 : t.alpha.back().t_s, t.beta.empty() ? 0.0 : t.beta.back().t_s);
+}
+
+RobotTrajectory window(const RobotTrajectory& t, double t0_s, double t1_s) {
+  RobotTrajectory out;
+  for (auto [from, to] : {std::pair{&t.alpha, &out.alpha}, std::pair{&t.beta, &out.beta}}) {
+    to->push_back({0.0, angle_at(*from, t0_s)});
+    for (const TimedAngle& p : *from)
+      if (p.t_s > t0_s && p.t_s < t1_s) to->push_back({p.t_s - t0_s, p.deg});
+    to->push_back({t1_s - t0_s, angle_at(*from, t1_s)});
+  }
+  return out;
 }
 
 double max_speed(std::span<const TimedAngle> points) noexcept {

@@ -35,6 +35,11 @@ Result<void> validate(const RobotTrajectory& t);
 
 // The angle at time t (clamped to the ends).
 double angle_at(std::span<const TimedAngle> points, double t_s) noexcept;
+// When the trajectory's last point comes (the later arm's): the robot stands at its end from then.
+double end_time(const RobotTrajectory& t) noexcept;
+// The part of `t` between t0_s and t1_s (t0_s < t1_s), times from 0: each arm's angles at both
+// ends (interpolated) and its points in between.
+RobotTrajectory window(const RobotTrajectory& t, double t0_s, double t1_s);
 // The largest |d angle / dt| of any segment, deg/s (0 for a single point).
 double max_speed(std::span<const TimedAngle> points) noexcept;
 
