@@ -511,6 +511,78 @@ TEST(PlanPhases, OverlapIsRefusedWhereARobotStillInAAndOneAlreadyInBWouldTouch) 
   EXPECT_DOUBLE_EQ(end_time(w.plan.trajectories[1]), 10.0 - shift);
 }
 
+TEST(PlanPhases, MiddleTurnsStartWhenTheRobotHasFolded) {
+  // Robot 0 is folded after 1 s of A and turns alpha 10 -> 40 in the middle phase (2.5 s); robot 1,
+  // far away, folds until A's end at 4 s. Robot 0 turns from 1 s on, and B (3 s) starts when its
+  // turn ends (3.5 s: robot 0 leaves at once in B): 6.5 s instead of 4 + 2.5 + 3.
+  const auto m = build({robot_at(1, 0, 0), robot_at(2, 100, 0)});
+  PlanRequest req;
+  req.current = {{10, 100}, {20, 100}};
+  req.target = {{50, 90}, {20, 180}};
+  const PlannerOptions o{};
+  const Context ctx = make_context(m, req, o);
+  Search s;
+  s.a = standing({{10, 180}, {20, 180}});
+  s.a.paths[0].beta = {{0, 100}, {1, 180}};
+  s.a.paths[1].beta = {{0, 100}, {4, 180}};
+  s.a.duration_s = 4;
+  s.middle = standing({{40, 180}, {20, 180}});
+  s.middle.paths[0].alpha = {{0, 10}, {2.5, 40}};
+  s.middle.duration_s = 2.5;
+  s.b = standing({{40, 180}, {20, 180}});
+  s.b.paths[0] = {{{0, 50}, {3, 40}}, {{0, 90}, {3, 180}}};
+  s.b.duration_s = 3;
+  std::size_t checks = 0;
+  double check_s = 0;
+  EXPECT_EQ(middle_starts(ctx, s, checks, check_s), (std::vector<double>{1, 4}));
+  EXPECT_EQ(checks, 1u);
+
+  Work w = prepare(ctx);
+  join_halves(ctx, w, s, Finish{{}, {false, false}, false});
+  EXPECT_EQ(pts(w.plan.trajectories[0].alpha), pts({{0, 10}, {1, 10}, {3.5, 40}, {6.5, 50}}));
+  EXPECT_DOUBLE_EQ(w.plan.stats.overlap_s, 0.5);  // robot 1 would allow 3 s, robot 0 0.5 s
+  EXPECT_EQ(w.plan.stats.middle_s, 2.5);
+
+  PlannerOptions off;
+  off.overlap_halves = false;
+  const Context ctx_off = make_context(m, req, off);
+  EXPECT_EQ(middle_starts(ctx_off, s, checks, check_s), (std::vector<double>{4, 4}));
+}
+
+TEST(PlanPhases, MiddleTurnWaitsForANeighbourStillUnfoldedInA) {
+  // Robot 0 is folded from the start and turns alpha 0 -> 120 in the middle; robot 1 stands
+  // unfolded next to it until 4 s of A, then folds. Turning at once would sweep robot 0 into it
+  // (the checker says so on its own): robot 0 turns at A's end.
+  const CollisionModel m = test::two_robots();
+  PlanRequest req;
+  req.current = {{0, 180}, {180, 45}};
+  req.target = {{120, 180}, {180, 180}};
+  const PlannerOptions o{};
+  const Context ctx = make_context(m, req, o);
+  Search s;
+  s.a = standing({{0, 180}, {180, 180}});
+  s.a.paths[1].beta = {{0, 45}, {4, 45}, {5, 180}};
+  s.a.duration_s = 5;
+  s.middle = standing({{120, 180}, {180, 180}});
+  s.middle.paths[0].alpha = {{0, 0}, {2.5, 120}};
+  s.middle.duration_s = 2.5;
+  s.b = standing({{120, 180}, {180, 180}});
+  TrajectoryChecker checker(m);
+  CheckReport r;
+  ASSERT_TRUE(checker.check(std::vector<RobotTrajectory>{s.middle.paths[0], s.a.paths[1]}, CheckOptions{}, r));
+  ASSERT_FALSE(r.ok());
+
+  std::size_t checks = 0;
+  double check_s = 0;
+  EXPECT_EQ(middle_starts(ctx, s, checks, check_s), (std::vector<double>{5, 5}));
+  EXPECT_EQ(checks, 2u);  // the early turn refused, then the turns at A's end checked
+  Work w = prepare(ctx);
+  join_halves(ctx, w, s, Finish{{}, {false, false}, false});
+  EXPECT_EQ(pts(w.plan.trajectories[0].alpha), pts({{0, 0}, {5, 0}, {7.5, 120}}));
+  ASSERT_TRUE(checker.check(w.plan.trajectories, CheckOptions{}, r));
+  EXPECT_TRUE(r.ok());
+}
+
 TEST(PlanPhases, SmoothAndSimplifyBuildsTheLayersAndFitsTheFirmwareLimit) {
   const auto m = build({robot_at(1, 0, 0), robot_at(2, 100, 0)});
   PlanRequest req;

@@ -285,8 +285,9 @@ TEST(Planner, SeededRandomPatchEveryRobotAccountedFor) {
 
 TEST(Planner, OverlappingTheHalvesShortensMovesFromRandomStartsAndStaysClear) {
   // Random to random on 37 robots: with B started before A ends (as far as each robot's own halves
-  // and the checker allow), the move is shorter by exactly that overlap, every plan still sound and
-  // the same robots reach their targets.
+  // and the checker allow) and the middle phase's turns as soon as each robot has folded, the move
+  // is shorter by at least the overlap, every plan still sound and the same robots reach their
+  // targets.
   const auto m = build(hex_patch(3));
   double overlapped = 0;
   for (std::uint64_t seed : {3u, 4u, 5u}) {
@@ -303,7 +304,8 @@ TEST(Planner, OverlappingTheHalvesShortensMovesFromRandomStartsAndStaysClear) {
     expect_sound(m, b.value(), req, off);
     EXPECT_EQ(b.value().stats.overlap_s, 0.0);
     EXPECT_EQ(a.value().not_reached, b.value().not_reached);
-    EXPECT_NEAR(a.value().stats.duration_s, b.value().stats.duration_s - a.value().stats.overlap_s, 1e-6) << "seed " << seed;
+    // Shorter by at least the overlap (more where middle-phase turns start early).
+    EXPECT_LE(a.value().stats.duration_s, b.value().stats.duration_s - a.value().stats.overlap_s + 1e-6) << "seed " << seed;
     overlapped += a.value().stats.overlap_s;
   }
   EXPECT_GT(overlapped, 0);

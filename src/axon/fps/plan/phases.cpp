@@ -225,15 +225,31 @@ std::vector<StepperRobot> middle_robots(const Work& w, const Search& s, bool& an
 }
 
 // The middle phase appended to half A's paths (from A's duration on).
-void append_middle(Search& s) {
-  const double ta0 = s.a.duration_s;
-  for (std::size_t i = 0; i < s.a.paths.size(); ++i)
-    for (auto [arm, m] : {std::pair{&s.a.paths[i].alpha, &s.middle.paths[i].alpha},
-                          std::pair{&s.a.paths[i].beta, &s.middle.paths[i].beta}}) {
-      if (m->size() < 2) continue;
-      if (arm->back().t_s < ta0) arm->push_back({ta0, arm->back().deg});
-      for (std::size_t k = 1; k < m->size(); ++k) arm->push_back({ta0 + (*m)[k].t_s, (*m)[k].deg});
-    }
+// Robot i's A path with its middle-phase turn appended, the turn starting at `start`.
+RobotTrajectory with_middle(const RobotTrajectory& a, const RobotTrajectory& middle, double start) {
+  RobotTrajectory out = a;
+  for (auto [arm, m] : {std::pair{&out.alpha, &middle.alpha}, std::pair{&out.beta, &middle.beta}}) {
+    if (m->size() < 2) continue;
+    if (arm->back().t_s < start) arm->push_back({start, arm->back().deg});
+    for (std::size_t k = 1; k < m->size(); ++k) arm->push_back({start + (*m)[k].t_s, (*m)[k].deg});
+  }
+  return out;
+}
+
+bool turns_in_middle(const Search& s, std::size_t i) {
+  return !s.middle.paths.empty() && (s.middle.paths[i].alpha.size() > 1 || s.middle.paths[i].beta.size() > 1);
+}
+
+// The middle phase appended to A, robot i's turn from start[i] on; returns when A and the middle
+// have ended (A's duration at least).
+double append_middle(Search& s, const std::vector<double>& start) {
+  double end = s.a.duration_s;
+  for (std::size_t i = 0; i < s.a.paths.size(); ++i) {
+    if (!turns_in_middle(s, i)) continue;
+    s.a.paths[i] = with_middle(s.a.paths[i], s.middle.paths[i], start[i]);
+    end = std::max(end, end_time(s.a.paths[i]));
+  }
+  return end;
 }
 
 // The finish of robot i appended to its joined trajectory (from `t0` on, after A, middle and B).
@@ -510,6 +526,55 @@ Finish finish_parked(const Context& ctx, Work& w, Search& s) {
   return fin;
 }
 
+std::vector<double> middle_starts(const Context& ctx, const Search& s, std::size_t& checks, double& check_s) {
+  const std::size_t n = ctx.size();
+  const double ta0 = s.a.duration_s;
+  std::vector<double> start(n, ta0);
+  if (s.middle.paths.empty() || !ctx.options.overlap_halves) return start;
+  bool any = false;
+  for (std::size_t i = 0; i < n; ++i)
+    if (detail::turns_in_middle(s, i) && ta0 - end_time(s.a.paths[i]) >= ctx.engine.dt_s) {
+      start[i] = end_time(s.a.paths[i]);
+      any = true;
+    }
+  if (!any) return start;
+  const auto t0 = Clock::now();
+  TrajectoryChecker checker(ctx.model);
+  CheckOptions check = ctx.options.check;
+  check.allow_standing_contacts = true;  // robots held where they started in contact
+  CheckReport report;
+  std::vector<RobotTrajectory> joined(n);
+  for (int round = 0; round < kMiddleStartRounds; ++round) {
+    double from = ta0, to = ta0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (detail::turns_in_middle(s, i)) {
+        from = std::min(from, start[i]);
+        to = std::max(to, start[i] + end_time(s.middle.paths[i]));
+      }
+    for (std::size_t i = 0; i < n; ++i)
+      joined[i] = window(detail::turns_in_middle(s, i) ? detail::with_middle(s.a.paths[i], s.middle.paths[i], start[i])
+                                                         : s.a.paths[i],
+                         from, to);
+    ++checks;
+    if (checker.check(joined, check, report) && report.ok()) break;
+    // The early turns in a contact wait for A's end; none there: give up on early turns.
+    bool changed = false;
+    const auto pairs = ctx.model.robot_pairs();
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      if (!report.robot_pairs[k].move_collided(check)) continue;
+      for (const std::uint32_t i : {pairs[k].a, pairs[k].b})
+        if (start[i] < ta0) {
+          start[i] = ta0;
+          changed = true;
+        }
+    }
+    if (!changed || round + 1 == kMiddleStartRounds) std::fill(start.begin(), start.end(), ta0);
+    if (!changed) break;
+  }
+  check_s += core::seconds_since(t0);
+  return start;
+}
+
 double overlap_shift(const Context& ctx, const Search& s, double ta, double tb, std::size_t& checks, double& check_s) {
   const double most = ctx.options.overlap_halves ? detail::most_shift(s, ta, tb) : 0.0;
   if (most < ctx.engine.dt_s) return 0;
@@ -538,9 +603,11 @@ void join_halves(const Context& ctx, Work& w, Search& s, const Finish& fin) {
   const std::size_t n = ctx.size();
   const double ta0 = s.a.duration_s, tb = s.b.duration_s;
   const double tm = s.middle.paths.empty() ? 0.0 : s.middle.duration_s;
-  if (!s.middle.paths.empty()) detail::append_middle(s);
-  const double shift = overlap_shift(ctx, s, ta0 + tm, tb, w.plan.stats.checks, w.plan.stats.check_s);
-  const double ta = ta0 + tm - shift;
+  double ta_end = ta0;
+  if (!s.middle.paths.empty())
+    ta_end = detail::append_middle(s, middle_starts(ctx, s, w.plan.stats.checks, w.plan.stats.check_s));
+  const double shift = overlap_shift(ctx, s, ta_end, tb, w.plan.stats.checks, w.plan.stats.check_s);
+  const double ta = ta_end - shift;
   w.plan.stats.middle_s = tm;
   w.plan.stats.overlap_s = shift;
   w.plan.trajectories = detail::joined_paths(s, ta, tb);

@@ -44,6 +44,7 @@ inline constexpr int kFinishPasses = 4;                   // finish_parked: engi
 inline constexpr double kSimplifyMinToleranceDeg = 1e-3;  // simplification starts at least this coarse
 inline constexpr double kSimplifyMaxToleranceDeg = 10;    // and doubles until it fits, giving up past this
 inline constexpr double kSameInstantS = 1e-9;             // joined points closer in time than this are one point
+inline constexpr int kMiddleStartRounds = 4;              // middle_starts: checker runs at most
 
 // The reason of a robot parked because half B could not bring it from its target to the fold
 // (finish_parked looks for it).
@@ -141,6 +142,15 @@ struct Finish {
 };
 Finish finish_parked(const Context& ctx, Work& w, Search& s);
 
+// When each robot's middle-phase turn starts: as soon as it has arrived in A, where the checker
+// proves the turns clear of the robots still in A (at the full buffer, from the first turn to the
+// end of A and the turns). The robots of a pair in contact turn at A's end instead and the check
+// repeats (kMiddleStartRounds runs at most, then every turn at A's end). At A's end (the engine's
+// certified middle run) also for robots that arrive within a step of it, and for all when
+// options.overlap_halves is off. Folded robots cannot touch each other: only robots still in A
+// are in question.
+std::vector<double> middle_starts(const Context& ctx, const Search& s, std::size_t& checks, double& check_s);
+
 // How much earlier than at `ta` (the end of A and the middle, appended to s.a) reversed B (tb
 // long) can start. The most any robot allows: B may not move it before it has arrived in A, so
 // the smallest over the robots of the time from its A arrival to ta plus its B departure. Whether
@@ -150,8 +160,8 @@ Finish finish_parked(const Context& ctx, Work& w, Search& s);
 // options.overlap_halves is off). `checks` counts the checker runs, `check_s` their time.
 double overlap_shift(const Context& ctx, const Search& s, double ta, double tb, std::size_t& checks, double& check_s);
 
-// Per robot: A, the middle phase appended to it, B reversed (from ta minus overlap_shift on), then
-// the finish; still points dropped. Fills the plan's trajectories, every robot's end, not_reached,
+// Per robot: A, the middle phase appended to it (from middle_starts on), B reversed (from the end
+// of both minus overlap_shift on), then the finish; still points dropped. Fills the plan's trajectories, every robot's end, not_reached,
 // middle_s, overlap_s and search_s.
 void join_halves(const Context& ctx, Work& w, Search& s, const Finish& fin);
 
