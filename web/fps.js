@@ -387,6 +387,13 @@ function listIds(ids) {
   return ids.length > 20 ? `${ids.slice(0, 20).join(', ')}, ... (${ids.length - 20} more)` : ids.join(', ');
 }
 
+// The slider's time. A range input keeps 15 significant digits of its value (Chromium), so at its
+// end it can read a hair (1e-14 s) below the plan's duration: the slider's end is the plan's end.
+function sliderTime(slider) {
+  const t = Number(slider.value), end = fps.replay.duration;
+  return t >= end * (1 - 1e-12) ? end : t;
+}
+
 function setReplayTime(t) {
   const replay = fps.replay;
   replay.t = Math.min(Math.max(t, 0), replay.duration);
@@ -463,7 +470,7 @@ function setUpReplay() {
   });
   $('replay-play').addEventListener('click', () => (fps.replay.playing ? pauseReplay() : playReplay()));
   $('replay-live').addEventListener('click', backToLive);
-  $('replay-slider').addEventListener('input', (event) => setReplayTime(Number(event.target.value)));
+  $('replay-slider').addEventListener('input', (event) => setReplayTime(sliderTime(event.target)));
   for (const b of $('replay-speeds').querySelectorAll('button')) {
     b.addEventListener('click', () => { fps.replay.speed = Number(b.dataset.speed); showPlay(); });
   }
