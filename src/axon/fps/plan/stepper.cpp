@@ -39,6 +39,32 @@ Pose apply(Pose p, Move mv, Pose goal) noexcept {
   return {advance(p.alpha_deg, mv.da, goal.alpha_deg), advance(p.beta_deg, mv.db, goal.beta_deg)};
 }
 
+// A robot's move over one (sub-)step: its poses and collision segments at both ends.
+struct Motion {
+  Pose p0, p1;
+  Segment s0, s1;
+};
+
+// The collision segment of robot r at the pose half-way between a motion's two (both angles
+// lerped): each arm's direction there is the bisector of its directions at the ends, so no sine or
+// cosine is needed. A turn of a half circle or more in one step (no such engine step) is computed
+// from the pose instead.
+Segment half_way(const Positioner& r, const Motion& m) noexcept {
+  const Vec2 c = r.centre();
+  const Vec2 a0 = m.s0.a - c, a1 = m.s1.a - c, b0 = m.s0.b - m.s0.a, b1 = m.s1.b - m.s1.a;
+  if (dot(a0, a1) <= 0 || dot(b0, b1) <= 0) return r.collision_segment(lerp(m.p0, m.p1, 0.5));
+  const Vec2 ua = a0 + a1, ub = b0 + b1;
+  const Vec2 axis = c + (r.alpha_length_mm() / norm(ua)) * ua;
+  return {axis, axis + (r.collision_length_mm() / norm(ub)) * ub};
+}
+
+// A motion's two halves (the first's end, the second's start: the half-way pose and segment).
+std::pair<Motion, Motion> halves(const Positioner& r, const Motion& m) noexcept {
+  const Pose pm = lerp(m.p0, m.p1, 0.5);
+  const Segment sm = half_way(r, m);
+  return {{m.p0, pm, m.s0, sm}, {pm, m.p1, sm, m.s1}};
+}
+
 struct ArmRecorder {
   std::vector<TimedAngle> points;
   double last_delta = 0;
@@ -89,9 +115,14 @@ class Stepper {
     const Positioner& r = m_.robot(i);
     return (std::abs(mv.da) * r.reach_mm() + std::abs(mv.db) * r.collision_length_mm()) * kRad;
   }
-  bool certify(std::size_t i, Pose i0, Pose i1, double ci0, double ci1, std::size_t j, Pose j0, Pose j1, double limit,
+  // Robot i's collision segment after move `mv` from its pose of this step's start, landing on
+  // q = apply(prev, mv, goal): a full step of each arm (or none) turns the start's segment by the
+  // step's precomputed rotations (no sine or cosine: the candidates of a step are most of the
+  // engine's trigonometry); a partial step, or one that snapped onto the goal, is computed anew.
+  [[nodiscard]] Segment moved_segment(std::size_t i, Move mv, Pose q) const noexcept;
+  bool certify(std::size_t i, const Motion& mi, double ci0, double ci1, std::size_t j, const Motion& mj, double limit,
                double s, int depth);
-  bool certify_obstacle(std::size_t i, Pose i0, Pose i1, double c0, double c1, const Segment& ob, double limit,
+  bool certify_obstacle(std::size_t i, const Motion& mi, double c0, double c1, const Segment& ob, double limit,
                         double s, int depth);
   Feasibility feasible(std::size_t i, Pose p1, const Segment& s1, double trav, bool want_clearance,
                        std::vector<std::uint32_t>* blockers);
@@ -119,7 +150,35 @@ class Stepper {
   std::vector<bool> field_tried_;
   bool has_scripts_ = false;
   std::size_t violations_ = 0;
+  // {cos, sin} of the alpha step's turns (-1, 0, +1 steps) and of the beta arm's direction's turns
+  // (alpha's plus beta's), for moved_segment.
+  std::array<Vec2, 3> turn_alpha_{};
+  std::array<std::array<Vec2, 3>, 3> turn_beta_{};
 };
+
+// -1, 0, +1 as an index 0..2 when `d` is exactly no step or one full step; -1 otherwise.
+int step_index(double d, double step) noexcept {
+  if (d == 0) return 1;
+  if (d == step) return 2;
+  if (d == -step) return 0;
+  return -1;
+}
+
+Segment Stepper::moved_segment(std::size_t i, Move mv, Pose q) const noexcept {
+  const Pose p = prev_[i];
+  const Positioner& r = m_.robot(i);
+  const int ka = step_index(mv.da, o_.alpha_step_deg), kb = step_index(mv.db, o_.beta_step_deg);
+  if (ka < 0 || kb < 0 || q.alpha_deg != p.alpha_deg + mv.da || q.beta_deg != p.beta_deg + mv.db)
+    return r.collision_segment(q);
+  if (ka == 1 && kb == 1) return seg_prev_[i];
+  const Segment& s0 = seg_prev_[i];
+  const Vec2 ua = (1.0 / r.alpha_length_mm()) * (s0.a - r.centre());
+  const Vec2 ub = (1.0 / r.collision_length_mm()) * (s0.b - s0.a);
+  const Vec2 ta = turn_alpha_[static_cast<std::size_t>(ka)];
+  const Vec2 tb = turn_beta_[static_cast<std::size_t>(ka)][static_cast<std::size_t>(kb)];
+  const Vec2 axis = r.centre() + r.alpha_length_mm() * rotate(ua, ta.x, ta.y);
+  return {axis, axis + r.collision_length_mm() * rotate(ub, tb.x, tb.y)};
+}
 
 double Stepper::field_cost(std::size_t i, Pose p) const noexcept {
   const Field& f = fields_[i];
@@ -241,7 +300,7 @@ void Stepper::hold_or_dodge(std::size_t i) {
       if (q.alpha_deg < lim.alpha_min_deg || q.alpha_deg > lim.alpha_max_deg || q.beta_deg < lim.beta_min_deg ||
           q.beta_deg > lim.beta_max_deg)
         continue;
-      const auto f = feasible(i, q, m_.robot(i).collision_segment(q), travel(i, mv), true, nullptr);
+      const auto f = feasible(i, q, moved_segment(i, mv, q), travel(i, mv), true, nullptr);
       if (f.ok && f.min_clearance > best) {
         best = f.min_clearance;
         chosen = mv;
@@ -254,34 +313,34 @@ void Stepper::hold_or_dodge(std::size_t i) {
   }
   const Pose q{p.alpha_deg + chosen.da, p.beta_deg + chosen.db};
   cur_[i] = q;
-  seg_cur_[i] = m_.robot(i).collision_segment(q);
+  seg_cur_[i] = moved_segment(i, chosen, q);
   trav_[i] = travel(i, chosen);
   st_[i].last = chosen;
 }
 
-bool Stepper::certify(std::size_t i, Pose i0, Pose i1, double c0, double c1, std::size_t j, Pose j0, Pose j1,
+bool Stepper::certify(std::size_t i, const Motion& mi, double c0, double c1, std::size_t j, const Motion& mj,
                       double limit, double s, int depth) {
   if (c0 + c1 - s >= 2 * kCertifyTinyMm) return true;
   if (c0 < 0 || c1 < 0) return false;
   if (s <= kCertifyResolutionMm) return true;  // a dip of at most kCertifyResolutionMm / 2 between two clear samples
   if (depth >= kMaxDepth) return false;
-  const Pose im = lerp(i0, i1, 0.5), jm = lerp(j0, j1, 0.5);
-  const double cm = segment_distance(m_.robot(i).collision_segment(im), m_.robot(j).collision_segment(jm)) - limit;
+  const auto [i0, i1] = halves(m_.robot(i), mi);
+  const auto [j0, j1] = halves(m_.robot(j), mj);
+  const double cm = segment_distance(i0.s1, j0.s1) - limit;
   ++checks_;
-  return certify(i, i0, im, c0, cm, j, j0, jm, limit, s / 2, depth + 1) &&
-         certify(i, im, i1, cm, c1, j, jm, j1, limit, s / 2, depth + 1);
+  return certify(i, i0, c0, cm, j, j0, limit, s / 2, depth + 1) && certify(i, i1, cm, c1, j, j1, limit, s / 2, depth + 1);
 }
 
-bool Stepper::certify_obstacle(std::size_t i, Pose i0, Pose i1, double c0, double c1, const Segment& ob,
-                               double limit, double s, int depth) {
+bool Stepper::certify_obstacle(std::size_t i, const Motion& mi, double c0, double c1, const Segment& ob, double limit,
+                               double s, int depth) {
   if (c0 + c1 - s >= 2 * kCertifyTinyMm) return true;
   if (c0 < 0 || c1 < 0) return false;
   if (s <= kCertifyResolutionMm) return true;
   if (depth >= kMaxDepth) return false;
-  const Pose im = lerp(i0, i1, 0.5);
-  const double cm = segment_distance(m_.robot(i).collision_segment(im), ob) - limit;
-  return certify_obstacle(i, i0, im, c0, cm, ob, limit, s / 2, depth + 1) &&
-         certify_obstacle(i, im, i1, cm, c1, ob, limit, s / 2, depth + 1);
+  const auto [i0, i1] = halves(m_.robot(i), mi);
+  const double cm = segment_distance(i0.s1, ob) - limit;
+  return certify_obstacle(i, i0, c0, cm, ob, limit, s / 2, depth + 1) &&
+         certify_obstacle(i, i1, cm, c1, ob, limit, s / 2, depth + 1);
 }
 
 Stepper::Feasibility Stepper::feasible(std::size_t i, Pose p1, const Segment& s1, double trav, bool want_clearance,
@@ -312,7 +371,8 @@ Stepper::Feasibility Stepper::feasible(std::size_t i, Pose p1, const Segment& s1
     const double c0 = segment_distance(s0, sj0) - limit;
     const double c1 = segment_distance(s1, sj1) - limit;
     f.min_clearance = std::min(f.min_clearance, c1);
-    const bool ok = c1 >= std::min(o_.margin_mm, c0) && certify(i, p0, p1, c0, c1, j, prev_[j], cur_[j], limit, s, 0);
+    const bool ok = c1 >= std::min(o_.margin_mm, c0) &&
+                    certify(i, {p0, p1, s0, s1}, c0, c1, j, {prev_[j], cur_[j], sj0, sj1}, limit, s, 0);
     if (!ok) {
       f.ok = false;
       if (blockers) blockers->push_back(static_cast<std::uint32_t>(j));
@@ -328,7 +388,7 @@ Stepper::Feasibility Stepper::feasible(std::size_t i, Pose p1, const Segment& s1
     f.min_clearance = std::min(f.min_clearance, c1);
     if (c1 >= 2 * trav + o_.margin_mm + 2 * kCertifyTinyMm) continue;  // c0 >= c1 - trav
     const double c0 = segment_distance(s0, ob) - op.limit_mm;
-    if (!(c1 >= std::min(o_.margin_mm, c0) && certify_obstacle(i, p0, p1, c0, c1, ob, op.limit_mm, trav, 0))) {
+    if (!(c1 >= std::min(o_.margin_mm, c0) && certify_obstacle(i, {p0, p1, s0, s1}, c0, c1, ob, op.limit_mm, trav, 0))) {
       f.ok = false;
       if (!want_clearance && !blockers) return f;
     }
@@ -390,7 +450,7 @@ void Stepper::step_robot(std::size_t i) {
       for (std::size_t b = a; b > 0 && cands[b].score < cands[b - 1].score; --b) std::swap(cands[b], cands[b - 1]);
     for (std::size_t k = 0; k < nc; ++k) {
       const Pose q = apply(p, cands[k].mv, g);
-      const Segment s1 = m_.robot(i).collision_segment(q);
+      const Segment s1 = moved_segment(i, cands[k].mv, q);
       if (feasible(i, q, s1, travel(i, cands[k].mv), false, nullptr).ok) {
         chosen = cands[k].mv;
         chosen_seg = s1;
@@ -402,7 +462,7 @@ void Stepper::step_robot(std::size_t i) {
     double best = -kInf;
     for (std::size_t k = 0; k < nc; ++k) {
       const Pose q = apply(p, cands[k].mv, g);
-      const Segment s1 = m_.robot(i).collision_segment(q);
+      const Segment s1 = moved_segment(i, cands[k].mv, q);
       const auto f = feasible(i, q, s1, travel(i, cands[k].mv), true, nullptr);
       if (!f.ok) continue;
       double score = kClrW * std::min(f.min_clearance, 5.0) + noise(rng_) + (cands[k].mv == st.last ? kKeepW : 0.0);
@@ -426,7 +486,7 @@ void Stepper::step_robot(std::size_t i) {
 
   const Pose q = apply(p, chosen, g);
   cur_[i] = q;
-  seg_cur_[i] = chosen == Move{} ? m_.robot(i).collision_segment(q) : chosen_seg;
+  seg_cur_[i] = chosen == Move{} ? moved_segment(i, chosen, q) : chosen_seg;
   trav_[i] = travel(i, chosen);
   st.last = chosen;
   if (chosen == Move{} && has_scripts_) hold_or_dodge(i);
@@ -454,7 +514,7 @@ void Stepper::step_robot(std::size_t i) {
     if (nc > 0) {
       blockers_.clear();
       const Pose q0 = apply(p, cands[0].mv, g);
-      feasible(i, q0, m_.robot(i).collision_segment(q0), travel(i, cands[0].mv), false, &blockers_);
+      feasible(i, q0, moved_segment(i, cands[0].mv, q0), travel(i, cands[0].mv), false, &blockers_);
       for (const std::uint32_t j : blockers_) {
         if (robots_[j].frozen || rank_[j] >= rank_[i] || st_[j].escape_left > 0 || st_[j].gave_up) continue;
         st_[j].escape_left = len(rng_);
@@ -487,6 +547,12 @@ void Stepper::record(std::size_t i, double t_s) {
 
 StepperResult Stepper::run() {
   const std::size_t n = m_.size();
+  for (std::size_t ka = 0; ka < 3; ++ka) {
+    const double da = (static_cast<double>(ka) - 1) * o_.alpha_step_deg;
+    turn_alpha_[ka] = unit(da * kRad);
+    for (std::size_t kb = 0; kb < 3; ++kb)
+      turn_beta_[ka][kb] = unit((da + (static_cast<double>(kb) - 1) * o_.beta_step_deg) * kRad);
+  }
   prev_.resize(n);
   for (std::size_t i = 0; i < n; ++i) prev_[i] = robots_[i].start;
   cur_ = prev_;
@@ -552,7 +618,7 @@ StepperResult Stepper::run() {
       const double t1 = static_cast<double>(step + 1) * o_.dt_s;
       const Pose q{cursors[k].first.at(t1), cursors[k].second.at(t1)};
       cur_[j] = q;
-      seg_cur_[j] = m_.robot(j).collision_segment(q);
+      seg_cur_[j] = q == prev_[j] ? seg_prev_[j] : m_.robot(j).collision_segment(q);
       const Positioner& r = m_.robot(j);
       trav_[j] = (std::abs(q.alpha_deg - prev_[j].alpha_deg) * r.reach_mm() +
                   std::abs(q.beta_deg - prev_[j].beta_deg) * r.collision_length_mm()) * kRad;
@@ -605,7 +671,7 @@ StepperResult Stepper::run() {
       const Move mv{std::clamp(g.alpha_deg - p.alpha_deg, -o_.alpha_step_deg, o_.alpha_step_deg),
                     std::clamp(g.beta_deg - p.beta_deg, -o_.beta_step_deg, o_.beta_step_deg)};
       const Pose q = apply(p, mv, g);
-      feasible(i, q, m_.robot(i).collision_segment(q), travel(i, mv), false, &out.blockers[i]);
+      feasible(i, q, moved_segment(i, mv, q), travel(i, mv), false, &out.blockers[i]);
     }
   }
   out.pair_checks = checks_;
