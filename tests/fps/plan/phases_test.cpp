@@ -50,6 +50,16 @@ StepperResult standing(const std::vector<Pose>& poses) {
   return r;
 }
 
+// Half A of two robots far apart that start at alpha 10 and 20, beta 100: robot 0 folds in A's
+// first second, robot 1 until A's end at 4 s.
+StepperResult a_folding_early_and_late() {
+  StepperResult a = standing({{10, 180}, {20, 180}});
+  a.paths[0].beta = {{0, 100}, {1, 180}};
+  a.paths[1].beta = {{0, 100}, {4, 180}};
+  a.duration_s = 4;
+  return a;
+}
+
 // A small random problem on 19 robots (folded lattice to random targets), prepared and settled.
 struct Patch {
   CollisionModel model = build(hex_patch(2));
@@ -439,10 +449,7 @@ TEST(PlanPhases, OverlapStartsBAsEarlyAsEveryRobotsOwnHalvesAllow) {
   const PlannerOptions o{};
   const Context ctx = make_context(m, req, o);
   Search s;
-  s.a = standing({{10, 180}, {20, 180}});
-  s.a.paths[0].beta = {{0, 100}, {1, 180}};
-  s.a.paths[1].beta = {{0, 100}, {4, 180}};
-  s.a.duration_s = 4;
+  s.a = a_folding_early_and_late();
   s.b = standing({{50, 180}, {60, 180}});
   s.b.paths[0] = {{{0, 50}, {3, 10}}, {{0, 90}, {3, 180}}};
   s.b.paths[1].beta = {{0, 120}, {1, 180}};
@@ -522,10 +529,7 @@ TEST(PlanPhases, MiddleTurnsStartWhenTheRobotHasFolded) {
   const PlannerOptions o{};
   const Context ctx = make_context(m, req, o);
   Search s;
-  s.a = standing({{10, 180}, {20, 180}});
-  s.a.paths[0].beta = {{0, 100}, {1, 180}};
-  s.a.paths[1].beta = {{0, 100}, {4, 180}};
-  s.a.duration_s = 4;
+  s.a = a_folding_early_and_late();
   s.middle = standing({{40, 180}, {20, 180}});
   s.middle.paths[0].alpha = {{0, 10}, {2.5, 40}};
   s.middle.duration_s = 2.5;
