@@ -46,14 +46,14 @@ struct Motion {
 };
 
 // The collision segment of robot r at the pose half-way between a motion's two (both angles
-// lerped): each arm's direction there is the bisector of its directions at the ends, so no sine or
-// cosine is needed. A turn of a half circle or more in one step (no such engine step) is computed
-// from the pose instead.
+// lerped): while each arm's direction turns by less than a half circle, its direction there is
+// the bisector of its directions at the ends, so no sine or cosine is needed. A turn of a quarter
+// circle or more (no engine step turns that much) is computed from the pose instead.
 Segment half_way(const Positioner& r, const Motion& m) noexcept {
+  const double turn_a = m.p1.alpha_deg - m.p0.alpha_deg, turn_b = turn_a + (m.p1.beta_deg - m.p0.beta_deg);
+  if (std::abs(turn_a) >= 90 || std::abs(turn_b) >= 90) return r.collision_segment(lerp(m.p0, m.p1, 0.5));
   const Vec2 c = r.centre();
-  const Vec2 a0 = m.s0.a - c, a1 = m.s1.a - c, b0 = m.s0.b - m.s0.a, b1 = m.s1.b - m.s1.a;
-  if (dot(a0, a1) <= 0 || dot(b0, b1) <= 0) return r.collision_segment(lerp(m.p0, m.p1, 0.5));
-  const Vec2 ua = a0 + a1, ub = b0 + b1;
+  const Vec2 ua = (m.s0.a - c) + (m.s1.a - c), ub = (m.s0.b - m.s0.a) + (m.s1.b - m.s1.a);
   const Vec2 axis = c + (r.alpha_length_mm() / norm(ua)) * ua;
   return {axis, axis + (r.collision_length_mm() / norm(ub)) * ub};
 }
