@@ -1,12 +1,15 @@
-// Small collision models the planner tests build by hand, and the clearance of a static pose.
+// Small collision models the planner tests build by hand, the clearance of a static pose, and an
+// arm's points in a form tests compare exactly.
 #pragma once
 
 #include "axon/fps/plan/collision.hpp"
+#include "axon/fps/plan/trajectory.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace axon::fps::plan::test {
@@ -45,6 +48,13 @@ inline double static_clearance(const CollisionModel& m, const std::vector<Pose>&
   m.segments(poses, s);
   std::vector<Contact> c;
   return m.find_contacts(s, c);
+}
+
+// An arm's points as (time, angle) pairs, for EXPECT_EQ on whole paths.
+inline std::vector<std::pair<double, double>> pts(const std::vector<TimedAngle>& arm) {
+  std::vector<std::pair<double, double>> out;
+  for (const TimedAngle& p : arm) out.emplace_back(p.t_s, p.deg);
+  return out;
 }
 
 }  // namespace axon::fps::plan::test

@@ -17,6 +17,7 @@ namespace axon::fps::plan::phases_test {
 using namespace axon::fps::plan::phases;
 using test::build;
 using test::hex_patch;
+using test::pts;
 using test::robot_at;
 using test::static_clearance;
 
@@ -29,13 +30,6 @@ std::size_t moving_contacts(const CollisionModel& m, const Work& w) {
   std::size_t count = 0;
   for (const auto& k : c) count += (w.still[k.a] && (k.kind != Contact::Kind::robot || w.still[k.b])) ? 0 : 1;
   return count;
-}
-
-// (time, angle) pairs, to compare arms.
-std::vector<std::pair<double, double>> pts(const std::vector<TimedAngle>& arm) {
-  std::vector<std::pair<double, double>> out;
-  for (const auto& p : arm) out.emplace_back(p.t_s, p.deg);
-  return out;
 }
 
 // A one-point engine path per robot at `poses` (an engine result where nobody moved).

@@ -3,9 +3,11 @@
 #include "axon/fps/plan/untangle.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <thread>
 
 // Helpers of this file only (a named namespace, for the unity build).
 namespace axon::fps::plan::half::detail {
@@ -38,6 +40,23 @@ void repair_patch(const CollisionModel& model, const std::vector<bool>& centre, 
     if (in[i])
       for (const std::uint32_t j : model.neighbours(i))
         if (!in[j]) border[j] = true;
+}
+
+// run(0) and, when `both`, run(1): side by side on a core borrowed from `cores` when one is
+// spare, otherwise one after the other. run(t) must not touch what run(1 - t) does.
+template <class Run>
+void run_pair(bool both, SpareCores* cores, const Run& run) {
+  if (both && cores != nullptr && cores->take()) {
+    struct Back {
+      SpareCores* c;
+      ~Back() { c->give(); }
+    } back{cores};
+    std::jthread second([&run] { run(1); });
+    run(0);
+    return;
+  }
+  run(0);
+  if (both) run(1);
 }
 
 // How many robots of the patch `in` the run leaves short of their goal.
@@ -206,13 +225,22 @@ void shorten_tail(const CollisionModel& model, std::vector<StepperRobot>& robots
   }
 }
 
+bool SpareCores::take() noexcept {
+  int n = spare_.load();
+  while (n > 0)
+    if (spare_.compare_exchange_weak(n, n - 1)) return true;
+  return false;
+}
+
+void SpareCores::give() noexcept { spare_.fetch_add(1); }
+
 StepperResult drive_half(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperOptions so,
-                         const PlannerOptions& o, std::size_t& runs) {
+                         const PlannerOptions& o, std::size_t& runs, SpareCores* cores) {
   StepperResult best = drive_to_goals(model, robots, so);
   ++runs;
   std::vector<StepperRobot> best_robots = robots;
   std::vector<bool> listed(robots.size(), false);
-  for (int k = 0; k < o.half_retries && count_unreached(best) > 0; ++k) {
+  for (int k = 0; k < o.half_retries && count_unreached(best) > 0; k += 2) {
     for (std::size_t i = 0; i < robots.size(); ++i) {
       if (best.reached[i]) continue;
       if (!listed[i]) {
@@ -221,13 +249,20 @@ StepperResult drive_half(const CollisionModel& model, std::vector<StepperRobot>&
       }
       if (k >= o.relax_after) robots[i].goal.alpha_deg = robots[i].start.alpha_deg;
     }
-    so.seed = next_seed(so.seed);
-    StepperResult r = drive_to_goals(model, robots, so);
-    ++runs;
-    const std::size_t a = count_unreached(r), b = count_unreached(best);
-    if (a < b || (a == b && r.duration_s < best.duration_s)) {
-      best = std::move(r);
-      best_robots = robots;
+    const std::size_t count = k + 1 < o.half_retries ? 2 : 1;
+    std::array<StepperOptions, 2> pair{so, so};
+    pair[0].seed = next_seed(so.seed);
+    pair[1].seed = next_seed(pair[0].seed);
+    so.seed = pair[count - 1].seed;
+    std::array<StepperResult, 2> r;
+    run_pair(count == 2, cores, [&](std::size_t t) { r[t] = drive_to_goals(model, robots, pair[t]); });
+    for (std::size_t t = 0; t < count; ++t) {
+      ++runs;
+      const std::size_t a = count_unreached(r[t]), b = count_unreached(best);
+      if (a < b || (a == b && r[t].duration_s < best.duration_s)) {
+        best = std::move(r[t]);
+        best_robots = robots;
+      }
     }
   }
   robots = std::move(best_robots);

@@ -9,22 +9,38 @@
 #include "axon/fps/plan/planner.hpp"
 #include "axon/fps/plan/stepper.hpp"
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 namespace axon::fps::plan::half {
 
+// Cores a half may borrow to run the second engine run of a pair beside the first: the halves run
+// on a thread each, and one that has finished lends its core to the other (more on a machine with
+// more cores). Thread-safe. Plans never depend on it: a pair's runs are the same runs whether they
+// go side by side or one after the other.
+class SpareCores {
+ public:
+  explicit SpareCores(int spare = 0) noexcept : spare_(spare) {}
+  [[nodiscard]] bool take() noexcept;  // one core, when one is spare
+  void give() noexcept;                // a core back, or lent by a half that has finished
+ private:
+  std::atomic<int> spare_;
+};
+
 // The local repairs and the tail draw from seeds of their own: the half's seed with these mixed in.
 inline constexpr std::uint64_t kLocalRepairSeedSalt = 0x9e3779b97f4a7c15ULL;
 inline constexpr std::uint64_t kTailSeedSalt = 0x7f4a7c159e3779b9ULL;
 
-// The half: re-run while robots get stuck (options.half_retries; those stuck so far step first,
-// from relax_after on they keep their start alpha), the run with the fewest stuck (then the
-// shortest) kept and `robots` given its goals; then repair_locally, the untangle (options.untangle)
-// and shorten_tail. `runs` counts the engine runs.
+// The half: re-run while robots get stuck (options.half_retries runs, in pairs with new seeds:
+// the robots stuck in the best run so far step first, from relax_after on they keep their start
+// alpha; a pair's two runs share those priorities, so that they can run side by side on a core
+// borrowed from `cores`), the run with the fewest stuck (then the shortest) kept and `robots`
+// given its goals; then repair_locally, the untangle (options.untangle) and shorten_tail. `runs`
+// counts the engine runs. The result does not depend on `cores` (nullptr: none to borrow).
 StepperResult drive_half(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperOptions so,
-                         const PlannerOptions& o, std::size_t& runs);
+                         const PlannerOptions& o, std::size_t& runs, SpareCores* cores = nullptr);
 
 // The stuck robots and options.local_rings rings of neighbours planned again with new seeds (the
 // ring around them follows its paths of `best`, scripted); a run replaces the patch's paths in

@@ -411,8 +411,15 @@ void run_halves(const Context& ctx, const Work& w, Folds& f, int round, Search& 
   const auto t0 = Clock::now();
   std::size_t runs_a = 0, runs_b = 0;
   if (o.parallel) {
-    std::thread worker([&] { s.a = half::drive_half(ctx.model, f.a, sa, o, runs_a); });
-    s.b = half::drive_half(ctx.model, f.b, sb, o, runs_b);
+    // A thread per half; the cores beyond those two, and the core of a half that is done, go to
+    // the other half's paired re-runs.
+    half::SpareCores cores(std::max(0, static_cast<int>(std::thread::hardware_concurrency()) - 2));
+    std::thread worker([&] {
+      s.a = half::drive_half(ctx.model, f.a, sa, o, runs_a, &cores);
+      cores.give();
+    });
+    s.b = half::drive_half(ctx.model, f.b, sb, o, runs_b, &cores);
+    cores.give();
     worker.join();
   } else {
     s.a = half::drive_half(ctx.model, f.a, sa, o, runs_a);
