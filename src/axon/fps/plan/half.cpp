@@ -116,6 +116,22 @@ std::vector<StepperRobot> repair_robots(const CollisionModel& model, const std::
   return sub;
 }
 
+// A tail try's cluster turns a random part (from `so`'s seed) of its alpha turn in this half;
+// returns how much longer the middle phase may then take (the largest rest, at full speed).
+double turn_less(std::vector<StepperRobot>& sub, const std::vector<bool>& cluster, const StepperOptions& so) {
+  std::mt19937_64 rng(so.seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double growth = 0;
+  for (std::size_t i = 0; i < sub.size(); ++i) {
+    if (!cluster[i]) continue;
+    const double turn = sub[i].goal.alpha_deg - sub[i].start.alpha_deg;
+    const double kept = u(rng) * turn;
+    sub[i].goal.alpha_deg = sub[i].start.alpha_deg + kept;
+    growth = std::max(growth, std::abs(turn - kept) / so.alpha_step_deg * so.dt_s);
+  }
+  return growth;
+}
+
 // The cluster of late robots around robot `from`: late robots within two neighbour steps of one
 // already in it.
 std::vector<bool> late_cluster(const CollisionModel& model, const std::vector<bool>& late, std::size_t from) {
@@ -143,18 +159,29 @@ namespace axon::fps::plan::half {
 using namespace detail;
 
 void repair_locally(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperResult& best,
-                    StepperOptions so, const PlannerOptions& o, std::size_t& runs) {
+                    StepperOptions so, const PlannerOptions& o, std::size_t& runs, SpareCores* cores) {
   std::vector<bool> in, border;
-  for (int k = 0; k < o.local_retries && count_unreached(best) > 0; ++k) {
-    // Recomputed every try: the patch grows when a repair leaves robots stuck elsewhere.
+  for (int k = 0; k < o.local_retries && count_unreached(best) > 0; k += 2) {
+    // Recomputed every pair: the patch grows when a repair leaves robots stuck elsewhere.
     repair_patch(model, unreached(best), o.local_rings, in, border, so.first);
-    const std::vector<StepperRobot> sub = repair_robots(model, robots, best, in, border, k, o.fold_spread_deg, so.seed);
-    so.seed = next_seed(so.seed);
-    StepperResult r = drive_to_goals(model, sub, so);
-    ++runs;
-    best.escapes += r.escapes;
-    if (r.violations > 0 || stuck_in(r, in) >= stuck_in(best, in)) continue;
-    take_patch(robots, sub, in, r, best);
+    const std::size_t count = k + 1 < o.local_retries ? 2 : 1;
+    std::array<std::vector<StepperRobot>, 2> sub;
+    std::array<StepperOptions, 2> pair{so, so};
+    for (std::size_t t = 0; t < count; ++t) {
+      sub[t] = repair_robots(model, robots, best, in, border, k + static_cast<int>(t), o.fold_spread_deg, so.seed);
+      so.seed = next_seed(so.seed);
+      pair[t].seed = so.seed;
+    }
+    std::array<StepperResult, 2> r;
+    run_pair(count == 2, cores, [&](std::size_t t) { r[t] = drive_to_goals(model, sub[t], pair[t]); });
+    std::size_t won = count;  // the clean try that leaves the fewest of the patch stuck (the first on a tie)
+    for (std::size_t t = 0; t < count; ++t) {
+      ++runs;
+      best.escapes += r[t].escapes;
+      const std::size_t left = stuck_in(r[t], in);
+      if (r[t].violations == 0 && left < stuck_in(best, in) && (won == count || left < stuck_in(r[won], in))) won = t;
+    }
+    if (won < count) take_patch(robots, sub[won], in, r[won], best);
   }
 }
 
@@ -178,7 +205,7 @@ std::vector<bool> late_robots(const std::vector<StepperRobot>& robots, const Ste
 }
 
 void shorten_tail(const CollisionModel& model, std::vector<StepperRobot>& robots, StepperResult& best, StepperOptions so,
-                  const PlannerOptions& o, std::size_t& runs) {
+                  const PlannerOptions& o, std::size_t& runs, SpareCores* cores) {
   const std::size_t n = robots.size();
   std::vector<bool> in, border;
   auto patch_end = [&](const StepperResult& r) {
@@ -188,7 +215,7 @@ void shorten_tail(const CollisionModel& model, std::vector<StepperRobot>& robots
     return t;
   };
   int fruitless = 0;
-  for (int k = 0; k < o.tail_retries && fruitless < o.tail_tries_per_cluster; ++k) {
+  for (int k = 0; k < o.tail_retries && fruitless < o.tail_tries_per_cluster; k += 2) {
     const std::vector<bool> late = late_robots(robots, best, o);
     std::size_t last = n;
     for (std::size_t i = 0; i < n; ++i)
@@ -196,32 +223,38 @@ void shorten_tail(const CollisionModel& model, std::vector<StepperRobot>& robots
     if (last == n) return;
     const std::vector<bool> cluster = late_cluster(model, late, last);
     repair_patch(model, cluster, o.tail_rings, in, border, so.first);
-    std::vector<StepperRobot> sub = repair_robots(model, robots, best, in, border, 0, 0, so.seed);
-    // Every other try, the late robots turn less alpha in this half. The middle phase turns the
-    // rest and may take that much longer: the try must win more than that.
-    double middle_growth = 0;
-    if (k % 2 == 1) {
-      std::mt19937_64 rng(so.seed);
-      std::uniform_real_distribution<double> u(0.0, 1.0);
-      for (std::size_t i = 0; i < n; ++i) {
-        if (!cluster[i]) continue;
-        const double turn = sub[i].goal.alpha_deg - sub[i].start.alpha_deg;
-        const double kept = u(rng) * turn;
-        sub[i].goal.alpha_deg = sub[i].start.alpha_deg + kept;
-        middle_growth = std::max(middle_growth, std::abs(turn - kept) / so.alpha_step_deg * so.dt_s);
+    // Two tries on the cluster (side by side on a borrowed core): the second has the late robots
+    // turn less alpha in this half. The middle phase turns the rest and may take that much
+    // longer: such a try must win more than that.
+    const std::size_t count = k + 1 < o.tail_retries ? 2 : 1;
+    std::array<std::vector<StepperRobot>, 2> sub;
+    std::array<double, 2> middle_growth{0, 0};
+    std::array<StepperOptions, 2> pair{so, so};
+    for (std::size_t t = 0; t < count; ++t) {
+      sub[t] = repair_robots(model, robots, best, in, border, 0, 0, so.seed);
+      if (t == 1) middle_growth[t] = turn_less(sub[t], cluster, so);
+      so.seed = next_seed(so.seed);
+      pair[t].seed = so.seed;
+    }
+    std::array<StepperResult, 2> r;
+    run_pair(count == 2, cores, [&](std::size_t t) { r[t] = drive_to_goals(model, sub[t], pair[t]); });
+    std::size_t won = count;  // the try whose patch ends first, by half a step at least
+    double won_end = patch_end(best) - so.dt_s / 2;
+    for (std::size_t t = 0; t < count; ++t) {
+      ++runs;
+      best.escapes += r[t].escapes;
+      const double end = patch_end(r[t]) + middle_growth[t];
+      if (r[t].violations == 0 && stuck_in(r[t], in) <= stuck_in(best, in) && end < won_end) {
+        won = t;
+        won_end = end;
       }
     }
-    so.seed = next_seed(so.seed);
-    StepperResult r = drive_to_goals(model, sub, so);
-    ++runs;
-    best.escapes += r.escapes;
-    if (r.violations > 0 || stuck_in(r, in) > stuck_in(best, in) ||
-        patch_end(r) + middle_growth >= patch_end(best) - so.dt_s / 2) {
-      ++fruitless;
+    if (won == count) {
+      fruitless += static_cast<int>(count);
       continue;
     }
     fruitless = 0;
-    take_patch(robots, sub, in, r, best);
+    take_patch(robots, sub[won], in, r[won], best);
   }
 }
 
@@ -240,7 +273,7 @@ StepperResult drive_half(const CollisionModel& model, std::vector<StepperRobot>&
   ++runs;
   std::vector<StepperRobot> best_robots = robots;
   std::vector<bool> listed(robots.size(), false);
-  for (int k = 0; k < o.half_retries && count_unreached(best) > 0; k += 2) {
+  for (int k = 0; k < o.half_retries && count_unreached(best) > 0; ++k) {
     for (std::size_t i = 0; i < robots.size(); ++i) {
       if (best.reached[i]) continue;
       if (!listed[i]) {
@@ -249,31 +282,24 @@ StepperResult drive_half(const CollisionModel& model, std::vector<StepperRobot>&
       }
       if (k >= o.relax_after) robots[i].goal.alpha_deg = robots[i].start.alpha_deg;
     }
-    const std::size_t count = k + 1 < o.half_retries ? 2 : 1;
-    std::array<StepperOptions, 2> pair{so, so};
-    pair[0].seed = next_seed(so.seed);
-    pair[1].seed = next_seed(pair[0].seed);
-    so.seed = pair[count - 1].seed;
-    std::array<StepperResult, 2> r;
-    run_pair(count == 2, cores, [&](std::size_t t) { r[t] = drive_to_goals(model, robots, pair[t]); });
-    for (std::size_t t = 0; t < count; ++t) {
-      ++runs;
-      const std::size_t a = count_unreached(r[t]), b = count_unreached(best);
-      if (a < b || (a == b && r[t].duration_s < best.duration_s)) {
-        best = std::move(r[t]);
-        best_robots = robots;
-      }
+    so.seed = next_seed(so.seed);
+    StepperResult r = drive_to_goals(model, robots, so);
+    ++runs;
+    const std::size_t a = count_unreached(r), b = count_unreached(best);
+    if (a < b || (a == b && r.duration_s < best.duration_s)) {
+      best = std::move(r);
+      best_robots = robots;
     }
   }
   robots = std::move(best_robots);
   if (o.local_retries > 0 && count_unreached(best) > 0) {
     so.seed ^= kLocalRepairSeedSalt;
-    repair_locally(model, robots, best, so, o, runs);
+    repair_locally(model, robots, best, so, o, runs, cores);
   }
   if (o.untangle && count_unreached(best) > 0) untangle_to_fold(model, robots, best, so);
   if (o.tail_retries > 0) {
     so.seed ^= kTailSeedSalt;
-    shorten_tail(model, robots, best, so, o, runs);
+    shorten_tail(model, robots, best, so, o, runs, cores);
   }
   return best;
 }
