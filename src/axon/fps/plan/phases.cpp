@@ -412,7 +412,7 @@ void run_halves(const Context& ctx, const Work& w, Folds& f, int round, Search& 
   std::size_t runs_a = 0, runs_b = 0;
   if (o.parallel) {
     // A thread per half; the cores beyond those two, and the core of a half that is done, go to
-    // the other half's paired re-runs.
+    // the other half's pairs of tries (its local re-plans and its tail).
     half::SpareCores cores(std::max(0, static_cast<int>(std::thread::hardware_concurrency()) - 2));
     std::thread worker([&] {
       s.a = half::drive_half(ctx.model, f.a, sa, o, runs_a, &cores);
