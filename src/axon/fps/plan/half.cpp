@@ -59,6 +59,31 @@ void run_pair(bool both, SpareCores* cores, const Run& run) {
   if (both) run(1);
 }
 
+// One or two tries of a re-plan: make(t, seed) builds try t's robots from the seed chain's value
+// before the try (so.seed, advanced once per try); each try runs with the next value, the two side
+// by side where `cores` lends a core. Their runs and escapes are counted into `runs` and `best`.
+struct Tries {
+  std::array<std::vector<StepperRobot>, 2> robots;
+  std::array<StepperResult, 2> result;
+};
+template <class Make>
+Tries run_tries(const CollisionModel& model, std::size_t count, StepperOptions& so, SpareCores* cores, const Make& make,
+                std::size_t& runs, StepperResult& best) {
+  Tries tries;
+  std::array<StepperOptions, 2> options{so, so};
+  for (std::size_t t = 0; t < count; ++t) {
+    tries.robots[t] = make(t, so.seed);
+    so.seed = next_seed(so.seed);
+    options[t].seed = so.seed;
+  }
+  run_pair(count == 2, cores, [&](std::size_t t) { tries.result[t] = drive_to_goals(model, tries.robots[t], options[t]); });
+  for (std::size_t t = 0; t < count; ++t) {
+    ++runs;
+    best.escapes += tries.result[t].escapes;
+  }
+  return tries;
+}
+
 // How many robots of the patch `in` the run leaves short of their goal.
 std::size_t stuck_in(const StepperResult& r, const std::vector<bool>& in) {
   std::size_t c = 0;
@@ -116,10 +141,11 @@ std::vector<StepperRobot> repair_robots(const CollisionModel& model, const std::
   return sub;
 }
 
-// A tail try's cluster turns a random part (from `so`'s seed) of its alpha turn in this half;
-// returns how much longer the middle phase may then take (the largest rest, at full speed).
-double turn_less(std::vector<StepperRobot>& sub, const std::vector<bool>& cluster, const StepperOptions& so) {
-  std::mt19937_64 rng(so.seed);
+// A tail try's cluster turns a random part (drawn from `seed`) of its alpha turn in this half;
+// returns how much longer the middle phase may then take (the largest rest, at `so`'s full speed).
+double turn_less(std::vector<StepperRobot>& sub, const std::vector<bool>& cluster, std::uint64_t seed,
+                 const StepperOptions& so) {
+  std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   double growth = 0;
   for (std::size_t i = 0; i < sub.size(); ++i) {
@@ -165,23 +191,16 @@ void repair_locally(const CollisionModel& model, std::vector<StepperRobot>& robo
     // Recomputed every pair: the patch grows when a repair leaves robots stuck elsewhere.
     repair_patch(model, unreached(best), o.local_rings, in, border, so.first);
     const std::size_t count = k + 1 < o.local_retries ? 2 : 1;
-    std::array<std::vector<StepperRobot>, 2> sub;
-    std::array<StepperOptions, 2> pair{so, so};
-    for (std::size_t t = 0; t < count; ++t) {
-      sub[t] = repair_robots(model, robots, best, in, border, k + static_cast<int>(t), o.fold_spread_deg, so.seed);
-      so.seed = next_seed(so.seed);
-      pair[t].seed = so.seed;
-    }
-    std::array<StepperResult, 2> r;
-    run_pair(count == 2, cores, [&](std::size_t t) { r[t] = drive_to_goals(model, sub[t], pair[t]); });
+    Tries tries = run_tries(model, count, so, cores, [&](std::size_t t, std::uint64_t seed) {
+      return repair_robots(model, robots, best, in, border, k + static_cast<int>(t), o.fold_spread_deg, seed);
+    }, runs, best);
+    const auto& r = tries.result;
     std::size_t won = count;  // the clean try that leaves the fewest of the patch stuck (the first on a tie)
     for (std::size_t t = 0; t < count; ++t) {
-      ++runs;
-      best.escapes += r[t].escapes;
       const std::size_t left = stuck_in(r[t], in);
       if (r[t].violations == 0 && left < stuck_in(best, in) && (won == count || left < stuck_in(r[won], in))) won = t;
     }
-    if (won < count) take_patch(robots, sub[won], in, r[won], best);
+    if (won < count) take_patch(robots, tries.robots[won], in, tries.result[won], best);
   }
 }
 
@@ -227,22 +246,16 @@ void shorten_tail(const CollisionModel& model, std::vector<StepperRobot>& robots
     // turn less alpha in this half. The middle phase turns the rest and may take that much
     // longer: such a try must win more than that.
     const std::size_t count = k + 1 < o.tail_retries ? 2 : 1;
-    std::array<std::vector<StepperRobot>, 2> sub;
     std::array<double, 2> middle_growth{0, 0};
-    std::array<StepperOptions, 2> pair{so, so};
-    for (std::size_t t = 0; t < count; ++t) {
-      sub[t] = repair_robots(model, robots, best, in, border, 0, 0, so.seed);
-      if (t == 1) middle_growth[t] = turn_less(sub[t], cluster, so);
-      so.seed = next_seed(so.seed);
-      pair[t].seed = so.seed;
-    }
-    std::array<StepperResult, 2> r;
-    run_pair(count == 2, cores, [&](std::size_t t) { r[t] = drive_to_goals(model, sub[t], pair[t]); });
+    Tries tries = run_tries(model, count, so, cores, [&](std::size_t t, std::uint64_t seed) {
+      std::vector<StepperRobot> sub = repair_robots(model, robots, best, in, border, 0, 0, seed);
+      if (t == 1) middle_growth[t] = turn_less(sub, cluster, seed, so);
+      return sub;
+    }, runs, best);
+    const auto& r = tries.result;
     std::size_t won = count;  // the try whose patch ends first, by half a step at least
     double won_end = patch_end(best) - so.dt_s / 2;
     for (std::size_t t = 0; t < count; ++t) {
-      ++runs;
-      best.escapes += r[t].escapes;
       const double end = patch_end(r[t]) + middle_growth[t];
       if (r[t].violations == 0 && stuck_in(r[t], in) <= stuck_in(best, in) && end < won_end) {
         won = t;
@@ -254,7 +267,7 @@ void shorten_tail(const CollisionModel& model, std::vector<StepperRobot>& robots
       continue;
     }
     fruitless = 0;
-    take_patch(robots, sub[won], in, r[won], best);
+    take_patch(robots, tries.robots[won], in, tries.result[won], best);
   }
 }
 

@@ -17,10 +17,9 @@
 namespace axon::fps::plan::half {
 
 // Cores a half may borrow to run the second engine run of a pair (a local repair's or the tail's)
-// beside the first: the halves run
-// on a thread each, and one that has finished lends its core to the other (more on a machine with
-// more cores). Thread-safe. Plans never depend on it: a pair's runs are the same runs whether they
-// go side by side or one after the other.
+// beside the first: the halves run on a thread each, and one that has finished lends its core to
+// the other (more on a machine with more cores). Thread-safe. Plans never depend on it: a pair's
+// runs are the same runs whether they go side by side or one after the other.
 class SpareCores {
  public:
   explicit SpareCores(int spare = 0) noexcept : spare_(spare) {}
