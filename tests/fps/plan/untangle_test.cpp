@@ -24,6 +24,14 @@ StepperResult stuck_result(const std::vector<StepperRobot>& robots, std::vector<
   return r;
 }
 
+// The independent checker finds no contact in the paths (at the full buffer).
+void expect_clear(const CollisionModel& m, const std::vector<RobotTrajectory>& paths) {
+  TrajectoryChecker checker(m);
+  CheckReport report;
+  ASSERT_TRUE(checker.check(paths, CheckOptions{}, report));
+  EXPECT_TRUE(report.ok()) << report.min_clearance_mm;
+}
+
 TEST(Untangle, StuckRobotReachesAFoldWithoutContact) {
   const auto m = two_robots();
   // Robot 2 folded with its capsule towards robot 1; robot 1 half unfolded towards robot 2.
@@ -33,10 +41,7 @@ TEST(Untangle, StuckRobotReachesAFoldWithoutContact) {
   EXPECT_TRUE(r.reached[0]);
   EXPECT_DOUBLE_EQ(r.end[0].beta_deg, 180.0);
   EXPECT_DOUBLE_EQ(r.paths[0].beta.back().deg, 180.0);
-  TrajectoryChecker checker(m);
-  CheckReport report;
-  ASSERT_TRUE(checker.check(r.paths, CheckOptions{}, report));
-  EXPECT_TRUE(report.ok());
+  expect_clear(m, r.paths);
   EXPECT_GT(r.duration_s, 0.0);
 }
 
@@ -65,10 +70,7 @@ TEST(Untangle, RobotAgainstTheAlphaStopNextToAFiducialGetsOut) {
     EXPECT_TRUE(r.reached[0]);
     EXPECT_DOUBLE_EQ(r.end[0].beta_deg, 180.0);
     EXPECT_GE(r.end[0].alpha_deg, 0.0);
-    TrajectoryChecker checker(m);
-    CheckReport report;
-    ASSERT_TRUE(checker.check(r.paths, CheckOptions{}, report));
-    EXPECT_TRUE(report.ok());
+    expect_clear(m, r.paths);
     // Never faster than the engine's speed (1 deg per step of 1/12 s on each arm).
     EXPECT_LE(max_speed(r.paths[0].alpha), 12.0 + 1e-6);
     EXPECT_LE(max_speed(r.paths[0].beta), 12.0 + 1e-6);
@@ -93,10 +95,54 @@ TEST(Untangle, FoldedNeighbourTurnsWithinTheRangeItCanReach) {
   EXPECT_DOUBLE_EQ(r.end[0].beta_deg, 180.0);
   EXPECT_NE(r.end[1].alpha_deg, 90.64);  // the neighbour turned
   EXPECT_DOUBLE_EQ(r.end[1].beta_deg, 180.0);
-  TrajectoryChecker checker(m);
-  CheckReport report;
-  ASSERT_TRUE(checker.check(r.paths, CheckOptions{}, report));
-  EXPECT_TRUE(report.ok());
+  expect_clear(m, r.paths);
+}
+
+// The engine keeps a stuck robot wandering until its stall limit, long after everyone else has
+// stopped: the untangle starts where the others came to rest (robot 2 at 2 s), from the stuck
+// robot's pose then, not after the wander (which ends at 20 s).
+TEST(Untangle, StartsWhenTheOthersHaveStoppedNotAfterTheWander) {
+  const auto m = two_robots();
+  std::vector<StepperRobot> robots{{{10, 40}, {10, 180}, false, nullptr}, {{170, 180}, {180, 180}, false, nullptr}};
+  StepperResult r = stuck_result(robots, {false, true});
+  r.paths[0].alpha = {{0, 10}, {2, 10}, {6, 12}, {10, 10}, {20, 11}};
+  r.paths[0].beta = {{0, 40}, {20, 40}};
+  r.end[0] = {11, 40};
+  r.paths[1] = RobotTrajectory::linear({170, 180}, {180, 180}, 0, 2);
+  r.end[1] = {180, 180};
+  r.duration_s = 20;
+  ASSERT_EQ(untangle_to_fold(m, robots, r, StepperOptions{}), 1u);
+  EXPECT_DOUBLE_EQ(angle_at(r.paths[0].alpha, 2.0), 10.0);
+  for (const TimedAngle& p : r.paths[0].alpha) EXPECT_NE(p.deg, 12.0) << "the wander after 2 s is dropped";
+  EXPECT_DOUBLE_EQ(r.end[0].beta_deg, 180.0);
+  EXPECT_LT(end_time(r.paths[0]), 20.0);
+  EXPECT_DOUBLE_EQ(r.duration_s, end_time(r.paths[0]));
+  expect_clear(m, r.paths);
+}
+
+// Two stuck robots far apart (sites 0 and 12 of a row of 16; robots two sites apart are still
+// neighbours): each starts when its own surroundings have stopped (robot 2 at 1 s, robot 14 at
+// 20 s), not when the last of the plane has.
+TEST(Untangle, FarApartStuckRobotsEachStartWhenTheirSurroundingsStop) {
+  std::vector<RobotSpec> row;
+  for (int k = 0; k < 16; ++k) row.push_back(test::robot_at(k + 1, 22.4 * k, 0));
+  const CollisionModel m = test::build(row);
+  std::vector<StepperRobot> robots(16, StepperRobot{{180, 180}, {180, 180}, false, nullptr});
+  robots[0] = robots[12] = {{10, 40}, {10, 180}, false, nullptr};
+  robots[13].start = {160, 180};
+  std::vector<bool> reached(16, true);
+  reached[0] = reached[12] = false;
+  StepperResult r = stuck_result(robots, reached);
+  r.paths[1] = RobotTrajectory::linear({180, 180}, {180, 180}, 0, 1);
+  r.paths[13] = RobotTrajectory::linear({160, 180}, {180, 180}, 0, 20);
+  r.end[13] = {180, 180};
+  r.duration_s = 20;
+  ASSERT_EQ(untangle_to_fold(m, robots, r, StepperOptions{}), 2u);
+  EXPECT_LT(end_time(r.paths[0]), 20.0);                    // started at 1 s
+  EXPECT_DOUBLE_EQ(angle_at(r.paths[12].beta, 20.0), 40.0);  // still until its neighbour stopped
+  EXPECT_GT(end_time(r.paths[12]), 20.0);
+  EXPECT_DOUBLE_EQ(r.duration_s, end_time(r.paths[12]));
+  expect_clear(m, r.paths);
 }
 
 }  // namespace

@@ -219,136 +219,246 @@ void append_path(RobotTrajectory& t, const std::vector<Pose>& path, double t0, d
   }
 }
 
-}  // namespace
+// Robot i's trajectory ends at time t: each arm at its angle then (the engine's pose at that
+// instant, inside its certificate), the points after it dropped.
+void cut_at(RobotTrajectory& path, double t) {
+  for (auto* arm : {&path.alpha, &path.beta}) {
+    if (arm->back().t_s <= t) continue;
+    const double deg = angle_at(*arm, t);
+    std::erase_if(*arm, [t](const TimedAngle& p) { return p.t_s >= t; });
+    arm->push_back({t, deg});
+  }
+}
 
-std::size_t untangle_to_fold(const CollisionModel& model, std::span<const StepperRobot> robots, StepperResult& result,
-                             const StepperOptions& o, std::size_t max_cells) {
-  const std::size_t n = model.size();
-  std::vector<std::uint32_t> stuck;
-  for (std::size_t i = 0; i < n; ++i)
-    if (!result.reached[i] && !robots[i].frozen && !robots[i].script) stuck.push_back(static_cast<std::uint32_t>(i));
-  if (stuck.empty()) return 0;
-  double t = result.duration_s;
-  for (const auto& p : result.paths) t = std::max({t, p.alpha.back().t_s, p.beta.back().t_s});
-  std::vector<Pose> poses = result.end;
-  std::vector<Segment> segs(n);
-  model.segments(poses, segs);
-  const auto all_pairs = model.robot_pairs();
-  std::size_t done = 0;
-  std::vector<bool> moving(n, false);
-  for (bool progress = true; progress && !stuck.empty();) {
-    progress = false;
-    std::fill(moving.begin(), moving.end(), false);
-    double wave = 0;
+// Robot i and the robots within two rings of neighbours around it.
+std::vector<std::uint32_t> two_rings(const CollisionModel& model, std::uint32_t i) {
+  std::vector<std::uint32_t> out{i};
+  for (const std::uint32_t j : model.neighbours(i)) {
+    out.push_back(j);
+    for (const std::uint32_t k : model.neighbours(j)) out.push_back(k);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+// The stuck robots in zones: a stuck robot and everything within two rings of it (what its own
+// move and its folded neighbours' turns can touch), zones merged where they overlap. No robot of
+// one zone's untangle is then a neighbour of one of another's, so each zone keeps its own clock.
+struct Zone {
+  std::vector<std::uint32_t> stuck;  // model order
+  std::vector<std::uint32_t> area;   // the stuck robots and their two rings
+};
+std::vector<Zone> zones_of(const CollisionModel& model, const std::vector<std::uint32_t>& stuck) {
+  std::vector<std::size_t> parent(stuck.size());
+  for (std::size_t k = 0; k < stuck.size(); ++k) parent[k] = k;
+  std::function<std::size_t(std::size_t)> root = [&](std::size_t k) { return parent[k] == k ? k : parent[k] = root(parent[k]); };
+  std::vector<std::ptrdiff_t> owner(model.size(), -1);
+  std::vector<std::vector<std::uint32_t>> rings(stuck.size());
+  for (std::size_t k = 0; k < stuck.size(); ++k) {
+    rings[k] = two_rings(model, stuck[k]);
+    for (const std::uint32_t r : rings[k]) {
+      if (owner[r] < 0) owner[r] = static_cast<std::ptrdiff_t>(k);
+      else parent[root(k)] = root(static_cast<std::size_t>(owner[r]));
+    }
+  }
+  std::vector<Zone> out;
+  std::vector<std::ptrdiff_t> index(stuck.size(), -1);
+  for (std::size_t k = 0; k < stuck.size(); ++k) {
+    const std::size_t r = root(k);
+    if (index[r] < 0) {
+      index[r] = static_cast<std::ptrdiff_t>(out.size());
+      out.emplace_back();
+    }
+    Zone& z = out[static_cast<std::size_t>(index[r])];
+    z.stuck.push_back(stuck[k]);
+    z.area.insert(z.area.end(), rings[k].begin(), rings[k].end());
+  }
+  for (Zone& z : out) {
+    std::sort(z.area.begin(), z.area.end());
+    z.area.erase(std::unique(z.area.begin(), z.area.end()), z.area.end());
+  }
+  return out;
+}
+
+// The untangle of a half's stuck robots, zone by zone (untangle_to_fold).
+class Untangler {
+ public:
+  Untangler(const CollisionModel& model, std::span<const StepperRobot> robots, StepperResult& result,
+            const StepperOptions& o, std::size_t max_cells)
+      : model_(model), robots_(robots), result_(result), o_(o), max_cells_(max_cells), poses_(result.end),
+        segs_(model.size()), moving_(model.size(), false), stuck_(model.size(), false), pairs_(model.robot_pairs()) {
+    model.segments(poses_, segs_);
+  }
+
+  // From when everything in the zone but its stuck robots has stopped for good: the stuck robots
+  // wander on after that until the engine's stall limit, so their paths are cut there (that
+  // instant is certified clear, and everything they can touch is still from then on). Then waves:
+  // stuck robots that are not neighbours of each other move at once, while they make progress.
+  // Returns how many reached a fold.
+  std::size_t run_zone(const Zone& z) {
+    double t = 0;
+    for (const std::uint32_t r : z.stuck) stuck_[r] = true;
+    for (const std::uint32_t r : z.area)
+      if (!stuck_[r]) t = std::max(t, end_time(result_.paths[r]));
+    for (const std::uint32_t i : z.stuck) {
+      cut_at(result_.paths[i], t);
+      poses_[i] = result_.end[i] = {result_.paths[i].alpha.back().deg, result_.paths[i].beta.back().deg};
+      segs_[i] = model_.robot(i).collision_segment(poses_[i]);
+    }
+    std::size_t done = 0;
+    std::vector<std::uint32_t> left = z.stuck;
+    for (bool progress = true; progress && !left.empty();) {
+      std::fill(moving_.begin(), moving_.end(), false);
+      const std::size_t before = left.size();
+      left = wave(left, t);
+      progress = left.size() < before;
+      done += before - left.size();
+    }
+    return done;
+  }
+
+ private:
+  // One wave from time t (t advances past it); returns the robots still stuck.
+  std::vector<std::uint32_t> wave(const std::vector<std::uint32_t>& stuck, double& t) {
+    double length = 0;
     std::vector<std::uint32_t> left;
     for (const std::uint32_t i : stuck) {
-      const auto nb = model.neighbours(i);
-      if (std::any_of(nb.begin(), nb.end(), [&](std::uint32_t j) { return moving[j]; })) {
+      const auto nb = model_.neighbours(i);
+      if (std::any_of(nb.begin(), nb.end(), [&](std::uint32_t j) { return moving_[j]; })) {
         left.push_back(i);
         continue;
       }
-      std::vector<Fixed> fixed;
-      const auto pairs = model.pairs_of(i);
-      if (std::any_of(nb.begin(), nb.end(), [&](std::uint32_t j) { return moving[j]; })) {
-        left.push_back(i);
-        continue;
-      }
-      for (std::size_t k = 0; k < nb.size(); ++k) fixed.push_back({segs[nb[k]], all_pairs[pairs[k]].limit_mm});
-      add_obstacles(model, i, fixed);
-      const double fold = robots[i].goal.beta_deg;
-      GridPath path = find_fold(model.robot(i), fixed, poses[i], fold, o, max_cells);
-      if (path.poses.empty() && !std::any_of(moving.begin(), moving.end(), [](bool b) { return b; })) {
-        // Folded neighbours can turn freely (folded robots never touch): turn each so that its
-        // folded capsule lies across the line to this robot's centre, as far as the unfolded
-        // robots around it allow, all at once while everyone else stands still; then search again.
-        std::vector<Segment> sweep;
-        for (double b = poses[i].beta_deg;; b += (fold > b ? 5.0 : -5.0)) {
-          const bool end = std::abs(fold - b) <= 5.0;
-          sweep.push_back(model.robot(i).collision_segment({poses[i].alpha_deg, end ? fold : b}));
-          if (end) break;
-        }
-        auto folded = [&](std::size_t j) {
-          return result.reached[j] && !robots[j].frozen && !robots[j].script && poses[j].beta_deg == robots[j].goal.beta_deg &&
-                 std::find(stuck.begin(), stuck.end(), j) == stuck.end();
-        };
-        double slot = 0;
-        std::vector<std::pair<std::uint32_t, std::vector<Pose>>> turns;
-        for (const std::uint32_t j : nb) {
-          if (!folded(j)) continue;
-          const Positioner& rj = model.robot(j);
-          const AngleLimits& lj = rj.limits();
-          // Clearance of the folded capsule to this robot's straight fold (beta alone, sampled).
-          auto sweep_clearance = [&](const Segment& sj) {
-            double c = std::numeric_limits<double>::infinity();
-            for (const Segment& si : sweep) c = std::min(c, segment_distance(si, sj));
-            return c;
-          };
-          std::vector<Fixed> fj;
-          const auto nbj = model.neighbours(j);
-          const auto pj = model.pairs_of(j);
-          for (std::size_t k = 0; k < nbj.size(); ++k)
-            if (!folded(nbj[k])) fj.push_back({segs[nbj[k]], all_pairs[pj[k]].limit_mm});
-          add_obstacles(model, j, fj);
-          RobotGrid gj(rj, std::move(fj), poses[j], o.alpha_step_deg, o.beta_step_deg, o.margin_mm);
-          // How far it can turn either way (the unfolded robots, often this one, may stop it);
-          // the best alpha within that range.
-          const double lo = gj.walk_to({lj.alpha_min_deg, poses[j].beta_deg}).back().alpha_deg;
-          const double hi = gj.walk_to({lj.alpha_max_deg, poses[j].beta_deg}).back().alpha_deg;
-          double best_a = poses[j].alpha_deg, best_d = sweep_clearance(segs[j]);
-          auto consider = [&](double a) {
-            const double d = sweep_clearance(rj.collision_segment({a, poses[j].beta_deg}));
-            if (d > best_d + 0.5 || (d > best_d - 1e-6 && std::abs(a - poses[j].alpha_deg) < std::abs(best_a - poses[j].alpha_deg))) {
-              best_d = d;
-              best_a = a;
-            }
-          };
-          for (double a = std::ceil(lo / 5) * 5; a <= hi; a += 5) consider(a);
-          consider(lo);
-          consider(hi);
-          if (best_a == poses[j].alpha_deg) continue;
-          std::vector<Pose> w = gj.walk_to({best_a, poses[j].beta_deg});
-          if (w.size() < 2) continue;
-          slot = std::max(slot, static_cast<double>(w.size() - 1) * o.dt_s);
-          turns.emplace_back(j, std::move(w));
-        }
-        if (!turns.empty()) {
-          std::vector<Fixed> fixed2;
-          std::vector<Segment> segs2 = segs;
-          for (const auto& [j, w] : turns) segs2[j] = model.robot(j).collision_segment(w.back());
-          for (std::size_t k = 0; k < nb.size(); ++k) fixed2.push_back({segs2[nb[k]], all_pairs[pairs[k]].limit_mm});
-          add_obstacles(model, i, fixed2);
-          path = find_fold(model.robot(i), fixed2, poses[i], fold, o, max_cells);
-          if (!path.poses.empty()) {
-            for (const auto& [j, w] : turns) {
-              append_path(result.paths[j], w, t, o.dt_s);
-              poses[j] = w.back();
-              segs[j] = segs2[j];
-              result.end[j] = poses[j];
-              moving[j] = true;
-            }
-            t += slot;
-          }
-        }
-      }
+      const double fold = robots_[i].goal.beta_deg;
+      GridPath path = find_fold(model_.robot(i), around(i, segs_), poses_[i], fold, o_, max_cells_);
+      if (path.poses.empty() && std::none_of(moving_.begin(), moving_.end(), [](bool b) { return b; }))
+        path = make_way(i, fold, t);
       if (path.poses.empty()) {
         left.push_back(i);
         continue;
       }
-      append_path(result.paths[i], path.poses, t, path.dt);
-      wave = std::max(wave, static_cast<double>(path.poses.size() - 1) * path.dt);
-      poses[i] = path.poses.back();
-      segs[i] = model.robot(i).collision_segment(poses[i]);
-      result.end[i] = poses[i];
-      result.reached[i] = true;
-      result.blockers[i].clear();
-      moving[i] = true;
-      progress = true;
-      ++done;
+      append_path(result_.paths[i], path.poses, t, path.dt);
+      length = std::max(length, static_cast<double>(path.poses.size() - 1) * path.dt);
+      poses_[i] = result_.end[i] = path.poses.back();
+      segs_[i] = model_.robot(i).collision_segment(poses_[i]);
+      result_.reached[i] = true;
+      result_.blockers[i].clear();
+      moving_[i] = true;
+      stuck_[i] = false;
     }
-    stuck = std::move(left);
-    t += wave;
+    t += length;
+    return left;
   }
-  result.duration_s = std::max(result.duration_s, t);
+
+  // Robot i's neighbours (at `segs`) and fixed obstacles, each with its pair's limit.
+  std::vector<Fixed> around(std::size_t i, const std::vector<Segment>& segs) const {
+    std::vector<Fixed> fixed;
+    const auto nb = model_.neighbours(i);
+    const auto pairs = model_.pairs_of(i);
+    for (std::size_t k = 0; k < nb.size(); ++k) fixed.push_back({segs[nb[k]], pairs_[pairs[k]].limit_mm});
+    add_obstacles(model_, i, fixed);
+    return fixed;
+  }
+
+  [[nodiscard]] bool folded(std::size_t j) const {
+    return result_.reached[j] && !robots_[j].frozen && !robots_[j].script && poses_[j].beta_deg == robots_[j].goal.beta_deg &&
+           !stuck_[j];
+  }
+
+  // Folded neighbours can turn freely (folded robots never touch): each turns so that its folded
+  // capsule lies across the line to robot i's centre, as far as the unfolded robots around it
+  // allow, all at once while everyone else stands still; then robot i's way out is searched again.
+  // Taken (the turns appended at t, t past them) only when that finds one.
+  GridPath make_way(std::size_t i, double fold, double& t) {
+    std::vector<Segment> sweep;
+    for (double b = poses_[i].beta_deg;; b += (fold > b ? 5.0 : -5.0)) {
+      const bool end = std::abs(fold - b) <= 5.0;
+      sweep.push_back(model_.robot(i).collision_segment({poses_[i].alpha_deg, end ? fold : b}));
+      if (end) break;
+    }
+    double slot = 0;
+    std::vector<std::pair<std::uint32_t, std::vector<Pose>>> turns;
+    for (const std::uint32_t j : model_.neighbours(i)) {
+      if (!folded(j)) continue;
+      std::vector<Pose> w = turn_aside(j, sweep);
+      if (w.size() < 2) continue;
+      slot = std::max(slot, static_cast<double>(w.size() - 1) * o_.dt_s);
+      turns.emplace_back(j, std::move(w));
+    }
+    if (turns.empty()) return {};
+    std::vector<Segment> segs2 = segs_;
+    for (const auto& [j, w] : turns) segs2[j] = model_.robot(j).collision_segment(w.back());
+    GridPath path = find_fold(model_.robot(i), around(i, segs2), poses_[i], fold, o_, max_cells_);
+    if (path.poses.empty()) return {};
+    for (const auto& [j, w] : turns) {
+      append_path(result_.paths[j], w, t, o_.dt_s);
+      poses_[j] = result_.end[j] = w.back();
+      segs_[j] = segs2[j];
+      moving_[j] = true;
+    }
+    t += slot;
+    return path;
+  }
+
+  // Folded robot j's turn to the alpha (within the range it can reach, the unfolded robots around
+  // it in the way) that keeps its capsule farthest from `sweep`; just its pose when none is better.
+  std::vector<Pose> turn_aside(std::uint32_t j, const std::vector<Segment>& sweep) const {
+    const Positioner& rj = model_.robot(j);
+    const AngleLimits& lj = rj.limits();
+    auto sweep_clearance = [&](const Segment& sj) {
+      double c = std::numeric_limits<double>::infinity();
+      for (const Segment& si : sweep) c = std::min(c, segment_distance(si, sj));
+      return c;
+    };
+    std::vector<Fixed> fj;
+    const auto nbj = model_.neighbours(j);
+    const auto pj = model_.pairs_of(j);
+    for (std::size_t k = 0; k < nbj.size(); ++k)
+      if (!folded(nbj[k])) fj.push_back({segs_[nbj[k]], pairs_[pj[k]].limit_mm});
+    add_obstacles(model_, j, fj);
+    RobotGrid gj(rj, std::move(fj), poses_[j], o_.alpha_step_deg, o_.beta_step_deg, o_.margin_mm);
+    const double lo = gj.walk_to({lj.alpha_min_deg, poses_[j].beta_deg}).back().alpha_deg;
+    const double hi = gj.walk_to({lj.alpha_max_deg, poses_[j].beta_deg}).back().alpha_deg;
+    double best_a = poses_[j].alpha_deg, best_d = sweep_clearance(segs_[j]);
+    auto consider = [&](double a) {
+      const double d = sweep_clearance(rj.collision_segment({a, poses_[j].beta_deg}));
+      if (d > best_d + 0.5 || (d > best_d - 1e-6 && std::abs(a - poses_[j].alpha_deg) < std::abs(best_a - poses_[j].alpha_deg))) {
+        best_d = d;
+        best_a = a;
+      }
+    };
+    for (double a = std::ceil(lo / 5) * 5; a <= hi; a += 5) consider(a);
+    consider(lo);
+    consider(hi);
+    if (best_a == poses_[j].alpha_deg) return {poses_[j]};
+    return gj.walk_to({best_a, poses_[j].beta_deg});
+  }
+
+  const CollisionModel& model_;
+  std::span<const StepperRobot> robots_;
+  StepperResult& result_;
+  const StepperOptions& o_;
+  std::size_t max_cells_;
+  std::vector<Pose> poses_;
+  std::vector<Segment> segs_;
+  std::vector<bool> moving_;  // moving in the current wave
+  std::vector<bool> stuck_;   // of the zone, not yet untangled
+  std::span<const RobotPair> pairs_;
+};
+
+}  // namespace
+
+std::size_t untangle_to_fold(const CollisionModel& model, std::span<const StepperRobot> robots, StepperResult& result,
+                             const StepperOptions& o, std::size_t max_cells) {
+  std::vector<std::uint32_t> stuck;
+  for (std::size_t i = 0; i < model.size(); ++i)
+    if (!result.reached[i] && !robots[i].frozen && !robots[i].script) stuck.push_back(static_cast<std::uint32_t>(i));
+  if (stuck.empty()) return 0;
+  Untangler u(model, robots, result, o, max_cells);
+  std::size_t done = 0;
+  for (const Zone& z : zones_of(model, stuck)) done += u.run_zone(z);
+  result.duration_s = 0;
+  for (const auto& p : result.paths) result.duration_s = std::max(result.duration_s, end_time(p));
   return done;
 }
 

@@ -9,9 +9,14 @@
 // margin). Breadth-first search over the 8-connected grid (one engine step per edge) finds the
 // quickest way out if there is one at this resolution.
 //
-// Robots are moved in waves: in a wave, stuck robots that are not neighbours of each other move at
-// once (neighbours of a moving robot wait for the next wave, so every plan sees still neighbours);
-// waves repeat while they make progress. The paths are appended after the half's end.
+// The stuck robots are grouped in zones (a stuck robot and two rings of neighbours around it, zones
+// that overlap merged): no robot one zone's untangle moves is a neighbour of one another's moves,
+// so each zone keeps a clock of its own. A zone starts when everything in it but its stuck robots
+// has stopped for good; the stuck robots' paths are cut at that instant (the engine kept them
+// wandering until its stall limit, a certified but useless 20 s). Within a zone robots move in
+// waves: stuck robots that are not neighbours of each other move at once (neighbours of a moving
+// robot wait for the next wave, so every plan sees still neighbours); waves repeat while they make
+// progress.
 #pragma once
 
 #include "axon/fps/plan/collision.hpp"
@@ -24,8 +29,9 @@
 namespace axon::fps::plan {
 
 // `robots` and `result` as from drive_to_goals (goals are folds at `fold_beta_deg`). Robots not
-// reached whose goal beta is the fold beta are untangled where possible: their paths, `end`,
-// `reached` and the result's duration are updated. Returns how many were untangled.
+// reached whose goal beta is the fold beta are untangled where possible: their paths (cut where
+// their zone comes to rest, the untangle appended), `end`, `reached` and the result's duration
+// (the last point of any path) are updated. Returns how many were untangled.
 std::size_t untangle_to_fold(const CollisionModel& model, std::span<const StepperRobot> robots, StepperResult& result,
                              const StepperOptions& options, std::size_t max_cells_per_robot = 200'000);
 
