@@ -145,5 +145,27 @@ TEST(Untangle, FarApartStuckRobotsEachStartWhenTheirSurroundingsStop) {
   expect_clear(m, r.paths);
 }
 
+// A stuck robot needs only its neighbours still to move on its own: it starts when they have
+// stopped (robot 2 at 1 s), not when their neighbours have (robot 4, three sites away, at 20 s).
+TEST(Untangle, AStuckRobotStartsWhenItsNeighboursStopNotTheirs) {
+  std::vector<RobotSpec> row;
+  for (int k = 0; k < 6; ++k) row.push_back(test::robot_at(k + 1, 22.4 * k, 0));
+  const CollisionModel m = test::build(row);
+  std::vector<StepperRobot> robots(6, StepperRobot{{180, 180}, {180, 180}, false, nullptr});
+  robots[0] = {{10, 40}, {10, 180}, false, nullptr};
+  robots[3].start = {160, 180};
+  std::vector<bool> reached(6, true);
+  reached[0] = false;
+  StepperResult r = stuck_result(robots, reached);
+  r.paths[1] = RobotTrajectory::linear({180, 180}, {180, 180}, 0, 1);
+  r.paths[3] = RobotTrajectory::linear({160, 180}, {180, 180}, 0, 20);
+  r.end[3] = {180, 180};
+  ASSERT_EQ(untangle_to_fold(m, robots, r, StepperOptions{}), 1u);
+  EXPECT_LT(angle_at(r.paths[0].beta, 2.0), angle_at(r.paths[0].beta, 5.0));  // on its way by then
+  EXPECT_LT(end_time(r.paths[0]), 20.0);
+  EXPECT_DOUBLE_EQ(r.end[0].beta_deg, 180.0);
+  expect_clear(m, r.paths);
+}
+
 }  // namespace
 }  // namespace axon::fps::plan

@@ -247,17 +247,14 @@ std::vector<std::uint32_t> two_rings(const CollisionModel& model, std::uint32_t 
 // one zone's untangle is then a neighbour of one of another's, so each zone keeps its own clock.
 struct Zone {
   std::vector<std::uint32_t> stuck;  // model order
-  std::vector<std::uint32_t> area;   // the stuck robots and their two rings
 };
 std::vector<Zone> zones_of(const CollisionModel& model, const std::vector<std::uint32_t>& stuck) {
   std::vector<std::size_t> parent(stuck.size());
   for (std::size_t k = 0; k < stuck.size(); ++k) parent[k] = k;
   std::function<std::size_t(std::size_t)> root = [&](std::size_t k) { return parent[k] == k ? k : parent[k] = root(parent[k]); };
   std::vector<std::ptrdiff_t> owner(model.size(), -1);
-  std::vector<std::vector<std::uint32_t>> rings(stuck.size());
   for (std::size_t k = 0; k < stuck.size(); ++k) {
-    rings[k] = two_rings(model, stuck[k]);
-    for (const std::uint32_t r : rings[k]) {
+    for (const std::uint32_t r : two_rings(model, stuck[k])) {
       if (owner[r] < 0) owner[r] = static_cast<std::ptrdiff_t>(k);
       else parent[root(k)] = root(static_cast<std::size_t>(owner[r]));
     }
@@ -270,13 +267,7 @@ std::vector<Zone> zones_of(const CollisionModel& model, const std::vector<std::u
       index[r] = static_cast<std::ptrdiff_t>(out.size());
       out.emplace_back();
     }
-    Zone& z = out[static_cast<std::size_t>(index[r])];
-    z.stuck.push_back(stuck[k]);
-    z.area.insert(z.area.end(), rings[k].begin(), rings[k].end());
-  }
-  for (Zone& z : out) {
-    std::sort(z.area.begin(), z.area.end());
-    z.area.erase(std::unique(z.area.begin(), z.area.end()), z.area.end());
+    out[static_cast<std::size_t>(index[r])].stuck.push_back(stuck[k]);
   }
   return out;
 }
@@ -287,25 +278,16 @@ class Untangler {
   Untangler(const CollisionModel& model, std::span<const StepperRobot> robots, StepperResult& result,
             const StepperOptions& o, std::size_t max_cells)
       : model_(model), robots_(robots), result_(result), o_(o), max_cells_(max_cells), poses_(result.end),
-        segs_(model.size()), moving_(model.size(), false), stuck_(model.size(), false), pairs_(model.robot_pairs()) {
+        segs_(model.size()), moving_(model.size(), false), stuck_(model.size(), false), cut_(model.size(), 0.0), pairs_(model.robot_pairs()) {
     model.segments(poses_, segs_);
   }
 
-  // From when everything in the zone but its stuck robots has stopped for good: the stuck robots
-  // wander on after that until the engine's stall limit, so their paths are cut there (that
-  // instant is certified clear, and everything they can touch is still from then on). Then waves:
-  // stuck robots that are not neighbours of each other move at once, while they make progress.
-  // Returns how many reached a fold.
+  // The zone's stuck robots in waves, while they make progress: stuck robots that are not
+  // neighbours of each other move in the same wave. Each stuck robot first has its path cut (see
+  // cut_clusters) and starts no earlier than that. Returns how many reached a fold.
   std::size_t run_zone(const Zone& z) {
-    double t = 0;
     for (const std::uint32_t r : z.stuck) stuck_[r] = true;
-    for (const std::uint32_t r : z.area)
-      if (!stuck_[r]) t = std::max(t, end_time(result_.paths[r]));
-    for (const std::uint32_t i : z.stuck) {
-      cut_at(result_.paths[i], t);
-      poses_[i] = result_.end[i] = {result_.paths[i].alpha.back().deg, result_.paths[i].beta.back().deg};
-      segs_[i] = model_.robot(i).collision_segment(poses_[i]);
-    }
+    double t = cut_clusters(z);
     std::size_t done = 0;
     std::vector<std::uint32_t> left = z.stuck;
     for (bool progress = true; progress && !left.empty();) {
@@ -319,9 +301,49 @@ class Untangler {
   }
 
  private:
-  // One wave from time t (t advances past it); returns the robots still stuck.
+  // The engine keeps a stuck robot wandering until its stall limit, long after the robots around
+  // it have stopped. A cluster of stuck robots (neighbours of each other) has its paths cut when
+  // every robot next to one of them has stopped for good: that instant is certified clear, and
+  // from then on nothing that can touch them moves. Returns the earliest cut of the zone.
+  double cut_clusters(const Zone& z) {
+    double first = std::numeric_limits<double>::infinity();
+    std::vector<bool> seen(model_.size(), false);
+    for (const std::uint32_t from : z.stuck) {
+      if (seen[from]) continue;
+      std::vector<std::uint32_t> cluster{from};
+      seen[from] = true;
+      double cut = 0;
+      for (std::size_t k = 0; k < cluster.size(); ++k)
+        for (const std::uint32_t j : model_.neighbours(cluster[k])) {
+          if (!stuck_[j]) cut = std::max(cut, end_time(result_.paths[j]));
+          else if (!seen[j]) {
+            seen[j] = true;
+            cluster.push_back(j);
+          }
+        }
+      for (const std::uint32_t i : cluster) {
+        cut_at(result_.paths[i], cut);
+        cut_[i] = cut;
+        poses_[i] = result_.end[i] = {result_.paths[i].alpha.back().deg, result_.paths[i].beta.back().deg};
+        segs_[i] = model_.robot(i).collision_segment(poses_[i]);
+      }
+      first = std::min(first, cut);
+    }
+    return first;
+  }
+
+  // When everything within two rings of robot i is still for good (the stuck robots there cut):
+  // from then on its folded neighbours may turn out of its way.
+  [[nodiscard]] double rest_around(std::uint32_t i) const {
+    double t = 0;
+    for (const std::uint32_t r : two_rings(model_, i)) t = std::max(t, stuck_[r] ? cut_[r] : end_time(result_.paths[r]));
+    return t;
+  }
+
+  // One wave from time t (t advances past it); returns the robots still stuck. A robot starts at
+  // t or at its cut, whichever is later.
   std::vector<std::uint32_t> wave(const std::vector<std::uint32_t>& stuck, double& t) {
-    double length = 0;
+    double end = t;
     std::vector<std::uint32_t> left;
     for (const std::uint32_t i : stuck) {
       const auto nb = model_.neighbours(i);
@@ -330,15 +352,20 @@ class Untangler {
         continue;
       }
       const double fold = robots_[i].goal.beta_deg;
+      double start = std::max(t, cut_[i]);
       GridPath path = find_fold(model_.robot(i), around(i, segs_), poses_[i], fold, o_, max_cells_);
-      if (path.poses.empty() && std::none_of(moving_.begin(), moving_.end(), [](bool b) { return b; }))
-        path = make_way(i, fold, t);
+      if (path.poses.empty() && std::none_of(moving_.begin(), moving_.end(), [](bool b) { return b; })) {
+        // Nothing moves in this wave yet: the turns go first, the wave starts after them.
+        start = std::max(start, rest_around(i));
+        path = make_way(i, fold, start);
+        if (!path.poses.empty()) end = t = start;
+      }
       if (path.poses.empty()) {
         left.push_back(i);
         continue;
       }
-      append_path(result_.paths[i], path.poses, t, path.dt);
-      length = std::max(length, static_cast<double>(path.poses.size() - 1) * path.dt);
+      append_path(result_.paths[i], path.poses, start, path.dt);
+      end = std::max(end, start + static_cast<double>(path.poses.size() - 1) * path.dt);
       poses_[i] = result_.end[i] = path.poses.back();
       segs_[i] = model_.robot(i).collision_segment(poses_[i]);
       result_.reached[i] = true;
@@ -346,7 +373,7 @@ class Untangler {
       moving_[i] = true;
       stuck_[i] = false;
     }
-    t += length;
+    t = end;
     return left;
   }
 
@@ -443,6 +470,7 @@ class Untangler {
   std::vector<Segment> segs_;
   std::vector<bool> moving_;  // moving in the current wave
   std::vector<bool> stuck_;   // of the zone, not yet untangled
+  std::vector<double> cut_;   // per stuck robot: where its path was cut (it starts no earlier)
   std::span<const RobotPair> pairs_;
 };
 

@@ -11,12 +11,13 @@
 //
 // The stuck robots are grouped in zones (a stuck robot and two rings of neighbours around it, zones
 // that overlap merged): no robot one zone's untangle moves is a neighbour of one another's moves,
-// so each zone keeps a clock of its own. A zone starts when everything in it but its stuck robots
-// has stopped for good; the stuck robots' paths are cut at that instant (the engine kept them
-// wandering until its stall limit, a certified but useless 20 s). Within a zone robots move in
-// waves: stuck robots that are not neighbours of each other move at once (neighbours of a moving
-// robot wait for the next wave, so every plan sees still neighbours); waves repeat while they make
-// progress.
+// so each zone keeps a clock of its own. The engine keeps stuck robots wandering until its stall
+// limit (a certified but useless 20 s): a cluster of stuck robots that touch each other has its
+// paths cut as soon as every robot next to one of them has stopped for good, and starts from there.
+// Turning folded neighbours out of the way waits until everything within two rings has stopped.
+// Within a zone robots move in waves: stuck robots that are not neighbours of each other move at
+// once (neighbours of a moving robot wait for the next wave, so every plan sees still
+// neighbours); waves repeat while they make progress.
 #pragma once
 
 #include "axon/fps/plan/collision.hpp"
