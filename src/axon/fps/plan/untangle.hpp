@@ -30,8 +30,8 @@
 namespace axon::fps::plan {
 
 // `robots` and `result` as from drive_to_goals (goals are folds at `fold_beta_deg`). Robots not
-// reached whose goal beta is the fold beta are untangled where possible: their paths (cut where
-// their zone comes to rest, the untangle appended), `end`, `reached` and the result's duration
+// reached whose goal beta is the fold beta are untangled where possible: their paths (cut once their
+// neighbours have stopped, the untangle appended), `end`, `reached` and the result's duration
 // (the last point of any path) are updated. Returns how many were untangled.
 std::size_t untangle_to_fold(const CollisionModel& model, std::span<const StepperRobot> robots, StepperResult& result,
                              const StepperOptions& options, std::size_t max_cells_per_robot = 200'000);
