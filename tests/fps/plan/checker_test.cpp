@@ -2,6 +2,7 @@
 // sampling step, the advancing method against brute force.
 #include "axon/fps/plan/checker.hpp"
 #include "model_util.hpp"
+#include "support/short_run.hpp"
 
 #include <gtest/gtest.h>
 
@@ -219,7 +220,9 @@ struct RandomPatchMove {
 
 TEST(PlanChecker, AdvancingAgreesWithBruteForceOnRandomPatchMoves) {
   std::size_t contacts = 0, close = 0;
-  for (unsigned seed = 1; seed <= 3; ++seed) {
+  // Under AXON_TEST_SHORT one move (seed 2: 35 contacts and 7 near misses of its own).
+  const std::vector<unsigned> seeds = test_support::short_run() ? std::vector<unsigned>{2} : std::vector<unsigned>{1, 2, 3};
+  for (const unsigned seed : seeds) {
     RandomPatchMove mv(seed, 4);
     TrajectoryChecker checker(mv.model);
     CheckReport r;
@@ -245,8 +248,8 @@ TEST(PlanChecker, AdvancingAgreesWithBruteForceOnRandomPatchMoves) {
     }
   }
   // The moves exercise both cases.
-  EXPECT_GT(contacts, 20u);
-  EXPECT_GT(close, 10u);
+  EXPECT_GT(contacts, 20u * seeds.size() / 3);
+  EXPECT_GT(close, 10u * seeds.size() / 3);
 }
 
 TEST(PlanChecker, AdvancingGivesTheSameReportWithOneOrTwoThreadsAndFewerEvaluations) {

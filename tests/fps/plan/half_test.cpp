@@ -5,6 +5,7 @@
 #include "axon/fps/plan/phases.hpp"
 #include "axon/fps/plan/problems.hpp"
 #include "model_util.hpp"
+#include "support/short_run.hpp"
 
 #include <gtest/gtest.h>
 
@@ -126,7 +127,8 @@ TEST(PlanHalf, TheTailNeverLengthensAHalfNorLeavesMoreShortAndStaysContactFree) 
   // no more robots short, and the checker proves its paths contact-free; on some it ends earlier.
   const CollisionModel model = build(hex_patch(3));
   int late_seen = 0, shortened = 0;
-  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+  const auto seeds = static_cast<std::uint64_t>(test_support::cases(12));
+  for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
     PlanRequest request;
     request.current = random_poses(model, 100 + seed);
     request.target = random_poses(model, 200 + seed);
@@ -168,8 +170,9 @@ TEST(PlanHalf, PairedRunsGiveTheSamePlanWithOrWithoutASpareCore) {
   repairs.tail_retries = 0;
   repairs.untangle = false;
   int repaired = 0, more = 0;
+  const auto seeds = static_cast<std::uint64_t>(test_support::cases(8));
   for (const PlannerOptions& o : {repairs, PlannerOptions{}}) {
-    for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
       PlanRequest request;
       request.current = random_poses(model, 300 + seed);
       request.target = random_poses(model, 400 + seed);
