@@ -92,6 +92,17 @@ SimRun run_sim(std::uint16_t port, std::string_view yaml, double max_s = 20) {
   return r;
 }
 
+// The simulator's run ends once it has sent its last packet; the server's cycle thread may not have
+// taken that one yet (on a loaded machine it runs a cycle or two behind: seen under ctest -j4, where
+// a test missed the controller's final exit-from-open request). Waits, at most 2 s, until the server
+// has received every packet the simulator sent, then stops it.
+void stop_after_last_packet(H::Server& server, const SimRun& run) {
+  const std::uint64_t sent = run.c->stats().packets_sent;
+  for (int i = 0; i < 200 && server.counters().packets.load() < sent; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  server.stop();
+}
+
 bool all_modes(const P::Packet& p, std::int32_t m) {
   for (std::size_t i = 0; i < p.count; ++i)
     if (p.axes[i].mode != m) return false;
@@ -127,7 +138,7 @@ TEST(ServerAgainstSim, Mode8VelocityContributionShiftsTheAxisThenExitFromOpenEnd
   - move: {arm: 1, deg: [2, 0, 0, 0, 0, 0], duration: 0.2}
   - wait_for_pc: {timeout: 5}
   - exit_open)");
-  server->stop();
+  stop_after_last_packet(*server, run);
   EXPECT_TRUE(run.c->scenario_done()) << run.log();
   EXPECT_FALSE(run.c->communication_error());
   EXPECT_EQ(run.c->stats().refused_requests, 0u);
@@ -154,7 +165,7 @@ TEST(ServerAgainstSim, Mode9CurrentContributionIsSaturatedByTheServerBeforeTheCo
   - go_open: {type: B, mode: 9, arms: [1]}
   - wait_for_pc: {timeout: 5}
   - exit_open)");
-  server->stop();
+  stop_after_last_packet(*server, run);
   EXPECT_TRUE(run.c->scenario_done()) << run.log();
   EXPECT_FALSE(run.has(S::event::kFollowErrorController)) << run.log();
   EXPECT_GE(server->safety().counters().currents_clamped.load(), 5u);
@@ -342,7 +353,7 @@ TEST(ServerAgainstSim, ActiveFreezing500ToleratesAStalledPcUntilExitFromOpen) {
   - drive_on
   - delay: 1.0
   - exit_open)");
-  server->stop();
+  stop_after_last_packet(*server, run);
   EXPECT_TRUE(run.c->scenario_done()) << run.log();
   EXPECT_FALSE(run.c->communication_error()) << run.log();
   EXPECT_TRUE(run.has(S::event::kFreezing, "active freezing (500)")) << run.log();
@@ -443,7 +454,7 @@ TEST(ServerAgainstSim, FreezeRequestedOutsideMode0WaitsForMode0) {
   - wait_for_pc: {timeout: 5}
   - delay: 0.5
   - exit_open)");
-  server->stop();
+  stop_after_last_packet(*server, run);
   EXPECT_TRUE(run.c->scenario_done()) << run.log();
   EXPECT_TRUE(asked.load());
   EXPECT_FALSE(frozen_in7.load());
@@ -476,7 +487,7 @@ TEST(ServerAgainstSim, ForbiddenModeRequestsAreRefusedByTheServerAndNeverReachTh
   - move: {arm: 1, deg: [1, 0, 0, 0, 0, 0], duration: 0.2}
   - wait_for_pc: {timeout: 5}
   - exit_open)");
-  server->stop();
+  stop_after_last_packet(*server, run);
   EXPECT_TRUE(run.c->scenario_done()) << run.log();
   EXPECT_GE(server->counters().refused_mode_changes.load(), 29u);
   EXPECT_EQ(run.c->stats().refused_requests, 0u) << run.log();
@@ -512,7 +523,7 @@ TEST(ServerAgainstSim, ThePcSetsAnOpenModeFromMode0AndBothSidesAgree) {
   - drive_on
   - delay: 1.0
   - exit_open)");
-  server->stop();
+  stop_after_last_packet(*server, run);
   EXPECT_TRUE(run.c->scenario_done()) << run.log();
   EXPECT_EQ(run.c->stats().refused_requests, 0u) << run.log();
   EXPECT_GE(server->counters().refused_mode_changes.load(), 1u);  // the ones during 501
