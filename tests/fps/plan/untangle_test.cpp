@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 namespace axon::fps::plan {
@@ -43,6 +44,26 @@ TEST(Untangle, StuckRobotReachesAFoldWithoutContact) {
   EXPECT_DOUBLE_EQ(r.paths[0].beta.back().deg, 180.0);
   expect_clear(m, r.paths);
   EXPECT_GT(r.duration_s, 0.0);
+}
+
+// A robot alone, half unfolded at alpha 10, planned to fold at alpha 100. Folding straight takes
+// 140 steps and leaves a 90-step turn for later; turning alpha on the way folds it at alpha 100 in
+// the same 140 steps.
+TEST(Untangle, TheWayOutEndsAtThePlannedAlphaWhenThatIsQuickestWithTheTurnAfter) {
+  const std::vector<RobotSpec> specs{RobotSpec{1, {0, 0}, {}, {}, 2.0}};
+  auto built = CollisionModel::build(specs, ArmDesign{}, std::vector<FiducialSpec>{});
+  ASSERT_TRUE(built) << built.error().message();
+  const CollisionModel& m = built.value();
+  const StepperOptions o;
+  std::vector<StepperRobot> robots{{{10, 40}, {100, 180}, false, nullptr}};
+  StepperResult r = stuck_result(robots, {false});
+  ASSERT_EQ(untangle_to_fold(m, robots, r, o), 1u);
+  EXPECT_DOUBLE_EQ(r.end[0].beta_deg, 180.0);
+  EXPECT_NEAR(r.end[0].alpha_deg, 100.0, 1e-9);
+  const double turn_after = std::abs(r.end[0].alpha_deg - 100.0) / o.alpha_step_deg * o.dt_s;
+  EXPECT_LE(end_time(r.paths[0]) + turn_after, 140 * o.dt_s + 1e-9);
+  EXPECT_LE(max_speed(r.paths[0].alpha), 12.0 + 1e-6);
+  expect_clear(m, r.paths);
 }
 
 TEST(Untangle, RobotsAlreadyReachedAreLeftAlone) {

@@ -7,6 +7,7 @@
 #include <limits>
 #include <functional>
 #include <numbers>
+#include <optional>
 #include <queue>
 #include <tuple>
 #include <string>
@@ -29,9 +30,11 @@ class RobotGrid {
       : r_(r), fixed_(std::move(fixed)), start_(start), sa_(sa), sb_(sb), margin_(margin) {}
 
   // Path of poses from the start to a fold at beta `fold`, empty when none within `max_cells`.
-  // Breadth-first (the quickest way out at this resolution); `greedy`: the cells nearest the fold
-  // first, which finds *a* way out visiting far fewer cells (reachability only).
-  std::vector<Pose> search(double fold, std::size_t max_cells, bool greedy = false) {
+  // Breadth-first: the quickest way out at this resolution or, with `aim` (the planned fold's alpha),
+  // the way out that is quickest counting the folded turn to `aim` still to come after it (at one
+  // alpha step per step, as the middle phase turns). `greedy`: the cells nearest the fold first,
+  // which finds *a* way out visiting far fewer cells (reachability only).
+  std::vector<Pose> search(double fold, std::size_t max_cells, bool greedy = false, std::optional<double> aim = {}) {
     const AngleLimits& l = r_.limits();
     // The outermost cell on each side may be a partial step that lands exactly on the limit
     // (pose() clamps): robots caught against a stop often get out only along it.
@@ -39,75 +42,45 @@ class RobotGrid {
     const int a_hi = static_cast<int>(std::ceil((l.alpha_max_deg - start_.alpha_deg) / sa_ - 1e-9));
     const int b_lo = -static_cast<int>(std::ceil((start_.beta_deg - l.beta_min_deg) / sb_ - 1e-9));
     const int b_hi = static_cast<int>(std::ceil((l.beta_max_deg - start_.beta_deg) / sb_ - 1e-9));
-    auto key = [](int a, int b) { return (static_cast<std::int64_t>(a) << 32) ^ static_cast<std::uint32_t>(b); };
-    std::unordered_map<std::int64_t, std::int64_t> parent;  // cell -> previous cell
-    std::deque<std::pair<int, int>> q;
-    std::priority_queue<std::tuple<double, int, int>, std::vector<std::tuple<double, int, int>>, std::greater<>> near;
-    auto push = [&](int a, int b) {
-      if (greedy) near.push({std::abs(pose(a, b).beta_deg - fold), a, b});
-      else q.push_back({a, b});
-    };
-    auto pop = [&] {
-      std::pair<int, int> c;
-      if (greedy) {
-        c = {std::get<1>(near.top()), std::get<2>(near.top())};
-        near.pop();
-      } else {
-        c = q.front();
-        q.pop_front();
-      }
-      return c;
-    };
-    auto empty = [&] { return greedy ? near.empty() : q.empty(); };
-    parent.reserve(4096);
-    parent[key(0, 0)] = key(0, 0);
-    push(0, 0);
-    const double c_start = clearance(start_);
-    auto cell_clear = [&](int a, int b) {
-      auto it = clr_.find(key(a, b));
-      if (it != clr_.end()) return it->second;
-      const double c = clearance(pose(a, b));
-      clr_[key(a, b)] = c;
-      return c;
-    };
-    clr_[key(0, 0)] = c_start;
+    parent_.clear();
+    parent_.reserve(4096);
+    Frontier frontier(greedy);
+    parent_[key(0, 0)] = key(0, 0);
+    frontier.push({0, 0, 0}, 0.0);
+    clr_[key(0, 0)] = clearance(start_);
     exhausted_ = false;
-    while (!empty() && parent.size() < max_cells) {
-      const auto [a, b] = pop();
-      const Pose p = pose(a, b);
-      const double cp = cell_clear(a, b);
+    Finish best;
+    while (!frontier.empty() && parent_.size() < max_cells) {
+      const Cell c = frontier.pop();
+      if (c.depth >= best.cost) break;  // nothing deeper finishes sooner
+      const Pose p = pose(c.a, c.b);
+      const double cp = cell_clear(c.a, c.b);
       // Within one step of the fold: finish there if that last step is clear.
       if (std::abs(p.beta_deg - fold) <= sb_ + 1e-9) {
         const Pose f{p.alpha_deg, fold};
-        const double cf = clearance(f);
+        const double cf = p == f ? cp : clearance(f);
         if (p == f || (cf >= std::min(margin_, cp) && edge_ok(p, f, cp, cf))) {
-          std::vector<Pose> path{f};
-          if (!(p == f)) path.push_back(p);
-          for (std::int64_t k = key(a, b); k != key(0, 0);) {
-            k = parent[k];
-            const int ka = static_cast<int>(k >> 32), kb = static_cast<int>(static_cast<std::int32_t>(k & 0xffffffff));
-            path.push_back(pose(ka, kb));
-          }
-          std::reverse(path.begin(), path.end());
-          return path;
+          const double cost = c.depth + (p == f ? 0 : 1) + (aim ? std::abs(p.alpha_deg - *aim) / sa_ : 0.0);
+          if (cost < best.cost - 1e-9) best = {c, f, cost};
+          if (!aim) break;
         }
       }
       for (int da = -1; da <= 1; ++da)
         for (int db = -1; db <= 1; ++db) {
           if (da == 0 && db == 0) continue;
-          const int a2 = a + da, b2 = b + db;
+          const int a2 = c.a + da, b2 = c.b + db;
           if (a2 < a_lo || a2 > a_hi || b2 < b_lo || b2 > b_hi) continue;
-          if (parent.count(key(a2, b2))) continue;
+          if (parent_.count(key(a2, b2))) continue;
           const double c2 = cell_clear(a2, b2);
           if (c2 < std::min(margin_, cp) || !edge_ok(p, pose(a2, b2), cp, c2)) continue;
-          parent[key(a2, b2)] = key(a, b);
-          push(a2, b2);
+          parent_[key(a2, b2)] = key(c.a, c.b);
+          frontier.push({a2, b2, c.depth + 1}, std::abs(pose(a2, b2).beta_deg - fold));
         }
     }
-    exhausted_ = empty();
+    if (best.cost < std::numeric_limits<double>::infinity()) return path_to(best);
+    exhausted_ = frontier.empty();
     return {};
   }
-
 
   // Whether the last search() ran out of cells to visit (a closed region at this resolution), as
   // opposed to reaching its cell limit or a fold.
@@ -133,6 +106,64 @@ class RobotGrid {
     return path;
   }
  private:
+  struct Cell {
+    int a, b, depth;
+  };
+  // Where a search finishes: the cell, the fold pose reached from it, and its cost in steps.
+  struct Finish {
+    Cell cell{0, 0, 0};
+    Pose fold{};
+    double cost = std::numeric_limits<double>::infinity();
+  };
+  // The cells still to visit: first in, first out (breadth-first), or nearest the fold first.
+  class Frontier {
+   public:
+    explicit Frontier(bool greedy) : greedy_(greedy) {}
+    void push(Cell c, double to_fold) {
+      if (greedy_) near_.push({to_fold, c.a, c.b, c.depth});
+      else fifo_.push_back(c);
+    }
+    Cell pop() {
+      if (!greedy_) {
+        const Cell c = fifo_.front();
+        fifo_.pop_front();
+        return c;
+      }
+      const auto [d, a, b, depth] = near_.top();
+      near_.pop();
+      return {a, b, depth};
+    }
+    [[nodiscard]] bool empty() const { return greedy_ ? near_.empty() : fifo_.empty(); }
+
+   private:
+    bool greedy_;
+    std::deque<Cell> fifo_;
+    std::priority_queue<std::tuple<double, int, int, int>, std::vector<std::tuple<double, int, int, int>>, std::greater<>> near_;
+  };
+
+  static std::int64_t key(int a, int b) noexcept { return (static_cast<std::int64_t>(a) << 32) ^ static_cast<std::uint32_t>(b); }
+
+  double cell_clear(int a, int b) {
+    auto it = clr_.find(key(a, b));
+    if (it != clr_.end()) return it->second;
+    const double c = clearance(pose(a, b));
+    clr_[key(a, b)] = c;
+    return c;
+  }
+
+  // The poses from the start to the finish, through the last search's parents.
+  std::vector<Pose> path_to(const Finish& f) const {
+    std::vector<Pose> path{f.fold};
+    const Pose last = pose(f.cell.a, f.cell.b);
+    if (!(last == f.fold)) path.push_back(last);
+    for (std::int64_t k = key(f.cell.a, f.cell.b); k != key(0, 0);) {
+      k = parent_.at(k);
+      path.push_back(pose(static_cast<int>(k >> 32), static_cast<int>(static_cast<std::int32_t>(k & 0xffffffff))));
+    }
+    std::reverse(path.begin(), path.end());
+    return path;
+  }
+
   [[nodiscard]] Pose pose(int a, int b) const noexcept {
     const AngleLimits& l = r_.limits();
     return {std::clamp(start_.alpha_deg + a * sa_, l.alpha_min_deg, l.alpha_max_deg),
@@ -162,6 +193,7 @@ class RobotGrid {
   Pose start_;
   double sa_, sb_, margin_;
   std::unordered_map<std::int64_t, double> clr_;
+  std::unordered_map<std::int64_t, std::int64_t> parent_;  // cell -> previous cell, of the last search
   bool exhausted_ = false;
 };
 
@@ -185,17 +217,19 @@ std::array<std::pair<double, double>, 3> grid_levels(const StepperOptions& o) {
   return {{{1.0, o.margin_mm}, {0.5, fine_margin}, {0.25, fine_margin}}};
 }
 
-// The search on the engine's grid first; where that finds no way out, on grids of half and a
+// A way to a fold at `goal`'s beta, aiming at its alpha (RobotGrid::search). The search on the
+// engine's grid first; where that finds no way out, on grids of half and a
 // quarter of the step (each step then takes as much less time, the speed stays the same) that
 // keep a smaller margin. The robots left after the engine are mostly caught in narrow passages
 // between a fixed obstacle and an alpha stop, which the coarse grid with the full margin cannot
 // thread (they are not closed pockets: with only the obstacles present, every start pose of the
 // bench problems reaches a fold on a 0.25 deg grid).
-GridPath find_fold(const Positioner& r, const std::vector<Fixed>& fixed, Pose start, double fold, const StepperOptions& o,
+GridPath find_fold(const Positioner& r, const std::vector<Fixed>& fixed, Pose start, Pose goal, const StepperOptions& o,
                    std::size_t max_cells) {
+  const double fold = goal.beta_deg;
   for (const auto& [f, margin] : grid_levels(o)) {
     RobotGrid g(r, fixed, start, o.alpha_step_deg * f, o.beta_step_deg * f, margin);
-    std::vector<Pose> p = g.search(fold, max_cells);
+    std::vector<Pose> p = g.search(fold, max_cells, false, goal.alpha_deg);
     if (!p.empty()) return {std::move(p), o.dt_s * f};
   }
   return {};
@@ -353,7 +387,7 @@ class Untangler {
       }
       const double fold = robots_[i].goal.beta_deg;
       double start = std::max(t, cut_[i]);
-      GridPath path = find_fold(model_.robot(i), around(i, segs_), poses_[i], fold, o_, max_cells_);
+      GridPath path = find_fold(model_.robot(i), around(i, segs_), poses_[i], robots_[i].goal, o_, max_cells_);
       if (path.poses.empty() && std::none_of(moving_.begin(), moving_.end(), [](bool b) { return b; })) {
         // Nothing moves in this wave yet: the turns go first, the wave starts after them.
         start = std::max(start, rest_around(i));
@@ -415,7 +449,7 @@ class Untangler {
     if (turns.empty()) return {};
     std::vector<Segment> segs2 = segs_;
     for (const auto& [j, w] : turns) segs2[j] = model_.robot(j).collision_segment(w.back());
-    GridPath path = find_fold(model_.robot(i), around(i, segs2), poses_[i], fold, o_, max_cells_);
+    GridPath path = find_fold(model_.robot(i), around(i, segs2), poses_[i], robots_[i].goal, o_, max_cells_);
     if (path.poses.empty()) return {};
     for (const auto& [j, w] : turns) {
       append_path(result_.paths[j], w, t, o_.dt_s);

@@ -1,6 +1,7 @@
 // Untangling after a half: robots the lock-step engine left away from their fold are planned one
-// at a time on a grid of their own two angles, everyone else standing still, to *any* fold (beta at
-// the fold angle, whatever alpha: the turn to the planned fold alpha happens later, while folded).
+// at a time on a grid of their own two angles, everyone else standing still, to a fold (beta at the
+// fold angle) at any alpha: the turn to the planned fold alpha happens later, while folded, and the
+// search picks the fold that makes the way out and that turn together quickest.
 //
 // With one robot moving and every other body still, the step certificate is exact: a point of the
 // collision segment moves at most |d alpha| * reach + |d beta| * collision length over a step, so
